@@ -1,0 +1,26 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <vector>
+
+#include "turtlegas/sim/events.hpp"
+#include "turtlegas/sim/toi.hpp"
+#include "turtlegas/sim/world.hpp"
+#include "turtlegas/sim/world_def.hpp"
+
+// Slow, obviously-correct references that tests cross-check the engine against.
+namespace turtlegas::sim::reference {
+
+/// Deepest overlap among discs (ball-ball) and between discs and segments, found with a hash
+/// grid built from scratch (independent of the engine's grid). Periodic arenas use the minimum
+/// image when width/height are > 0. ball_pairs false checks discs against walls only.
+Overlap overlap(const std::vector<Vec2>& pos, const std::vector<double>& radius,
+                const std::vector<bool>& alive, const std::vector<Segment>& walls,
+                double periodic_width = 0.0, double periodic_height = 0.0, bool ball_pairs = true);
+
+/// Exact-mode events up to t_end found by brute force: every pair and every wall checked after
+/// every event, O(N^2) per event, no grid, no event queue. Same contact rules as the engine.
+/// Boundaries `none` and `walls` only. Returns the events and leaves final states in *final.
+std::vector<Event> events(const WorldDef& def, double t_end, std::vector<BallState>* final = nullptr);
+
+}  // namespace turtlegas::sim::reference

@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "turtlegas/sim/events.hpp"
+#include "turtlegas/sim/world_def.hpp"
+
+namespace turtlegas::sim {
+
+/// Counters a run accumulates. Collisions are physical contacts; events also count internal
+/// bookkeeping (cell crossings, step boundaries, stale predictions).
+struct Stats {
+  std::uint64_t ball_ball = 0;
+  std::uint64_t ball_wall = 0;
+  std::uint64_t ball_wall_end = 0;
+  std::uint64_t exits = 0;
+  std::uint64_t cell_crossings = 0;  ///< exact mode
+  std::uint64_t stale = 0;           ///< predictions found invalid when their time came
+  std::uint64_t steps = 0;           ///< step mode: completed steps
+  std::uint64_t events = 0;          ///< everything taken off the event queue
+  std::uint64_t collisions() const { return ball_ball + ball_wall + ball_wall_end; }
+};
+
+/// Position and velocity of one ball at the world's current time.
+struct BallState {
+  Vec2 pos;
+  Vec2 vel;
+  bool alive = true;  ///< false once the ball has exited
+};
+
+/// Overlap found by World::measure_overlap, in world units and as a fraction of the smaller radius.
+struct Overlap {
+  double depth = 0.0;
+  double relative = 0.0;
+};
+
+/// The GAS engine: balls and walls in a uniform grid, advanced in `exact` or `step` mode.
+///
+/// The physics is chosen once, at construction, from the effects the scene declares: a scene
+/// without gravity runs straight-line flights, one with `ball_ball` false never looks at ball
+/// pairs. See docs/physics.md for the model and engine.cpp for the order of one step.
+class World {
+ public:
+  /// Throws std::invalid_argument with the validate() message if the scene is not valid, or
+  /// if a requested cell size breaks the memo's rule in step mode.
+  World(const WorldDef& def, Mode mode);
+  ~World();
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+
+  /// Runs the physics until time t (seconds; t >= time()). Output at any t in both modes: in step
+  /// mode a stop inside a step leaves the step's remaining events for the next call, so the
+  /// physics does not depend on how a run is cut into calls.
+  void advance_to(double t);
+
+  /// When set, every physical event is appended to *log (nullptr stops logging).
+  void set_event_log(std::vector<Event>* log);
+
+  double time() const;
+  Mode mode() const;
+  double dt() const;
+  /// The cell side actually used (world units), and the grid size without the perimeter ring.
+  double cell_size() const;
+  int cells_x() const;
+  int cells_y() const;
+
+  std::size_t ball_count() const;
+  BallState ball(std::size_t i) const;
+  double radius(std::size_t i) const;
+  double mass(std::size_t i) const;
+  /// All walls, the scene's followed by the arena's (boundary `walls`).
+  const std::vector<WallDef>& walls() const;
+
+  /// Kinetic plus gravitational potential energy of the live balls; the potential of a ball is
+  /// -m g.x, zero at the origin.
+  double energy() const;
+  const Stats& stats() const;
+  /// Deepest ball-ball or ball-wall overlap right now (brute force over grid neighbours).
+  Overlap measure_overlap() const;
+  /// Largest overlap seen at any collision so far.
+  Overlap max_contact_overlap() const;
+
+  class Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace turtlegas::sim

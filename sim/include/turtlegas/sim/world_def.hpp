@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "turtlegas/sim/vec2.hpp"
+
+namespace turtlegas::sim {
+
+/// What happens at the arena's edges.
+enum class Boundary {
+  none,      ///< the arena only bounds the grid; a ball whose centre leaves it is removed (`exit`)
+  walls,     ///< four walls on the edges (ids `arena-bottom`, `arena-right`, `arena-top`, `arena-left`)
+  periodic,  ///< opposite edges are identified
+};
+
+/// How time advances.
+enum class Mode {
+  exact,  ///< continuous-time, event-driven; analytic flights under fields
+  step,   ///< the memo's algorithm: fixed dt, earliest collision first inside a step, field kicks between steps
+};
+
+/// The rectangle (0,0)-(width,height) that the grid covers.
+struct ArenaDef {
+  double width = 1600.0;   ///< world units
+  double height = 1600.0;  ///< world units
+  /// Requested grid cell side in world units; empty chooses it by the memo's rule.
+  std::optional<double> cell;
+  Boundary boundary = Boundary::none;
+};
+
+/// The physics a scene asks for. Anything left at its default costs nothing at run time.
+struct EffectsDef {
+  Vec2 gravity{};            ///< uniform acceleration, units/s^2
+  Vec2 electric{};           ///< uniform field; acceleration charge/mass * E (not simulated yet)
+  double magnetic = 0.0;     ///< field normal to the plane (not simulated yet)
+  double restitution = 1.0;  ///< e in [0, 1]: the memo's "2 replaced by 1+e"
+  bool ball_ball = true;     ///< whether balls collide with each other
+  /// Inelastic-collapse threshold t_c in seconds (see docs/physics.md): a ball-ball collision of a
+  /// ball whose previous collision was less than t_c ago is elastic (the TC rule, used only when
+  /// restitution < 1), and a ball pressed onto a wall or wall end by gravity never leaves it slower
+  /// than g_n t_c / 2, so it hops for at least t_c (the rest threshold).
+  double tc = 1e-4;
+};
+
+/// A line-segment wall. Its two ends are collision objects of their own.
+struct WallDef {
+  std::string id;
+  Vec2 from;
+  Vec2 to;
+};
+
+/// A disc ("ball", a gas molecule).
+struct BallDef {
+  std::string id;
+  Vec2 pos;            ///< centre, world units
+  Vec2 vel;            ///< units/s
+  double radius = 1.0;
+  double mass = 1.0;
+  double charge = 0.0;
+};
+
+/// A whole scene, independent of any file format.
+struct WorldDef {
+  std::string name;
+  std::uint64_t seed = 1;
+  double dt = 1.0 / 30.0;  ///< step of `step` mode, seconds (the memo's 1/30 s)
+  ArenaDef arena;
+  EffectsDef effects;
+  std::vector<WallDef> walls;
+  std::vector<BallDef> balls;
+};
+
+/// A problem with a WorldDef, naming the offending object.
+struct DefProblem {
+  enum class Where { world, arena, effects, wall, ball };
+  Where where = Where::world;
+  std::size_t index = 0;  ///< index into walls or balls, when `where` is one of them
+  std::string field;      ///< the offending field ("radius", "pos", ...), may be empty
+  std::string message;    ///< one line, says what is wrong and how to fix it
+};
+
+/// Checks a scene for everything the engine relies on: finite numbers, positive radii and masses,
+/// non-zero-length walls, unique ids, balls inside the arena and not overlapping each other or a
+/// wall, restitution in [0, 1]. Returns the first problem found, if any. O(N) expected time.
+std::optional<DefProblem> validate(const WorldDef& def);
+
+/// The arena walls that `Boundary::walls` adds, in the order and with the ids the engine uses.
+std::vector<WallDef> arena_walls(const ArenaDef& arena);
+
+}  // namespace turtlegas::sim

@@ -1,0 +1,145 @@
+// SPDX-License-Identifier: MIT
+#include "cell_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace turtlegas::sim::detail {
+namespace {
+
+// Liang-Barsky: does segment p->q meet the closed box [x0,x1] x [y0,y1]?
+bool segment_meets_box(Vec2 p, Vec2 q, double x0, double y0, double x1, double y1) {
+  double t0 = 0.0, t1 = 1.0;
+  const Vec2 d = q - p;
+  const double pk[4] = {-d.x, d.x, -d.y, d.y};
+  const double qk[4] = {p.x - x0, x1 - p.x, p.y - y0, y1 - p.y};
+  for (int k = 0; k < 4; ++k) {
+    if (pk[k] == 0.0) {
+      if (qk[k] < 0.0) return false;
+    } else {
+      const double r = qk[k] / pk[k];
+      if (pk[k] < 0.0) t0 = std::max(t0, r);
+      else t1 = std::min(t1, r);
+      if (t0 > t1) return false;
+    }
+  }
+  return true;
+}
+
+// Turns (cell, item) pairs into compressed rows: start offsets per cell plus the items, sorted and
+// without repeats. Two passes over the pairs, no per-cell containers, so empty cells cost 4 bytes.
+template <class T>
+void compress(std::size_t cells, std::vector<std::pair<std::uint32_t, T>>& pairs,
+              std::vector<std::uint32_t>& start, std::vector<T>& items) {
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  start.assign(cells + 1, 0);
+  for (const auto& pr : pairs) ++start[pr.first + 1];
+  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+  items.clear();
+  items.reserve(pairs.size());
+  for (const auto& pr : pairs) items.push_back(pr.second);
+  pairs.clear();
+  pairs.shrink_to_fit();
+}
+
+}  // namespace
+
+CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
+                   const std::vector<Segment>& walls, const std::vector<WallEnd>& ends)
+    : width_(width), height_(height), periodic_(periodic) {
+  nx_ = std::max(1, static_cast<int>(std::floor(width / min_cell)));
+  ny_ = std::max(1, static_cast<int>(std::floor(height / min_cell)));
+  cw_ = width / nx_;
+  ch_ = height / ny_;
+  if (static_cast<double>(nx_ + 2) * (ny_ + 2) > 2.0e8)
+    throw std::invalid_argument("the grid would need more than 2e8 cells; set a larger arena.cell");
+  for (int sy = 0; sy < 3; ++sy)
+    for (int sx = 0; sx < 3; ++sx) shifts_[sy * 3 + sx] = {(sx - 1) * width, (sy - 1) * height};
+
+  const auto n = static_cast<std::size_t>(cell_count());
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> wl, el;
+  // A little slack so that a wall running exactly along a grid line is listed on both sides.
+  const double sx = 1e-9 * cw_, sy = 1e-9 * ch_;
+  auto col = [&](double x) { return std::clamp(static_cast<int>(std::floor(x / cw_)) + 1, 0, nx_ + 1); };
+  auto row = [&](double y) { return std::clamp(static_cast<int>(std::floor(y / ch_)) + 1, 0, ny_ + 1); };
+  for (std::uint32_t w = 0; w < walls.size(); ++w) {
+    const Vec2 p = walls[w].p1, q = walls[w].p1 + walls[w].len * walls[w].u;
+    const int ix0 = col(std::min(p.x, q.x) - sx), ix1 = col(std::max(p.x, q.x) + sx);
+    const int iy0 = row(std::min(p.y, q.y) - sy), iy1 = row(std::max(p.y, q.y) + sy);
+    for (int iy = iy0; iy <= iy1; ++iy)
+      for (int ix = ix0; ix <= ix1; ++ix) {
+        // Ring cells extend to infinity outward so that walls beyond the grid are still listed.
+        const double x0 = ix == 0 ? -INFINITY : x_edge(ix - 1) - sx;
+        const double x1 = ix == nx_ + 1 ? INFINITY : x_edge(ix) + sx;
+        const double y0 = iy == 0 ? -INFINITY : y_edge(iy - 1) - sy;
+        const double y1 = iy == ny_ + 1 ? INFINITY : y_edge(iy) + sy;
+        if (segment_meets_box(p, q, x0, y0, x1, y1)) wl.emplace_back(index(ix, iy), w);
+      }
+  }
+  for (std::uint32_t e = 0; e < ends.size(); ++e) el.emplace_back(index(col(ends[e].p.x), row(ends[e].p.y)), e);
+
+  // Deduplicated 3x3 neighbourhoods of the arena cells: every listed item is pushed to the arena
+  // cells around the cell that lists it, with the shift under which they see it.
+  std::vector<std::pair<std::uint32_t, Near>> nw, ne;
+  auto spread = [&](const std::vector<std::pair<std::uint32_t, std::uint32_t>>& src,
+                    std::vector<std::pair<std::uint32_t, Near>>& out) {
+    for (const auto& [cell, item] : src) {
+      const int ix = ix_of(static_cast<int>(cell)), iy = iy_of(static_cast<int>(cell));
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          int jx = ix + dx, jy = iy + dy;
+          Vec2 seen_shift{};
+          if (periodic_) {
+            // The arena cell (jx, jy) sees this item across the seam with the opposite shift.
+            if (jx < 1) { jx += nx_; seen_shift.x = width_; }
+            else if (jx > nx_) { jx -= nx_; seen_shift.x = -width_; }
+            if (jy < 1) { jy += ny_; seen_shift.y = height_; }
+            else if (jy > ny_) { jy -= ny_; seen_shift.y = -height_; }
+            if (ix < 1 || ix > nx_ || iy < 1 || iy > ny_) continue;  // ring cells are unused
+          }
+          if (jx < 1 || jx > nx_ || jy < 1 || jy > ny_) continue;
+          out.emplace_back(index(jx, jy), Near{item, shift_index(seen_shift)});
+        }
+    }
+  };
+  spread(wl, nw);
+  spread(el, ne);
+  compress(n, wl, wall_start_, wall_items_);
+  compress(n, el, end_start_, end_items_);
+  compress(n, nw, near_wall_start_, near_walls_);
+  compress(n, ne, near_end_start_, near_ends_);
+}
+
+int CellGrid::arena_cell_of(Vec2 p) const {
+  const int ix = std::clamp(static_cast<int>(std::floor(p.x / cw_)) + 1, 1, nx_);
+  const int iy = std::clamp(static_cast<int>(std::floor(p.y / ch_)) + 1, 1, ny_);
+  return index(ix, iy);
+}
+
+CellGrid::Neighbour CellGrid::neighbour(int ix, int iy, int dx, int dy) const {
+  int jx = ix + dx, jy = iy + dy;
+  Vec2 shift{};
+  if (periodic_) {
+    if (jx < 1) { jx += nx_; shift.x = -width_; }
+    else if (jx > nx_) { jx -= nx_; shift.x = width_; }
+    if (jy < 1) { jy += ny_; shift.y = -height_; }
+    else if (jy > ny_) { jy -= ny_; shift.y = height_; }
+  }
+  return {index(jx, jy), shift};
+}
+
+std::uint32_t CellGrid::shift_index(Vec2 s) const {
+  const int sx = s.x < 0.0 ? 0 : (s.x > 0.0 ? 2 : 1);
+  const int sy = s.y < 0.0 ? 0 : (s.y > 0.0 ? 2 : 1);
+  return static_cast<std::uint32_t>(sy * 3 + sx);
+}
+
+std::size_t CellGrid::memory_bytes() const {
+  return sizeof(std::uint32_t) * (wall_start_.capacity() + wall_items_.capacity() + end_start_.capacity() +
+                                  end_items_.capacity() + near_wall_start_.capacity() + near_end_start_.capacity()) +
+         sizeof(Near) * (near_walls_.capacity() + near_ends_.capacity());
+}
+
+}  // namespace turtlegas::sim::detail

@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <compare>
+#include <cstdint>
+#include <vector>
+
+#include "turtlegas/sim/toi.hpp"
+#include "turtlegas/sim/vec2.hpp"
+
+namespace turtlegas::sim::detail {
+
+/// A wall end point, shared by every wall that ends there.
+struct WallEnd {
+  Vec2 p;
+  std::uint32_t wall = 0;  ///< the first wall that owns it (named in events)
+};
+
+/// The memo's table: nx by ny cells over the arena plus a ring of perimeter cells, so
+/// (nx+2) x (ny+2) in all. Cell (ix, iy), ix in [0, nx+1], covers
+/// [(ix-1) w, ix w] x [(iy-1) h, iy h]; arena cells have ix in [1, nx]. Cells are squares of the
+/// requested side when it divides the arena, otherwise stretched so a whole number fit.
+/// Walls are listed in every cell they pass through, wall ends in the cell that holds them.
+class CellGrid {
+ public:
+  CellGrid() = default;
+  CellGrid(double width, double height, double min_cell, bool periodic,
+           const std::vector<Segment>& walls, const std::vector<WallEnd>& ends);
+
+  int nx() const { return nx_; }
+  int ny() const { return ny_; }
+  int stride() const { return nx_ + 2; }
+  int cell_count() const { return (nx_ + 2) * (ny_ + 2); }
+  double cell_w() const { return cw_; }
+  double cell_h() const { return ch_; }
+  double width() const { return width_; }
+  double height() const { return height_; }
+  bool periodic() const { return periodic_; }
+
+  int index(int ix, int iy) const { return iy * stride() + ix; }
+  int ix_of(int cell) const { return cell % stride(); }
+  int iy_of(int cell) const { return cell / stride(); }
+  /// The arena cell holding p (clamped into the arena cells).
+  int arena_cell_of(Vec2 p) const;
+  /// The grid line between columns k and k+1 (rows, for y_edge); exact at the arena's edges.
+  double x_edge(int k) const { return k < nx_ ? k * cw_ : width_ + (k - nx_) * cw_; }
+  double y_edge(int k) const { return k < ny_ ? k * ch_ : height_ + (k - ny_) * ch_; }
+
+  /// Neighbour (ix+dx, iy+dy) of an arena cell, wrapped when periodic; `shift` is what to add to
+  /// the positions of objects listed there to see them from the original cell.
+  struct Neighbour {
+    int cell;
+    Vec2 shift;
+  };
+  Neighbour neighbour(int ix, int iy, int dx, int dy) const;
+
+  /// Walls passing through a cell, and wall ends inside it.
+  const std::uint32_t* walls_begin(int cell) const { return wall_items_.data() + wall_start_[cell]; }
+  const std::uint32_t* walls_end(int cell) const { return wall_items_.data() + wall_start_[cell + 1]; }
+  const std::uint32_t* ends_begin(int cell) const { return end_items_.data() + end_start_[cell]; }
+  const std::uint32_t* ends_end(int cell) const { return end_items_.data() + end_start_[cell + 1]; }
+
+  /// Walls and ends within the 3x3 neighbourhood of an arena cell, each listed once with the
+  /// shift (index into shifts()) under which it is seen; built for exact mode's full rescans.
+  struct Near {
+    std::uint32_t item;
+    std::uint32_t shift;
+    friend auto operator<=>(const Near&, const Near&) = default;
+  };
+  const Near* near_walls_begin(int cell) const { return near_walls_.data() + near_wall_start_[cell]; }
+  const Near* near_walls_end(int cell) const { return near_walls_.data() + near_wall_start_[cell + 1]; }
+  const Near* near_ends_begin(int cell) const { return near_ends_.data() + near_end_start_[cell]; }
+  const Near* near_ends_end(int cell) const { return near_ends_.data() + near_end_start_[cell + 1]; }
+  Vec2 shift(std::uint32_t k) const { return shifts_[k]; }
+  std::uint32_t shift_index(Vec2 s) const;
+
+  std::size_t memory_bytes() const;
+
+ private:
+  int nx_ = 1, ny_ = 1;
+  double cw_ = 1.0, ch_ = 1.0, width_ = 1.0, height_ = 1.0;
+  bool periodic_ = false;
+  std::vector<std::uint32_t> wall_start_, wall_items_, end_start_, end_items_;
+  std::vector<std::uint32_t> near_wall_start_, near_end_start_;
+  std::vector<Near> near_walls_, near_ends_;
+  Vec2 shifts_[9];
+};
+
+}  // namespace turtlegas::sim::detail

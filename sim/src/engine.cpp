@@ -1,0 +1,839 @@
+// SPDX-License-Identifier: MIT
+//
+// The GAS engine. One class template, instantiated once per combination of the physics a scene
+// can ask for (straight flights or parabolas under gravity; ball-ball collisions on or off; exact
+// or step mode), chosen when the World is built, so nothing is decided per collision.
+//
+// Order of work, exact mode (event-driven):
+//   1. Every ball holds one pending prediction: its earliest collision among the objects in its
+//      3x3 cell neighbourhood, and the time it leaves its cell. An indexed heap orders balls by the
+//      earlier of the two. Balls keep their own local time; a ball is moved only when an event
+//      touches it.
+//   2. Pop the earliest ball. A collision whose partner ball has changed course since the
+//      prediction (its collision counter moved on) is stale: re-predict and go on.
+//   3. A collision: bring the ball(s) to the event time, apply the memo's response, bump their
+//      counters, log the event, predict afresh for each.
+//   4. A cell crossing: move the ball to the next cell (wrap it in a periodic arena, remove it
+//      with an `exit` event when it leaves an open arena), look only at the strip of cells that
+//      has just come into its neighbourhood, and keep the earlier of that and its old prediction.
+//
+// Order of work, step mode (the memo's algorithm, AI Memo 272):
+//   1. At the start of a step all balls are at the same time. Balls are listed in the cell of their
+//      centre. Each ball predicts its earliest collision within the step among the objects in the
+//      cells its path can reach (the memo's rule makes that the 3x3 neighbourhood).
+//   2. Take the earliest collision in the step, make it happen, re-predict the balls it changed;
+//      repeat until no collision is left in the step (steps 2 and 3 of exact mode, without cells).
+//   3. Move every ball to the end of the step and apply the field kick v += a dt. Balls outside an
+//      open arena exit; a periodic arena wraps them.
+#include "engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "cell_grid.hpp"
+#include "event_queue.hpp"
+#include "turtlegas/sim/reference.hpp"
+#include "turtlegas/sim/toi.hpp"
+
+namespace turtlegas::sim::detail {
+namespace {
+
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+/// Straight-line flight: no field acts between events.
+struct FreeFlight {
+  static constexpr bool kAccelerates = false;
+  Vec2 a{};
+  Vec2 pos(Vec2 x, Vec2 v, double dt) const { return x + dt * v; }
+  Vec2 vel(Vec2 v, double) const { return v; }
+  static AxisExit exit(double x, double v, double lo, double hi) {
+    if (v > 0.0) return {std::max(0.0, (hi - x) / v), true};
+    if (v < 0.0) return {std::max(0.0, (lo - x) / v), false};
+    return {};
+  }
+  AxisExit exit_x(double x, double v, double lo, double hi) const { return exit(x, v, lo, hi); }
+  AxisExit exit_y(double y, double v, double lo, double hi) const { return exit(y, v, lo, hi); }
+};
+
+/// Parabolic flight under a uniform acceleration shared by all balls (gravity).
+struct GravityFlight {
+  static constexpr bool kAccelerates = true;
+  Vec2 a{};
+  Vec2 pos(Vec2 x, Vec2 v, double dt) const { return x + dt * v + (0.5 * dt * dt) * a; }
+  Vec2 vel(Vec2 v, double dt) const { return v + dt * a; }
+  AxisExit exit_x(double x, double v, double lo, double hi) const { return axis_exit(x, v, a.x, lo, hi); }
+  AxisExit exit_y(double y, double v, double lo, double hi) const { return axis_exit(y, v, a.y, lo, hi); }
+};
+
+/// One ball's state at its own local time t, kept in one cache line for the neighbour scans.
+struct Body {
+  Vec2 x;
+  Vec2 v;
+  double t = 0.0;
+  double r = 0.0;
+  std::uint32_t count = 0;  ///< bumped whenever the ball changes course
+  std::uint32_t cell = kNone;  ///< kNone once the ball has exited
+  std::uint32_t next = kNone;  ///< cell list links
+  std::uint32_t prev = kNone;
+};
+static_assert(sizeof(Body) == 64);
+
+enum class Partner : std::uint8_t { none, ball, wall, end };
+
+/// The earliest predicted collision of a ball, and when it leaves its cell (exact mode).
+struct Pending {
+  double t_coll = kNever;
+  double t_cross = kNever;
+  std::uint32_t partner = 0;
+  std::uint32_t partner_count = 0;
+  Partner kind = Partner::none;
+  std::uint8_t cross_dir = 0;  ///< 0: -x, 1: +x, 2: -y, 3: +y
+};
+
+// Who a ball collided with last, packed as kind << 30 | index: with straight relative motion a
+// pair that has just collided cannot meet again before one of them has another event, so the
+// prediction skips it rather than trusting the sign of a round-off-sized approach speed.
+constexpr std::uint32_t last_code(Partner k, std::uint32_t index) {
+  return (static_cast<std::uint32_t>(k) << 30) | index;
+}
+
+double path_length(Vec2 v, double dt) { return norm(v) * dt; }
+
+template <class Flight, bool kBallBall, bool kStep>
+class Engine final : public EngineBase {
+ public:
+  Engine(const WorldDef& def, Mode mode);
+
+  void advance_to(double t) override;
+  void set_event_log(std::vector<Event>* log) override { log_ = log; }
+  double time() const override { return t_base_ + now_; }
+  std::size_t ball_count() const override { return body_.size(); }
+  BallState ball(std::size_t i) const override {
+    const Body& b = body_[i];
+    const double dt = now_ - b.t;
+    return {flight_.pos(b.x, b.v, dt), flight_.vel(b.v, dt), b.cell != kNone};
+  }
+  double radius(std::size_t i) const override { return body_[i].r; }
+  double mass(std::size_t i) const override { return mass_[i]; }
+  const std::vector<WallDef>& walls() const override { return wall_defs_; }
+  double energy() const override;
+  const Stats& stats() const override { return stats_; }
+  Overlap measure_overlap() const override;
+  Overlap max_contact_overlap() const override { return max_contact_; }
+  double cell_size() const override { return std::min(grid_.cell_w(), grid_.cell_h()); }
+  int cells_x() const override { return grid_.nx(); }
+  int cells_y() const override { return grid_.ny(); }
+  Mode mode() const override { return kStep ? Mode::step : Mode::exact; }
+  double dt() const override { return dt_; }
+
+ private:
+  // Bookkeeping.
+  void link(std::uint32_t i, std::uint32_t cell);
+  void unlink(std::uint32_t i);
+  void sync(std::uint32_t i);
+  void log(EventKind kind, std::uint32_t a, std::uint32_t b) {
+    if (log_) log_->push_back({t_base_ + now_, kind, a, b});
+  }
+  void note_contact(double depth, double radius) {
+    if (depth > max_contact_.depth) max_contact_.depth = depth;
+    if (depth / radius > max_contact_.relative) max_contact_.relative = depth / radius;
+  }
+
+  // Predict.
+  void predict(std::uint32_t i);
+  void predict_strip(std::uint32_t i, int dir);
+  void consider_ball(std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift, Pending& p) const;
+  void consider_wall(std::uint32_t i, const Body& bi, std::uint32_t w, Vec2 shift, Pending& p) const;
+  void consider_end(std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift, Pending& p) const;
+  void predict_crossing(std::uint32_t i);
+  void schedule(std::uint32_t i) {
+    const Pending& p = pending_[i];
+    heap_.set(i, std::min(p.t_coll, p.t_cross));
+  }
+  int step_rings(double reach) const {
+    return static_cast<int>(std::floor(reach / std::min(grid_.cell_w(), grid_.cell_h()))) + 1;
+  }
+
+  // Apply.
+  void process(double limit);
+  void collide(std::uint32_t i);
+  void collide_balls(std::uint32_t i, std::uint32_t j);
+  void collide_wall(std::uint32_t i, std::uint32_t w);
+  void collide_end(std::uint32_t i, std::uint32_t e);
+  void cross(std::uint32_t i);
+  void remove(std::uint32_t i);
+  double restitution_for(std::uint32_t i) const;
+  Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n) const;
+  void after_change(std::uint32_t i);
+
+  // Time.
+  double rebase();
+  void begin_step();
+  void finish_step();
+
+  Flight flight_;
+  double e_ = 1.0;
+  double tc_ = 0.0;
+  bool inelastic_ = false;
+  Boundary boundary_ = Boundary::none;
+  double width_ = 0.0, height_ = 0.0;
+  double dt_ = 0.0;
+  Vec2 kick_{};
+
+  std::vector<Body> body_;
+  std::vector<double> mass_;
+  std::vector<std::uint32_t> last_;
+  std::vector<double> last_time_;  ///< only when restitution < 1 (the TC rule)
+  std::vector<Pending> pending_;
+  std::vector<std::uint32_t> head_;
+  EventQueue heap_;
+
+  std::vector<WallDef> wall_defs_;
+  std::vector<Segment> walls_;
+  std::vector<WallEnd> ends_;
+  CellGrid grid_;
+
+  double now_ = 0.0;     ///< internal time, relative to t_base_
+  double t_base_ = 0.0;  ///< external time of internal time zero
+  std::uint64_t events_since_rebase_ = 0;
+  std::uint64_t rebase_every_ = 0;
+
+  // Step mode.
+  std::uint64_t step_index_ = 0;
+  double rmax_ = 0.0;
+  double dmax_ = 0.0;              ///< largest path length of any ball in this step
+  std::vector<double> travel_;     ///< path length so far in this step
+  mutable std::vector<std::uint32_t> stamp_;  ///< de-duplicates walls and ends in ring scans
+  mutable std::uint32_t scan_ = 0;
+
+  Stats stats_;
+  Overlap max_contact_;
+  std::vector<Event>* log_ = nullptr;
+};
+
+template <class Flight, bool kBallBall, bool kStep>
+Engine<Flight, kBallBall, kStep>::Engine(const WorldDef& def, Mode) {
+  if (auto problem = validate(def)) throw std::invalid_argument(problem->message);
+  const EffectsDef& fx = def.effects;
+  if constexpr (kStep) kick_ = fx.gravity;
+  else flight_.a = fx.gravity;
+  e_ = fx.restitution;
+  tc_ = fx.tc;
+  inelastic_ = e_ < 1.0;
+  boundary_ = def.arena.boundary;
+  width_ = def.arena.width;
+  height_ = def.arena.height;
+  dt_ = def.dt;
+
+  wall_defs_ = def.walls;
+  if (boundary_ == Boundary::walls)
+    for (auto& w : arena_walls(def.arena)) wall_defs_.push_back(w);
+  for (const auto& w : wall_defs_) {
+    walls_.push_back(make_segment(w.from, w.to));
+    if (boundary_ == Boundary::periodic) {
+      for (Vec2 p : {w.from, w.to})
+        if (p.x < 0.0 || p.x > width_ || p.y < 0.0 || p.y > height_)
+          throw std::invalid_argument("wall '" + w.id + "' reaches outside a periodic arena; keep walls inside it");
+    }
+  }
+  // Wall ends, one per distinct point: a corner shared by two walls is one collision object.
+  for (std::uint32_t w = 0; w < wall_defs_.size(); ++w)
+    for (Vec2 p : {wall_defs_[w].from, wall_defs_[w].to}) ends_.push_back({p, w});
+  std::stable_sort(ends_.begin(), ends_.end(), [](const WallEnd& a, const WallEnd& b) {
+    return a.p.x != b.p.x ? a.p.x < b.p.x : a.p.y < b.p.y;
+  });
+  ends_.erase(std::unique(ends_.begin(), ends_.end(), [](const WallEnd& a, const WallEnd& b) { return a.p == b.p; }),
+              ends_.end());
+
+  const std::size_t n = def.balls.size();
+  double vmax = 0.0;
+  for (const auto& b : def.balls) {
+    rmax_ = std::max(rmax_, b.radius);
+    vmax = std::max(vmax, norm(b.vel));
+  }
+  // Cell size. Exact mode needs cells at least a diameter wide so that touching balls are always
+  // in neighbouring cells; step mode needs the memo's rule: a cell wider than any two balls' radii
+  // plus their paths in one step. Beyond that, aim for about two balls per cell.
+  const double area = width_ * height_;
+  const double rule = kStep ? 2.0 * (rmax_ + vmax * dt_) : 2.0 * rmax_;
+  double cell = 0.0;
+  if (def.arena.cell) {
+    cell = *def.arena.cell;
+    if (cell < rule) {
+      const std::string why = kStep
+          ? "the memo's rule in step mode needs cells wider than twice (largest radius + largest speed x dt) = " +
+                std::to_string(rule) + "; set arena.cell >= that, use a smaller dt, or use --mode exact"
+          : "exact mode needs cells at least as wide as the largest ball (diameter " + std::to_string(rule) +
+                "); set arena.cell >= that";
+      throw std::invalid_argument("arena.cell " + std::to_string(cell) + " is too small: " + why);
+    }
+  } else {
+    const double density_cell = n > 0 ? std::sqrt(2.0 * area / static_cast<double>(n)) : std::max(width_, height_) / 16.0;
+    cell = std::max(rule * (1.0 + 1e-9), density_cell);
+    cell = std::max(cell, std::sqrt(area / 4.0e7));  // keep the table under ~4e7 cells
+    // A periodic arena needs three cells across, so that no pair is seen through two images.
+    if (boundary_ == Boundary::periodic) cell = std::max(rule * (1.0 + 1e-9), std::min(cell, std::min(width_, height_) / 3.0));
+  }
+  const bool periodic = boundary_ == Boundary::periodic;
+  grid_ = CellGrid(width_, height_, cell, periodic, walls_, ends_);
+  if (periodic && (grid_.nx() < 3 || grid_.ny() < 3))
+    throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell) +
+                                "); enlarge the arena or use smaller balls");
+
+  body_.resize(n);
+  mass_.resize(n);
+  last_.assign(n, kNone);
+  if (inelastic_) last_time_.assign(n, -kNever);
+  pending_.assign(n, Pending{});
+  head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
+  heap_.reset(n);
+  if constexpr (kStep) {
+    travel_.assign(n, 0.0);
+    stamp_.assign(walls_.size() * 9 + ends_.size() * 9, 0);
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const BallDef& d = def.balls[i];
+    body_[i].x = d.pos;
+    body_[i].v = d.vel;
+    body_[i].r = d.radius;
+    mass_[i] = d.mass;
+    link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(d.pos)));
+  }
+  rebase_every_ = std::max<std::uint64_t>(4 * n, 4096);
+  if constexpr (kStep) {
+    begin_step();
+  } else {
+    for (std::uint32_t i = 0; i < n; ++i) {
+      predict(i);
+      predict_crossing(i);
+      schedule(i);
+    }
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::link(std::uint32_t i, std::uint32_t cell) {
+  Body& b = body_[i];
+  b.cell = cell;
+  b.prev = kNone;
+  b.next = head_[cell];
+  if (b.next != kNone) body_[b.next].prev = i;
+  head_[cell] = i;
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::unlink(std::uint32_t i) {
+  Body& b = body_[i];
+  if (b.prev != kNone) body_[b.prev].next = b.next;
+  else head_[b.cell] = b.next;
+  if (b.next != kNone) body_[b.next].prev = b.prev;
+  b.next = b.prev = kNone;
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::sync(std::uint32_t i) {
+  Body& b = body_[i];
+  const double dt = now_ - b.t;
+  if constexpr (kStep) travel_[i] += path_length(b.v, dt);
+  b.x = flight_.pos(b.x, b.v, dt);
+  b.v = flight_.vel(b.v, dt);
+  b.t = now_;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Predict
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::consider_ball(std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift,
+                                                     Pending& p) const {
+  if (j == i) return;
+  if (last_[i] == last_code(Partner::ball, j) && last_[j] == last_code(Partner::ball, i)) return;
+  const Body& bj = body_[j];
+  const double dtj = now_ - bj.t;
+  // Under uniform gravity both balls fall alike, so their relative motion is a straight line.
+  const Vec2 r = flight_.pos(bj.x, bj.v, dtj) + shift - bi.x;
+  const Vec2 v = flight_.vel(bj.v, dtj) - bi.v;
+  const double t = now_ + toi_disc_disc(r, v, bi.r + bj.r);
+  if (t < p.t_coll) {
+    p.t_coll = t;
+    p.kind = Partner::ball;
+    p.partner = j;
+    p.partner_count = bj.count;
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::consider_wall(std::uint32_t i, const Body& bi, std::uint32_t w, Vec2 shift,
+                                                     Pending& p) const {
+  if (!Flight::kAccelerates && last_[i] == last_code(Partner::wall, w)) return;
+  const Segment& s = walls_[w];
+  // Relative to the wall's first end, so walls far from the origin lose nothing.
+  const double t = now_ + toi_disc_segment(bi.x - (s.p1 + shift), bi.v, flight_.a, s, bi.r);
+  if (t < p.t_coll) {
+    p.t_coll = t;
+    p.kind = Partner::wall;
+    p.partner = w;
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::consider_end(std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift,
+                                                    Pending& p) const {
+  if (!Flight::kAccelerates && last_[i] == last_code(Partner::end, e)) return;
+  const Vec2 rel = bi.x - (ends_[e].p + shift);
+  double dt;
+  if constexpr (Flight::kAccelerates) dt = toi_disc_point_accel(rel, bi.v, flight_.a, bi.r, p.t_coll - now_);
+  else dt = toi_disc_point(rel, bi.v, bi.r);
+  const double t = now_ + dt;
+  if (t < p.t_coll) {
+    p.t_coll = t;
+    p.kind = Partner::end;
+    p.partner = e;
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::predict(std::uint32_t i) {
+  const Body& bi = body_[i];
+  Pending& p = pending_[i];
+  p.t_coll = kNever;
+  p.kind = Partner::none;
+  const int ix = grid_.ix_of(static_cast<int>(bi.cell)), iy = grid_.iy_of(static_cast<int>(bi.cell));
+  if constexpr (!kStep) {
+    if constexpr (kBallBall) {
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const auto nb = grid_.neighbour(ix, iy, dx, dy);
+          for (std::uint32_t j = head_[nb.cell]; j != kNone; j = body_[j].next) consider_ball(i, bi, j, nb.shift, p);
+        }
+    }
+    for (auto it = grid_.near_walls_begin(bi.cell); it != grid_.near_walls_end(bi.cell); ++it)
+      consider_wall(i, bi, it->item, grid_.shift(it->shift), p);
+    for (auto it = grid_.near_ends_begin(bi.cell); it != grid_.near_ends_end(bi.cell); ++it)
+      consider_end(i, bi, it->item, grid_.shift(it->shift), p);
+  }
+  if constexpr (kStep) {
+    // The memo's rule normally makes this the 3x3 neighbourhood; a ball sped up by a collision
+    // inside the step widens the search instead of missing a partner.
+    const double step_end = dt_;
+    const double d_i = travel_[i] + path_length(bi.v, step_end - now_);
+    dmax_ = std::max(dmax_, d_i);
+    const int kb = step_rings(bi.r + rmax_ + d_i + dmax_);
+    const int kw = step_rings(bi.r + d_i);
+    const bool periodic = grid_.periodic();
+    if (periodic && (2 * kb + 1 > grid_.nx() || 2 * kb + 1 > grid_.ny()))
+      throw std::runtime_error("step mode: a ball moves too far in one step for this periodic arena; use a smaller dt or --mode exact");
+    const int n1x = grid_.nx() + 1, n1y = grid_.ny() + 1;
+    if constexpr (kBallBall) {
+      for (int dy = -kb; dy <= kb; ++dy)
+        for (int dx = -kb; dx <= kb; ++dx) {
+          if (!periodic && (ix + dx < 1 || ix + dx > n1x - 1 || iy + dy < 1 || iy + dy > n1y - 1)) continue;
+          const auto nb = grid_.neighbour(ix, iy, dx, dy);
+          for (std::uint32_t j = head_[nb.cell]; j != kNone; j = body_[j].next) consider_ball(i, bi, j, nb.shift, p);
+        }
+    }
+    ++scan_;
+    for (int dy = -kw; dy <= kw; ++dy)
+      for (int dx = -kw; dx <= kw; ++dx) {
+        if (!periodic && (ix + dx < 0 || ix + dx > n1x || iy + dy < 0 || iy + dy > n1y)) continue;
+        const auto nb = grid_.neighbour(ix, iy, dx, dy);
+        const std::uint32_t s = grid_.shift_index(nb.shift);
+        for (auto it = grid_.walls_begin(nb.cell); it != grid_.walls_end(nb.cell); ++it) {
+          std::uint32_t& st = stamp_[*it * 9 + s];
+          if (st == scan_) continue;
+          st = scan_;
+          consider_wall(i, bi, *it, nb.shift, p);
+        }
+        for (auto it = grid_.ends_begin(nb.cell); it != grid_.ends_end(nb.cell); ++it) {
+          std::uint32_t& st = stamp_[walls_.size() * 9 + *it * 9 + s];
+          if (st == scan_) continue;
+          st = scan_;
+          consider_end(i, bi, *it, nb.shift, p);
+        }
+      }
+    if (p.t_coll > step_end) {
+      p.t_coll = kNever;
+      p.kind = Partner::none;
+    }
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::predict_strip(std::uint32_t i, int dir) {
+  // The three cells that have just come within the 3x3 neighbourhood after a crossing in `dir`.
+  const Body& bi = body_[i];
+  Pending& p = pending_[i];
+  const int ix = grid_.ix_of(static_cast<int>(bi.cell)), iy = grid_.iy_of(static_cast<int>(bi.cell));
+  const int ax = dir == 0 ? -1 : (dir == 1 ? 1 : 0);
+  const int ay = dir == 2 ? -1 : (dir == 3 ? 1 : 0);
+  for (int k = -1; k <= 1; ++k) {
+    const int dx = ax != 0 ? ax : k;
+    const int dy = ay != 0 ? ay : k;
+    const auto nb = grid_.neighbour(ix, iy, dx, dy);
+    if constexpr (kBallBall)
+      for (std::uint32_t j = head_[nb.cell]; j != kNone; j = body_[j].next) consider_ball(i, bi, j, nb.shift, p);
+    for (auto it = grid_.walls_begin(nb.cell); it != grid_.walls_end(nb.cell); ++it) consider_wall(i, bi, *it, nb.shift, p);
+    for (auto it = grid_.ends_begin(nb.cell); it != grid_.ends_end(nb.cell); ++it) consider_end(i, bi, *it, nb.shift, p);
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::predict_crossing(std::uint32_t i) {
+  const Body& b = body_[i];
+  Pending& p = pending_[i];
+  const int ix = grid_.ix_of(static_cast<int>(b.cell)), iy = grid_.iy_of(static_cast<int>(b.cell));
+  // Relative to the cell's edges, computed from the cell index rather than re-derived from the
+  // position, so a ball sitting on an edge by round-off is never assigned twice.
+  const AxisExit ex = flight_.exit_x(b.x.x, b.v.x, grid_.x_edge(ix - 1), grid_.x_edge(ix));
+  const AxisExit ey = flight_.exit_y(b.x.y, b.v.y, grid_.y_edge(iy - 1), grid_.y_edge(iy));
+  if (ex.t <= ey.t) {
+    p.t_cross = now_ + ex.t;
+    p.cross_dir = ex.upper ? 1 : 0;
+  } else {
+    p.t_cross = now_ + ey.t;
+    p.cross_dir = ey.upper ? 3 : 2;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Apply
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::process(double limit) {
+  while (!heap_.empty() && heap_.top_key() <= limit) {
+    const std::uint32_t i = heap_.top_id();
+    now_ = heap_.top_key();
+    ++stats_.events;
+    const Pending& p = pending_[i];
+    if (p.t_coll <= p.t_cross) collide(i);
+    else cross(i);
+    if constexpr (!kStep) {
+      if (++events_since_rebase_ >= rebase_every_) limit -= rebase();
+    }
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::collide(std::uint32_t i) {
+  const Pending p = pending_[i];
+  switch (p.kind) {
+    case Partner::ball:
+      if (body_[p.partner].count != p.partner_count) {
+        ++stats_.stale;
+        sync(i);
+        predict(i);
+        schedule(i);
+        return;
+      }
+      collide_balls(i, p.partner);
+      return;
+    case Partner::wall: collide_wall(i, p.partner); return;
+    case Partner::end: collide_end(i, p.partner); return;
+    case Partner::none: break;
+  }
+  // A ball with nothing pending has an infinite key and is never popped.
+  sync(i);
+  predict(i);
+  schedule(i);
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+double Engine<Flight, kBallBall, kStep>::restitution_for(std::uint32_t i) const {
+  // The TC rule (Luding & McNamara): a ball that collided less than tc ago collides elastically,
+  // so a cluster cannot collapse into infinitely many collisions in finite time.
+  return now_ - last_time_[i] < tc_ ? 1.0 : e_;
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+Vec2 Engine<Flight, kBallBall, kStep>::bounce(std::uint32_t i, Vec2 v, Vec2 n) const {
+  // n: unit contact normal pointing from the obstacle to the ball. Approach speed w >= 0.
+  // Walls take the plain restitution: the TC rule is for ball clusters; a ball pressed onto a wall
+  // is kept from collapsing by the rest threshold below.
+  (void)i;
+  const double w = -dot(v, n);
+  double w_out = e_ * w;
+  if constexpr (Flight::kAccelerates) {
+    // The rest threshold: a ball pressed onto the obstacle by the field leaves it at least fast
+    // enough to stay away for tc. Without it an inelastic ball would bounce infinitely often before
+    // coming to rest, and a ball at rest would sink.
+    const double a_n = dot(flight_.a, n);
+    if (a_n < 0.0) w_out = std::max(w_out, -a_n * tc_ / 2.0);
+  }
+  return v + (w + w_out) * n;
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::after_change(std::uint32_t i) {
+  ++body_[i].count;
+  if (inelastic_) last_time_[i] = now_;
+  if constexpr (kStep) {
+    // The rest of the step is walked at the new speed.
+    dmax_ = std::max(dmax_, travel_[i] + path_length(body_[i].v, dt_ - now_));
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::collide_balls(std::uint32_t i, std::uint32_t j) {
+  sync(i);
+  sync(j);
+  Body& a = body_[i];
+  Body& b = body_[j];
+  Vec2 F = b.x - a.x;
+  if (grid_.periodic()) {
+    // Minimum image: the arena is at least 3 cells (so 3 diameters) across.
+    F.x -= width_ * std::round(F.x / width_);
+    F.y -= height_ * std::round(F.y / height_);
+  }
+  const double sigma = a.r + b.r;
+  note_contact(sigma - norm(F), std::min(a.r, b.r));
+  double e = e_;
+  if (inelastic_) e = std::max(restitution_for(i), restitution_for(j));
+  respond_disc_disc(a.v, b.v, mass_[i], mass_[j], F, e);
+  ++stats_.ball_ball;
+  log(EventKind::ball_ball, i, j);
+  after_change(i);
+  after_change(j);
+  last_[i] = last_code(Partner::ball, j);
+  last_[j] = last_code(Partner::ball, i);
+  predict(i);
+  predict(j);
+  if constexpr (!kStep) {
+    // Crossing times depend on the velocities just changed.
+    predict_crossing(i);
+    predict_crossing(j);
+  }
+  schedule(i);
+  schedule(j);
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::collide_wall(std::uint32_t i, std::uint32_t w) {
+  sync(i);
+  Body& a = body_[i];
+  const Segment& s = walls_[w];
+  Vec2 rel = a.x - s.p1;
+  if (grid_.periodic()) {
+    rel.x -= width_ * std::round(rel.x / width_);
+    rel.y -= height_ * std::round(rel.y / height_);
+  }
+  const double d = dot(rel, s.n);
+  const Vec2 n = d >= 0.0 ? s.n : -s.n;
+  note_contact(a.r - std::abs(d), a.r);
+  a.v = bounce(i, a.v, n);
+  ++stats_.ball_wall;
+  log(EventKind::ball_wall, i, w);
+  after_change(i);
+  last_[i] = last_code(Partner::wall, w);
+  predict(i);
+  if constexpr (!kStep) predict_crossing(i);
+  schedule(i);
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::collide_end(std::uint32_t i, std::uint32_t e) {
+  sync(i);
+  Body& a = body_[i];
+  Vec2 F = a.x - ends_[e].p;
+  if (grid_.periodic()) {
+    F.x -= width_ * std::round(F.x / width_);
+    F.y -= height_ * std::round(F.y / height_);
+  }
+  const double dist = norm(F);
+  note_contact(a.r - dist, a.r);
+  a.v = bounce(i, a.v, F / dist);
+  ++stats_.ball_wall_end;
+  log(EventKind::ball_wall_end, i, ends_[e].wall);
+  after_change(i);
+  last_[i] = last_code(Partner::end, e);
+  predict(i);
+  if constexpr (!kStep) predict_crossing(i);
+  schedule(i);
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::cross(std::uint32_t i) {
+  ++stats_.cell_crossings;
+  sync(i);
+  Body& b = body_[i];
+  const int dir = pending_[i].cross_dir;
+  int ix = grid_.ix_of(static_cast<int>(b.cell)), iy = grid_.iy_of(static_cast<int>(b.cell));
+  ix += dir == 0 ? -1 : (dir == 1 ? 1 : 0);
+  iy += dir == 2 ? -1 : (dir == 3 ? 1 : 0);
+  if (ix < 1 || ix > grid_.nx() || iy < 1 || iy > grid_.ny()) {
+    if (boundary_ != Boundary::periodic) {
+      // The centre has left the arena. (With boundary walls this happens only if the walls were
+      // missed; the ball is removed rather than left to fly through the table.)
+      log(EventKind::exit, i, 0);
+      ++stats_.exits;
+      remove(i);
+      return;
+    }
+    if (ix < 1) { ix = grid_.nx(); b.x.x += width_; }
+    else if (ix > grid_.nx()) { ix = 1; b.x.x -= width_; }
+    if (iy < 1) { iy = grid_.ny(); b.x.y += height_; }
+    else if (iy > grid_.ny()) { iy = 1; b.x.y -= height_; }
+  }
+  unlink(i);
+  link(i, static_cast<std::uint32_t>(grid_.index(ix, iy)));
+  predict_strip(i, dir);
+  predict_crossing(i);
+  schedule(i);
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::remove(std::uint32_t i) {
+  unlink(i);
+  body_[i].cell = kNone;
+  ++body_[i].count;  // predictions made against it are now stale
+  heap_.remove(i);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Time
+
+template <class Flight, bool kBallBall, bool kStep>
+double Engine<Flight, kBallBall, kStep>::rebase() {
+  // Keep internal times small: absolute times would lose a bit of position per doubling of t.
+  // All balls are brought to now, which becomes internal zero. Amortised O(1) per event.
+  events_since_rebase_ = 0;
+  const double shift = now_;
+  if (shift == 0.0) return 0.0;
+  for (std::uint32_t i = 0; i < body_.size(); ++i) {
+    if (body_[i].cell == kNone) continue;
+    sync(i);
+    body_[i].t = 0.0;
+    pending_[i].t_coll -= shift;
+    pending_[i].t_cross -= shift;
+    if (inelastic_) last_time_[i] -= shift;
+  }
+  heap_.shift_keys(shift);
+  t_base_ += shift;
+  now_ = 0.0;
+  return shift;
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::begin_step() {
+  // Internal time zero is the start of the step; all balls are there.
+  const std::size_t n = body_.size();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (body_[i].cell != kNone) unlink(i);
+  }
+  dmax_ = 0.0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    Body& b = body_[i];
+    if (b.cell == kNone) continue;
+    b.t = 0.0;
+    travel_[i] = 0.0;
+    if (boundary_ == Boundary::periodic) {
+      b.x.x -= width_ * std::floor(b.x.x / width_);
+      b.x.y -= height_ * std::floor(b.x.y / height_);
+    } else if (b.x.x < 0.0 || b.x.x > width_ || b.x.y < 0.0 || b.x.y > height_) {
+      log(EventKind::exit, i, 0);
+      ++stats_.exits;
+      b.cell = kNone;
+      ++b.count;
+      heap_.remove(i);
+      continue;
+    }
+    link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(b.x)));
+    dmax_ = std::max(dmax_, path_length(b.v, dt_));
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (body_[i].cell == kNone) continue;
+    predict(i);
+    schedule(i);
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::finish_step() {
+  now_ = dt_;
+  for (std::uint32_t i = 0; i < body_.size(); ++i) {
+    if (body_[i].cell == kNone) continue;
+    sync(i);
+    body_[i].v += dt_ * kick_;  // the memo: fields act as velocity kicks between steps
+  }
+  // A kick changes every course, so "just collided, cannot meet again" no longer holds.
+  if (kick_.x != 0.0 || kick_.y != 0.0) std::fill(last_.begin(), last_.end(), kNone);
+  ++step_index_;
+  ++stats_.steps;
+  ++stats_.events;
+  t_base_ = static_cast<double>(step_index_) * dt_;
+  now_ = 0.0;
+  begin_step();
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+void Engine<Flight, kBallBall, kStep>::advance_to(double t) {
+  if (!(t >= time())) throw std::invalid_argument("advance_to: time " + std::to_string(t) + " is before the world's time");
+  if constexpr (kStep) {
+    for (;;) {
+      const double target = t - t_base_;
+      if (target >= dt_) {
+        process(dt_);
+        finish_step();
+        continue;
+      }
+      process(target);
+      now_ = std::max(now_, target);
+      return;
+    }
+  } else {
+    process(t - t_base_);
+    now_ = t - t_base_;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Validate
+
+template <class Flight, bool kBallBall, bool kStep>
+double Engine<Flight, kBallBall, kStep>::energy() const {
+  const Vec2 g = kStep ? kick_ : flight_.a;
+  double e = 0.0;
+  for (std::size_t i = 0; i < body_.size(); ++i) {
+    const BallState s = ball(i);
+    if (!s.alive) continue;
+    e += 0.5 * mass_[i] * norm2(s.vel) - mass_[i] * dot(g, s.pos);
+  }
+  return e;
+}
+
+template <class Flight, bool kBallBall, bool kStep>
+Overlap Engine<Flight, kBallBall, kStep>::measure_overlap() const {
+  std::vector<Vec2> pos(body_.size());
+  std::vector<double> rad(body_.size());
+  std::vector<bool> alive(body_.size());
+  for (std::size_t i = 0; i < body_.size(); ++i) {
+    const BallState s = ball(i);
+    pos[i] = s.pos;
+    rad[i] = body_[i].r;
+    alive[i] = s.alive;
+  }
+  const bool periodic = boundary_ == Boundary::periodic;
+  // Without ball-ball collisions balls pass through each other by request; only walls count.
+  return reference::overlap(pos, rad, alive, walls_, periodic ? width_ : 0.0, periodic ? height_ : 0.0, kBallBall);
+}
+
+template <class Flight, bool kBallBall>
+std::unique_ptr<EngineBase> make_for_mode(const WorldDef& def, Mode mode) {
+  if (mode == Mode::step) return std::make_unique<Engine<FreeFlight, kBallBall, true>>(def, mode);
+  return std::make_unique<Engine<Flight, kBallBall, false>>(def, mode);
+}
+
+}  // namespace
+
+std::unique_ptr<EngineBase> make_engine(const WorldDef& def, Mode mode) {
+  const bool gravity = def.effects.gravity.x != 0.0 || def.effects.gravity.y != 0.0;
+  const bool ball_ball = def.effects.ball_ball;
+  if (gravity) {
+    return ball_ball ? make_for_mode<GravityFlight, true>(def, mode) : make_for_mode<GravityFlight, false>(def, mode);
+  }
+  return ball_ball ? make_for_mode<FreeFlight, true>(def, mode) : make_for_mode<FreeFlight, false>(def, mode);
+}
+
+}  // namespace turtlegas::sim::detail

@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "turtlegas/sim/world.hpp"
+
+namespace turtlegas::sim::detail {
+
+/// What World forwards to; one implementation per combination of physics (see engine.cpp).
+class EngineBase {
+ public:
+  virtual ~EngineBase() = default;
+  virtual void advance_to(double t) = 0;
+  virtual void set_event_log(std::vector<Event>* log) = 0;
+  virtual double time() const = 0;
+  virtual std::size_t ball_count() const = 0;
+  virtual BallState ball(std::size_t i) const = 0;
+  virtual double radius(std::size_t i) const = 0;
+  virtual double mass(std::size_t i) const = 0;
+  virtual const std::vector<WallDef>& walls() const = 0;
+  virtual double energy() const = 0;
+  virtual const Stats& stats() const = 0;
+  virtual Overlap measure_overlap() const = 0;
+  virtual Overlap max_contact_overlap() const = 0;
+  virtual double cell_size() const = 0;
+  virtual int cells_x() const = 0;
+  virtual int cells_y() const = 0;
+  virtual Mode mode() const = 0;
+  virtual double dt() const = 0;
+};
+
+std::unique_ptr<EngineBase> make_engine(const WorldDef& def, Mode mode);
+
+}  // namespace turtlegas::sim::detail

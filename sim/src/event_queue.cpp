@@ -1,0 +1,189 @@
+// SPDX-License-Identifier: MIT
+#include "event_queue.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace turtlegas::sim::detail {
+
+void EventQueue::reset(std::size_t ids) {
+  node_.assign(ids, Node{});
+  std::size_t buckets = 1024;
+  while (buckets < ids) buckets *= 2;
+  year_ = buckets;
+  bucket_head_.assign(buckets, kAbsent);
+  heap_.clear();
+  overflow_head_ = kAbsent;
+  finite_ = 0;
+  t0_ = 0.0;
+  width_ = 0.0;  // set at the first rebuild
+  current_ = 0;
+}
+
+std::uint64_t EventQueue::bucket_of(double key) const {
+  const double b = std::floor((key - t0_) / width_);
+  if (!(b >= 0.0)) return 0;
+  if (b >= static_cast<double>(year_)) return year_;
+  return static_cast<std::uint64_t>(b);
+}
+
+void EventQueue::push_list(std::uint32_t& head, std::uint32_t id, std::uint32_t where) {
+  Node& n = node_[id];
+  n.where = where;
+  n.prev = kAbsent;
+  n.next = head;
+  if (head != kAbsent) node_[head].prev = id;
+  head = id;
+}
+
+void EventQueue::insert(std::uint32_t id) {
+  Node& n = node_[id];
+  if (!(n.key < std::numeric_limits<double>::infinity())) {
+    n.where = kInfinite;
+    return;
+  }
+  ++finite_;
+  if (width_ == 0.0) {
+    // No calendar yet: everything waits in the overflow until the first serve builds one.
+    push_list(overflow_head_, id, kInOverflow);
+    return;
+  }
+  const std::uint64_t b = bucket_of(n.key);
+  if (b <= current_) heap_push(id);
+  else if (b >= year_) push_list(overflow_head_, id, kInOverflow);
+  else push_list(bucket_head_[b], id, static_cast<std::uint32_t>(b));
+}
+
+void EventQueue::unlink(std::uint32_t id) {
+  Node& n = node_[id];
+  switch (n.where) {
+    case kNowhere: return;
+    case kInfinite: break;
+    case kInHeap:
+      heap_erase(n.prev);
+      --finite_;
+      break;
+    default: {
+      std::uint32_t& head = n.where == kInOverflow ? overflow_head_ : bucket_head_[n.where];
+      if (n.prev != kAbsent) node_[n.prev].next = n.next;
+      else head = n.next;
+      if (n.next != kAbsent) node_[n.next].prev = n.prev;
+      --finite_;
+    }
+  }
+  n.where = kNowhere;
+}
+
+void EventQueue::set(std::uint32_t id, double key) {
+  unlink(id);
+  node_[id].key = key;
+  insert(id);
+}
+
+void EventQueue::remove(std::uint32_t id) { unlink(id); }
+
+void EventQueue::settle() {
+  while (heap_.empty()) {
+    if (width_ == 0.0 || current_ + 1 >= year_) {
+      // End of the year (or no calendar yet): rebuild around the earliest key.
+      double earliest = std::numeric_limits<double>::infinity();
+      for (std::uint32_t id = 0; id < node_.size(); ++id)
+        if (node_[id].where != kNowhere && node_[id].where != kInfinite) earliest = std::min(earliest, node_[id].key);
+      rebuild(earliest);
+      continue;
+    }
+    ++current_;
+    // Move the next bucket into the heap.
+    std::uint32_t id = bucket_head_[current_];
+    bucket_head_[current_] = kAbsent;
+    while (id != kAbsent) {
+      const std::uint32_t next = node_[id].next;
+      heap_push(id);
+      id = next;
+    }
+  }
+}
+
+void EventQueue::rebuild(double start) {
+  // Gather every stored id, then lay a new calendar whose year spans the bulk of them.
+  std::vector<std::uint32_t> ids;
+  ids.reserve(finite_);
+  double sum = 0.0;
+  for (std::uint32_t id = 0; id < node_.size(); ++id) {
+    const std::uint32_t w = node_[id].where;
+    if (w == kNowhere || w == kInfinite) continue;
+    ids.push_back(id);
+    sum += node_[id].key - start;
+  }
+  std::fill(bucket_head_.begin(), bucket_head_.end(), kAbsent);
+  heap_.clear();
+  overflow_head_ = kAbsent;
+  for (std::uint32_t id : ids) node_[id].where = kNowhere;
+  finite_ = 0;
+  // Each id holds one pending event, on average (sum / n) ahead; the queue serves about
+  // n / (sum / n) events per second, so this width gives a few events per bucket and a year
+  // of about four mean look-aheads.
+  const double n = static_cast<double>(ids.size());
+  const double mean_ahead = n > 0 ? sum / n : 0.0;
+  width_ = mean_ahead > 0.0 ? 4.0 * mean_ahead / static_cast<double>(year_) : 1.0;
+  if (!(width_ > 0.0) || !std::isfinite(width_)) width_ = 1.0;
+  t0_ = start;
+  current_ = 0;
+  for (std::uint32_t id : ids) insert(id);
+}
+
+void EventQueue::shift_keys(double dt) {
+  for (auto& n : node_)
+    if (n.where != kNowhere) n.key -= dt;
+  double earliest = std::numeric_limits<double>::infinity();
+  for (const auto& n : node_)
+    if (n.where != kNowhere && n.where != kInfinite) earliest = std::min(earliest, n.key);
+  if (finite_ > 0) rebuild(earliest);
+}
+
+void EventQueue::heap_push(std::uint32_t id) {
+  node_[id].where = kInHeap;
+  heap_.push_back(id);
+  heap_up(static_cast<std::uint32_t>(heap_.size() - 1));
+}
+
+void EventQueue::heap_erase(std::uint32_t pos) {
+  const std::uint32_t last = heap_.back();
+  heap_.pop_back();
+  if (pos == heap_.size()) return;
+  heap_place(pos, last);
+  heap_up(pos);
+  heap_down(node_[last].prev);
+}
+
+void EventQueue::heap_up(std::uint32_t pos) {
+  const std::uint32_t id = heap_[pos];
+  while (pos > 0) {
+    const std::uint32_t parent = (pos - 1) / 2;
+    if (!heap_before(id, heap_[parent])) break;
+    heap_place(pos, heap_[parent]);
+    pos = parent;
+  }
+  heap_place(pos, id);
+}
+
+void EventQueue::heap_down(std::uint32_t pos) {
+  const std::uint32_t id = heap_[pos];
+  const auto n = static_cast<std::uint32_t>(heap_.size());
+  for (;;) {
+    std::uint32_t child = 2 * pos + 1;
+    if (child >= n) break;
+    if (child + 1 < n && heap_before(heap_[child + 1], heap_[child])) ++child;
+    if (!heap_before(heap_[child], id)) break;
+    heap_place(pos, heap_[child]);
+    pos = child;
+  }
+  heap_place(pos, id);
+}
+
+std::size_t EventQueue::memory_bytes() const {
+  return node_.capacity() * sizeof(Node) + bucket_head_.capacity() * sizeof(std::uint32_t) +
+         heap_.capacity() * sizeof(std::uint32_t);
+}
+
+}  // namespace turtlegas::sim::detail

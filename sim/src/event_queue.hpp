@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace turtlegas::sim::detail {
+
+/// The event queue of exact mode: one key per body (the time of its next event), served in
+/// (key, id) order so that simultaneous events are deterministic.
+///
+/// A calendar queue after Paul (J. Comput. Phys. 221, 2007): keys fall into time buckets of width
+/// w; only the bucket being served is kept ordered, in a small binary heap, and the others are
+/// unordered linked lists, so insertion and removal are O(1) and serving costs O(log of the
+/// bucket's size). Keys beyond the calendar's year wait in an overflow list; at the end of each
+/// year the calendar is rebuilt around the keys it holds, with w re-estimated so that a bucket
+/// holds a few events. Infinite keys (no event) are tracked but never stored.
+class EventQueue {
+ public:
+  static constexpr std::uint32_t kAbsent = std::numeric_limits<std::uint32_t>::max();
+
+  void reset(std::size_t ids);
+  /// Inserts id or moves it to its new key (which may be infinite).
+  void set(std::uint32_t id, double key);
+  void remove(std::uint32_t id);
+  /// True when no finite key is stored.
+  bool empty() const { return finite_ == 0; }
+  /// The earliest (key, id); only when !empty().
+  double top_key() { settle(); return node_[heap_[0]].key; }
+  std::uint32_t top_id() { settle(); return heap_[0]; }
+  /// Subtracts dt from every key (time rebasing) and rebuilds the calendar around them.
+  void shift_keys(double dt);
+  std::size_t memory_bytes() const;
+
+ private:
+  enum : std::uint32_t { kInHeap = 0xFFFFFFF0u, kInOverflow, kInfinite, kNowhere };
+  struct Node {
+    double key = 0.0;
+    std::uint32_t where = kNowhere;  ///< bucket slot, or one of the k* states
+    std::uint32_t prev = kAbsent;    ///< list links, or the heap position when kInHeap
+    std::uint32_t next = kAbsent;
+  };
+
+  void insert(std::uint32_t id);
+  void unlink(std::uint32_t id);
+  void push_list(std::uint32_t& head, std::uint32_t id, std::uint32_t where);
+  void settle();
+  void rebuild(double start);
+  std::uint64_t bucket_of(double key) const;
+
+  // The small heap of the bucket being served.
+  bool heap_before(std::uint32_t a, std::uint32_t b) const {
+    return node_[a].key < node_[b].key || (node_[a].key == node_[b].key && a < b);
+  }
+  void heap_push(std::uint32_t id);
+  void heap_erase(std::uint32_t pos);
+  void heap_up(std::uint32_t pos);
+  void heap_down(std::uint32_t pos);
+  void heap_place(std::uint32_t pos, std::uint32_t id) {
+    heap_[pos] = id;
+    node_[id].prev = pos;
+  }
+
+  std::vector<Node> node_;
+  std::vector<std::uint32_t> bucket_head_;
+  std::vector<std::uint32_t> heap_;
+  std::uint32_t overflow_head_ = kAbsent;
+  std::size_t finite_ = 0;
+  double t0_ = 0.0;          ///< start of bucket 0 of this year
+  double width_ = 1.0;       ///< bucket width, seconds
+  std::uint64_t current_ = 0;  ///< the bucket being served; keys before its end go to the heap
+  std::uint64_t year_ = 0;     ///< number of buckets in a year
+};
+
+}  // namespace turtlegas::sim::detail

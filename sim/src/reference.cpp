@@ -1,0 +1,226 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/sim/reference.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+
+namespace turtlegas::sim::reference {
+namespace {
+
+Vec2 min_image(Vec2 d, double w, double h) {
+  if (w > 0.0) d.x -= w * std::round(d.x / w);
+  if (h > 0.0) d.y -= h * std::round(d.y / h);
+  return d;
+}
+
+double distance_to_segment(Vec2 p, const Segment& s) {
+  const Vec2 rel = p - s.p1;
+  const double foot = std::clamp(dot(rel, s.u), 0.0, s.len);
+  return norm(rel - foot * s.u);
+}
+
+}  // namespace
+
+Overlap overlap(const std::vector<Vec2>& pos, const std::vector<double>& radius, const std::vector<bool>& alive,
+                const std::vector<Segment>& walls, double periodic_width, double periodic_height, bool ball_pairs) {
+  Overlap worst;
+  auto note = [&](double depth, double r) {
+    if (depth <= 0.0) return;
+    worst.depth = std::max(worst.depth, depth);
+    worst.relative = std::max(worst.relative, depth / r);
+  };
+  const std::size_t n = pos.size();
+  double rmax = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (alive[i]) rmax = std::max(rmax, radius[i]);
+  if (rmax == 0.0) return worst;
+
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!alive[i]) continue;
+    for (const Segment& s : walls) {
+      Vec2 p = pos[i];
+      if (periodic_width > 0.0) p = s.p1 + min_image(p - s.p1, periodic_width, periodic_height);
+      note(radius[i] - distance_to_segment(p, s), radius[i]);
+    }
+  }
+  if (!ball_pairs) return worst;
+
+  // Sort by cell of side 2 rmax and compare with the 3x3 neighbouring cells: an independent grid.
+  const double cell = 2.0 * rmax;
+  struct Key {
+    std::int64_t cx, cy;
+    std::size_t i;
+  };
+  std::vector<Key> keys;
+  keys.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!alive[i]) continue;
+    Vec2 p = pos[i];
+    if (periodic_width > 0.0) p = {p.x - periodic_width * std::floor(p.x / periodic_width),
+                                   p.y - periodic_height * std::floor(p.y / periodic_height)};
+    keys.push_back({static_cast<std::int64_t>(std::floor(p.x / cell)), static_cast<std::int64_t>(std::floor(p.y / cell)), i});
+  }
+  auto less = [](const Key& a, const Key& b) { return a.cx != b.cx ? a.cx < b.cx : (a.cy != b.cy ? a.cy < b.cy : a.i < b.i); };
+  std::sort(keys.begin(), keys.end(), less);
+  const std::int64_t ncx = periodic_width > 0.0 ? static_cast<std::int64_t>(std::floor(periodic_width / cell)) : 0;
+  const std::int64_t ncy = periodic_height > 0.0 ? static_cast<std::int64_t>(std::floor(periodic_height / cell)) : 0;
+  const bool brute = periodic_width > 0.0 && (ncx < 3 || ncy < 3);
+  if (brute || keys.size() < 64) {
+    for (std::size_t a = 0; a < keys.size(); ++a)
+      for (std::size_t b = a + 1; b < keys.size(); ++b) {
+        const std::size_t i = keys[a].i, j = keys[b].i;
+        const Vec2 d = min_image(pos[j] - pos[i], periodic_width, periodic_height);
+        note(radius[i] + radius[j] - norm(d), std::min(radius[i], radius[j]));
+      }
+    return worst;
+  }
+  for (const Key& k : keys) {
+    for (std::int64_t dy = -1; dy <= 1; ++dy)
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        std::int64_t cx = k.cx + dx, cy = k.cy + dy;
+        if (periodic_width > 0.0) {
+          // Cells past the last whole one belong to the last; wrap the rest.
+          cx = ((cx % (ncx + 1)) + (ncx + 1)) % (ncx + 1);
+          cy = ((cy % (ncy + 1)) + (ncy + 1)) % (ncy + 1);
+        }
+        auto it = std::lower_bound(keys.begin(), keys.end(), Key{cx, cy, 0}, less);
+        for (; it != keys.end() && it->cx == cx && it->cy == cy; ++it) {
+          const std::size_t i = k.i, j = it->i;
+          if (j <= i) continue;
+          const Vec2 d = min_image(pos[j] - pos[i], periodic_width, periodic_height);
+          note(radius[i] + radius[j] - norm(d), std::min(radius[i], radius[j]));
+        }
+      }
+  }
+  return worst;
+}
+
+std::vector<Event> events(const WorldDef& def, double t_end, std::vector<BallState>* final) {
+  if (def.arena.boundary == Boundary::periodic)
+    throw std::invalid_argument("reference::events supports boundaries none and walls only");
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  enum Kind : std::uint32_t { kBall = 1, kWall = 2, kEnd = 3 };
+  const Vec2 g = def.effects.gravity;
+  const bool accel = g.x != 0.0 || g.y != 0.0;
+  const double e = def.effects.restitution, tc = def.effects.tc;
+  const bool inelastic = e < 1.0;
+
+  std::vector<WallDef> wall_defs = def.walls;
+  if (def.arena.boundary == Boundary::walls)
+    for (auto& w : arena_walls(def.arena)) wall_defs.push_back(w);
+  std::vector<Segment> walls;
+  for (const auto& w : wall_defs) walls.push_back(make_segment(w.from, w.to));
+  struct End {
+    Vec2 p;
+    std::uint32_t wall;
+  };
+  std::vector<End> ends;
+  for (std::uint32_t w = 0; w < wall_defs.size(); ++w)
+    for (Vec2 p : {wall_defs[w].from, wall_defs[w].to}) {
+      bool seen = false;
+      for (const End& x : ends) seen = seen || x.p == p;
+      if (!seen) ends.push_back({p, w});
+    }
+
+  const std::size_t n = def.balls.size();
+  std::vector<Vec2> x(n), v(n);
+  std::vector<bool> alive(n, true);
+  std::vector<std::uint32_t> last(n, kNone);
+  std::vector<double> last_time(n, -kNever);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = def.balls[i].pos;
+    v[i] = def.balls[i].vel;
+  }
+  auto code = [](std::uint32_t kind, std::size_t index) { return (kind << 30) | static_cast<std::uint32_t>(index); };
+  auto e_for = [&](std::size_t i, double now) { return now - last_time[i] < tc ? 1.0 : e; };
+
+  std::vector<Event> out;
+  double now = 0.0;
+  for (;;) {
+    double best = kNever;
+    std::uint32_t kind = 0;
+    std::size_t bi = 0, bj = 0;
+    auto offer = [&](double dt, std::uint32_t k, std::size_t i, std::size_t j) {
+      if (now + dt < best) {
+        best = now + dt;
+        kind = k;
+        bi = i;
+        bj = j;
+      }
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!alive[i]) continue;
+      const double r = def.balls[i].radius;
+      if (def.effects.ball_ball)
+        for (std::size_t j = i + 1; j < n; ++j) {
+          if (!alive[j]) continue;
+          if (last[i] == code(kBall, j) && last[j] == code(kBall, i)) continue;
+          offer(toi_disc_disc(x[j] - x[i], v[j] - v[i], r + def.balls[j].radius), kBall, i, j);
+        }
+      for (std::size_t w = 0; w < walls.size(); ++w) {
+        if (!accel && last[i] == code(kWall, w)) continue;
+        offer(toi_disc_segment(x[i] - walls[w].p1, v[i], g, walls[w], r), kWall, i, w);
+      }
+      for (std::size_t k = 0; k < ends.size(); ++k) {
+        if (!accel && last[i] == code(kEnd, k)) continue;
+        offer(toi_disc_point_accel(x[i] - ends[k].p, v[i], g, r, best - now), kEnd, i, k);
+      }
+      if (def.arena.boundary == Boundary::none) {
+        const AxisExit ex = axis_exit(x[i].x, v[i].x, g.x, 0.0, def.arena.width);
+        const AxisExit ey = axis_exit(x[i].y, v[i].y, g.y, 0.0, def.arena.height);
+        offer(std::min(ex.t, ey.t), 0, i, 0);
+      }
+    }
+    const double t_next = std::min(best, t_end);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!alive[i]) continue;
+      const double dt = t_next - now;
+      x[i] = x[i] + dt * v[i] + (0.5 * dt * dt) * g;
+      v[i] = v[i] + dt * g;
+    }
+    now = t_next;
+    if (best > t_end) break;
+    auto bounce = [&](std::size_t i, Vec2 vel, Vec2 nrm) {
+      const double w = -dot(vel, nrm);
+      (void)i;
+      double w_out = e * w;
+      const double a_n = dot(g, nrm);
+      if (accel && a_n < 0.0) w_out = std::max(w_out, -a_n * tc / 2.0);
+      return vel + (w + w_out) * nrm;
+    };
+    if (kind == kBall) {
+      const double ee = inelastic ? std::max(e_for(bi, now), e_for(bj, now)) : e;
+      respond_disc_disc(v[bi], v[bj], def.balls[bi].mass, def.balls[bj].mass, x[bj] - x[bi], ee);
+      out.push_back({now, EventKind::ball_ball, static_cast<std::uint32_t>(bi), static_cast<std::uint32_t>(bj)});
+      last[bi] = code(kBall, bj);
+      last[bj] = code(kBall, bi);
+      last_time[bi] = last_time[bj] = now;
+    } else if (kind == kWall) {
+      const Segment& s = walls[bj];
+      const double d = dot(x[bi] - s.p1, s.n);
+      v[bi] = bounce(bi, v[bi], d >= 0.0 ? s.n : -s.n);
+      out.push_back({now, EventKind::ball_wall, static_cast<std::uint32_t>(bi), static_cast<std::uint32_t>(bj)});
+      last[bi] = code(kWall, bj);
+      last_time[bi] = now;
+    } else if (kind == kEnd) {
+      const Vec2 F = x[bi] - ends[bj].p;
+      v[bi] = bounce(bi, v[bi], F / norm(F));
+      out.push_back({now, EventKind::ball_wall_end, static_cast<std::uint32_t>(bi), ends[bj].wall});
+      last[bi] = code(kEnd, bj);
+      last_time[bi] = now;
+    } else {
+      alive[bi] = false;
+      out.push_back({now, EventKind::exit, static_cast<std::uint32_t>(bi), 0});
+    }
+  }
+  if (final) {
+    final->resize(n);
+    for (std::size_t i = 0; i < n; ++i) (*final)[i] = {x[i], v[i], alive[i]};
+  }
+  return out;
+}
+
+}  // namespace turtlegas::sim::reference

@@ -1,0 +1,419 @@
+// SPDX-License-Identifier: MIT
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <functional>
+#include <vector>
+
+#include "turtlegas/sim/world_def.hpp"
+
+namespace turtlegas::sim {
+namespace {
+
+using Where = DefProblem::Where;
+
+/// Shortest decimal that round-trips, so messages show "-1" rather than "-1.000000".
+std::string num(double v) {
+  std::array<char, 32> buf{};
+  auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  return std::string(buf.data(), r.ptr);
+}
+
+// Appended piecewise: GCC 12 gives a false -Wrestrict for "literal" + std::string (bug 105329).
+std::string vec(Vec2 v) {
+  std::string s = "[";
+  s += num(v.x);
+  s += ", ";
+  s += num(v.y);
+  s += ']';
+  return s;
+}
+
+std::string quoted(std::string_view id) {
+  std::string s = "'";
+  s += id;
+  s += '\'';
+  return s;
+}
+
+std::string ball_name(const BallDef& b, std::size_t i) {
+  return b.id.empty() ? "ball #" + std::to_string(i) : "ball " + quoted(b.id);
+}
+
+std::string wall_name(const WallDef& w, std::size_t i) {
+  return w.id.empty() ? "wall #" + std::to_string(i) : "wall " + quoted(w.id);
+}
+
+DefProblem problem(Where where, std::size_t index, std::string field, std::string message) {
+  return DefProblem{where, index, std::move(field), std::move(message)};
+}
+
+/// Squared distance from p to the segment a-b (a != b).
+double segment_distance2(Vec2 p, Vec2 a, Vec2 b) {
+  const Vec2 ab = b - a;
+  const double t = std::clamp(dot(p - a, ab) / norm2(ab), 0.0, 1.0);
+  return norm2(p - (a + t * ab));
+}
+
+/// A uniform grid over a rectangle with singly linked per-cell lists, filled incrementally so that
+/// each object is tested only against objects inserted before it (the first problem is found
+/// without building the whole grid when a scene is badly broken).
+class CoverGrid {
+ public:
+  CoverGrid(Vec2 lo, Vec2 hi, double side, std::size_t max_cells) : lo_(lo) {
+    const double w = hi.x - lo.x;
+    const double h = hi.y - lo.y;
+    const double cap = static_cast<double>(max_cells);
+    double nx = std::clamp(std::ceil(w / side), 1.0, cap);
+    double ny = std::clamp(std::ceil(h / side), 1.0, cap);
+    if (nx * ny > cap) {
+      const double shrink = std::sqrt(nx * ny / cap);
+      nx = std::max(1.0, std::floor(nx / shrink));
+      ny = std::max(1.0, std::floor(ny / shrink));
+    }
+    nx_ = static_cast<int>(nx);
+    ny_ = static_cast<int>(ny);
+    sx_ = w / nx_;
+    sy_ = h / ny_;
+    head_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_), npos);
+  }
+
+  struct Range {
+    int x0, x1, y0, y1;
+  };
+
+  /// The cells that the box [lo, hi] touches, clamped to the grid.
+  Range cover(Vec2 lo, Vec2 hi) const {
+    return Range{cx(lo.x), cx(hi.x), cy(lo.y), cy(hi.y)};
+  }
+
+  int cx(double x) const { return clamp_index((x - lo_.x) / sx_, nx_); }
+  int cy(double y) const { return clamp_index((y - lo_.y) / sy_, ny_); }
+  double cell_x0(int ix) const { return lo_.x + ix * sx_; }
+  double cell_w() const { return sx_; }
+
+  void insert(int ix, int iy, std::uint32_t item) {
+    const std::size_t c = cell(ix, iy);
+    entries_.push_back(Entry{item, head_[c]});
+    head_[c] = static_cast<std::uint32_t>(entries_.size() - 1);
+  }
+
+  void insert(Range r, std::uint32_t item) {
+    for (int iy = r.y0; iy <= r.y1; ++iy)
+      for (int ix = r.x0; ix <= r.x1; ++ix) insert(ix, iy, item);
+  }
+
+  /// Calls f(item) for every item in the cells of r (an item may be seen more than once).
+  /// Stops and returns true as soon as f returns true.
+  template <class F>
+  bool any(Range r, F&& f) const {
+    for (int iy = r.y0; iy <= r.y1; ++iy)
+      for (int ix = r.x0; ix <= r.x1; ++ix)
+        for (std::uint32_t e = head_[cell(ix, iy)]; e != npos; e = entries_[e].next)
+          if (f(entries_[e].item)) return true;
+    return false;
+  }
+
+ private:
+  static constexpr std::uint32_t npos = std::numeric_limits<std::uint32_t>::max();
+  struct Entry {
+    std::uint32_t item;
+    std::uint32_t next;
+  };
+
+  static int clamp_index(double u, int n) {
+    // Written so that NaN-free but huge values cannot overflow the int conversion.
+    if (!(u > 0.0)) return 0;
+    if (u >= n - 1) return n - 1;
+    return static_cast<int>(u);
+  }
+  std::size_t cell(int ix, int iy) const {
+    return static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
+  }
+
+  Vec2 lo_;
+  int nx_ = 1, ny_ = 1;
+  double sx_ = 1.0, sy_ = 1.0;
+  std::vector<std::uint32_t> head_;
+  std::vector<Entry> entries_;
+};
+
+std::optional<DefProblem> check_scalars(const WorldDef& def) {
+  if (!std::isfinite(def.dt) || def.dt <= 0.0)
+    return problem(Where::world, 0, "dt", "dt must be a finite number of seconds > 0 (got " + num(def.dt) + "); the memo's step is 1/30");
+
+  const ArenaDef& a = def.arena;
+  if (!std::isfinite(a.width) || a.width <= 0.0)
+    return problem(Where::arena, 0, "width", "arena width must be finite and > 0 (got " + num(a.width) + ")");
+  if (!std::isfinite(a.height) || a.height <= 0.0)
+    return problem(Where::arena, 0, "height", "arena height must be finite and > 0 (got " + num(a.height) + ")");
+  if (a.cell && (!std::isfinite(*a.cell) || *a.cell <= 0.0))
+    return problem(Where::arena, 0, "cell", "arena cell must be finite and > 0 (got " + num(*a.cell) + "); leave it out to let the memo's rule choose it");
+
+  const EffectsDef& e = def.effects;
+  if (!is_finite(e.gravity))
+    return problem(Where::effects, 0, "gravity", "gravity must be finite (got " + vec(e.gravity) + ")");
+  if (!is_finite(e.electric))
+    return problem(Where::effects, 0, "electric", "electric field must be finite (got " + vec(e.electric) + ")");
+  if (!std::isfinite(e.magnetic))
+    return problem(Where::effects, 0, "magnetic", "magnetic field must be finite (got " + num(e.magnetic) + ")");
+  if (!(e.restitution >= 0.0 && e.restitution <= 1.0))
+    return problem(Where::effects, 0, "restitution", "restitution must be in [0, 1] (got " + num(e.restitution) + "); 1 is elastic, 0 perfectly inelastic");
+  if (!std::isfinite(e.tc) || e.tc <= 0.0)
+    return problem(Where::effects, 0, "tc", "tc must be a finite number of seconds > 0 (got " + num(e.tc) + "); the default is 1e-4");
+  return std::nullopt;
+}
+
+std::optional<DefProblem> check_walls(const WorldDef& def) {
+  for (std::size_t i = 0; i < def.walls.size(); ++i) {
+    const WallDef& w = def.walls[i];
+    if (!is_finite(w.from))
+      return problem(Where::wall, i, "from", wall_name(w, i) + ": from must be finite (got " + vec(w.from) + ")");
+    if (!is_finite(w.to))
+      return problem(Where::wall, i, "to", wall_name(w, i) + ": to must be finite (got " + vec(w.to) + ")");
+    if (w.from == w.to)
+      return problem(Where::wall, i, "to", wall_name(w, i) + " has zero length (from and to are both " + vec(w.from) + "); move one end or remove the wall");
+  }
+  return std::nullopt;
+}
+
+std::optional<DefProblem> check_balls(const WorldDef& def) {
+  const ArenaDef& a = def.arena;
+  const std::string arena_box = "[0, " + num(a.width) + "] x [0, " + num(a.height) + "]";
+  for (std::size_t i = 0; i < def.balls.size(); ++i) {
+    const BallDef& b = def.balls[i];
+    if (!is_finite(b.pos))
+      return problem(Where::ball, i, "pos", ball_name(b, i) + ": pos must be finite (got " + vec(b.pos) + ")");
+    if (!is_finite(b.vel))
+      return problem(Where::ball, i, "vel", ball_name(b, i) + ": vel must be finite (got " + vec(b.vel) + ")");
+    if (!std::isfinite(b.radius) || b.radius <= 0.0)
+      return problem(Where::ball, i, "radius", ball_name(b, i) + ": radius must be > 0 (got " + num(b.radius) + ")");
+    if (!std::isfinite(b.mass) || b.mass <= 0.0)
+      return problem(Where::ball, i, "mass", ball_name(b, i) + ": mass must be > 0 (got " + num(b.mass) + ")");
+    if (!std::isfinite(b.charge))
+      return problem(Where::ball, i, "charge", ball_name(b, i) + ": charge must be finite (got " + num(b.charge) + ")");
+
+    const Vec2 p = b.pos;
+    if (a.boundary == Boundary::walls) {
+      const double r = b.radius;
+      if (p.x - r < 0.0 || p.x + r > a.width || p.y - r < 0.0 || p.y + r > a.height)
+        return problem(Where::ball, i, "pos",
+                       ball_name(b, i) + " (radius " + num(r) + ") at " + vec(p) +
+                           " sticks out of the arena walls; the whole disc must lie in " + arena_box +
+                           ", so move it inside or make it smaller");
+    } else if (p.x < 0.0 || p.x > a.width || p.y < 0.0 || p.y > a.height) {
+      return problem(Where::ball, i, "pos",
+                     ball_name(b, i) + " at " + vec(p) + " is outside the arena " + arena_box +
+                         "; move its centre inside or enlarge the arena");
+    }
+    if (a.boundary == Boundary::periodic && (2.0 * b.radius >= a.width || 2.0 * b.radius >= a.height))
+      return problem(Where::ball, i, "radius",
+                     ball_name(b, i) + " (radius " + num(b.radius) +
+                         ") would touch its own periodic image; its diameter must be smaller than the arena's width and height");
+  }
+  return std::nullopt;
+}
+
+const std::array<std::string_view, 4> arena_ids = {"arena-bottom", "arena-right", "arena-top", "arena-left"};
+
+std::optional<DefProblem> check_ids(const WorldDef& def) {
+  // Every named object in a fixed order: the arena's walls (boundary walls only), walls, balls.
+  // Empty ids are anonymous (scenes built in code need not name anything); the loader requires them.
+  const std::size_t arena_n = def.arena.boundary == Boundary::walls ? arena_ids.size() : 0;
+  const std::size_t total = arena_n + def.walls.size() + def.balls.size();
+  auto id_of = [&](std::size_t k) -> std::string_view {
+    if (k < arena_n) return arena_ids[k];
+    k -= arena_n;
+    if (k < def.walls.size()) return def.walls[k].id;
+    return def.balls[k - def.walls.size()].id;
+  };
+  auto describe = [&](std::size_t k) -> std::string {
+    if (k < arena_n) return "the arena wall of boundary \"walls\"";
+    k -= arena_n;
+    if (k < def.walls.size()) return "wall #" + std::to_string(k);
+    return "ball #" + std::to_string(k - def.walls.size());
+  };
+
+  // Open addressing over object numbers + 1 (0 is empty): a million ids in a few tens of ms, where
+  // a node-based map spends most of its time in the allocator.
+  std::size_t size = 16;
+  while (size < 2 * total) size *= 2;
+  std::vector<std::uint32_t> table(size, 0);
+  const std::hash<std::string_view> hash;
+  for (std::size_t k = 0; k < total; ++k) {
+    const std::string_view id = id_of(k);
+    if (id.empty()) continue;
+    for (std::size_t slot = hash(id) & (size - 1);; slot = (slot + 1) & (size - 1)) {
+      if (table[slot] == 0) {
+        table[slot] = static_cast<std::uint32_t>(k + 1);
+        break;
+      }
+      if (id_of(table[slot] - 1) != id) continue;
+      const std::size_t i = k - arena_n;
+      const bool is_wall = i < def.walls.size();
+      return problem(is_wall ? Where::wall : Where::ball, is_wall ? i : i - def.walls.size(), "id",
+                     "duplicate id " + quoted(id) + " (already used by " + describe(table[slot] - 1) +
+                         "); every wall and ball needs its own id");
+    }
+  }
+  return std::nullopt;
+}
+
+/// Ball-ball and ball-wall overlaps, with one grid over the arena grown by the largest radius (so
+/// every disc lies inside it). Walls are entered in every cell their segment crosses, balls in every
+/// cell their bounding box covers; a pair that overlaps then shares at least one cell. In a periodic
+/// arena a disc that crosses an edge is also entered (and tested) at its shifted images.
+std::optional<DefProblem> check_overlaps(const WorldDef& def) {
+  const std::size_t n = def.balls.size();
+  if (n == 0) return std::nullopt;
+  const ArenaDef& a = def.arena;
+  const bool periodic = a.boundary == Boundary::periodic;
+
+  double r_max = 0.0;
+  std::vector<double> radii(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    radii[i] = def.balls[i].radius;
+    r_max = std::max(r_max, radii[i]);
+  }
+  // The median diameter as cell side keeps a few balls per cell even when a handful are huge.
+  std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(n / 2), radii.end());
+  const double side = 2.0 * radii[n / 2];
+  radii = {};
+
+  const Vec2 lo{-r_max, -r_max};
+  const Vec2 hi{a.width + r_max, a.height + r_max};
+  CoverGrid grid(lo, hi, side, 4 * (n + def.walls.size()) + 1024);
+
+  // A ball's images: itself and, in a periodic arena, its copies shifted across each edge it crosses.
+  auto images = [&](const BallDef& b, std::array<Vec2, 4>& out) -> int {
+    out[0] = b.pos;
+    if (!periodic) return 1;
+    double sx = 0.0, sy = 0.0;
+    if (b.pos.x - b.radius < 0.0) sx = a.width;
+    else if (b.pos.x + b.radius > a.width) sx = -a.width;
+    if (b.pos.y - b.radius < 0.0) sy = a.height;
+    else if (b.pos.y + b.radius > a.height) sy = -a.height;
+    int k = 1;
+    if (sx != 0.0) out[k++] = b.pos + Vec2{sx, 0.0};
+    if (sy != 0.0) out[k++] = b.pos + Vec2{0.0, sy};
+    if (sx != 0.0 && sy != 0.0) out[k++] = b.pos + Vec2{sx, sy};
+    return k;
+  };
+  auto box = [&](Vec2 p, double r) { return grid.cover(p - Vec2{r, r}, p + Vec2{r, r}); };
+
+  if (def.effects.ball_ball) {
+    // Items are ball * 4 + image, so a periodic pair is caught from whichever side crosses the edge.
+    std::array<Vec2, 4> img{}, other{};
+    for (std::size_t i = 0; i < n; ++i) {
+      const BallDef& b = def.balls[i];
+      const int k = images(b, img);
+      std::optional<std::size_t> hit;
+      for (int m = 0; m < k && !hit; ++m) {
+        const Vec2 p = img[m];
+        grid.any(box(p, b.radius), [&](std::uint32_t item) {
+          const std::size_t j = item / 4;
+          const BallDef& o = def.balls[j];
+          Vec2 q = o.pos;
+          if (item % 4 != 0) {
+            images(o, other);
+            q = other[item % 4];
+          }
+          const double s = b.radius + o.radius;
+          if (norm2(p - q) < s * s) hit = j;
+          return hit.has_value();
+        });
+      }
+      if (hit) {
+        const BallDef& o = def.balls[*hit];
+        return problem(Where::ball, i, "pos",
+                       ball_name(b, i) + " at " + vec(b.pos) + " overlaps " + ball_name(o, *hit) + " at " +
+                           vec(o.pos) + " (radii " + num(b.radius) + " + " + num(o.radius) +
+                           "); move them apart or make them smaller");
+      }
+      for (int m = 0; m < k; ++m)
+        grid.insert(box(img[m], b.radius), static_cast<std::uint32_t>(i * 4 + static_cast<std::size_t>(m)));
+    }
+  }
+
+  if (def.walls.empty()) return std::nullopt;
+  CoverGrid walls_grid(lo, hi, side, 4 * (n + def.walls.size()) + 1024);
+  for (std::size_t w = 0; w < def.walls.size(); ++w) {
+    // Enter the segment column by column: in each column of cells, the cells between the lowest and
+    // highest y the segment reaches there. The padding absorbs rounding at cell borders.
+    Vec2 p = def.walls[w].from, q = def.walls[w].to;
+    if (p.x > q.x) std::swap(p, q);
+    const double pad = 1e-9 * (walls_grid.cell_w() + std::abs(q.x - p.x) + std::abs(q.y - p.y));
+    const int x0 = walls_grid.cx(p.x - pad), x1 = walls_grid.cx(q.x + pad);
+    for (int ix = x0; ix <= x1; ++ix) {
+      double ya = p.y, yb = q.y;
+      if (q.x > p.x && ix != x0 && ix != x1) {
+        // An interior column: the segment spans it from its left to its right border.
+        const double slope = (q.y - p.y) / (q.x - p.x);
+        ya = p.y + slope * (walls_grid.cell_x0(ix) - p.x);
+        yb = p.y + slope * (walls_grid.cell_x0(ix) + walls_grid.cell_w() - p.x);
+      } else if (q.x > p.x) {
+        // An end column: from the end point to the border it crosses (or the other end point).
+        const double slope = (q.y - p.y) / (q.x - p.x);
+        const double xa = ix == x0 ? p.x : std::max(p.x, walls_grid.cell_x0(ix));
+        const double xb = ix == x1 ? q.x : std::min(q.x, walls_grid.cell_x0(ix) + walls_grid.cell_w());
+        ya = ix == x0 ? p.y : p.y + slope * (xa - p.x);
+        yb = ix == x1 ? q.y : p.y + slope * (xb - p.x);
+      }
+      const int y0 = walls_grid.cy(std::min(ya, yb) - pad), y1 = walls_grid.cy(std::max(ya, yb) + pad);
+      for (int iy = y0; iy <= y1; ++iy) walls_grid.insert(ix, iy, static_cast<std::uint32_t>(w));
+    }
+  }
+  std::array<Vec2, 4> img{};
+  for (std::size_t i = 0; i < n; ++i) {
+    const BallDef& b = def.balls[i];
+    const int k = images(b, img);
+    std::optional<std::size_t> hit;
+    for (int m = 0; m < k && !hit; ++m) {
+      const Vec2 p = img[m];
+      walls_grid.any(box(p, b.radius), [&](std::uint32_t w) {
+        const WallDef& wall = def.walls[w];
+        if (segment_distance2(p, wall.from, wall.to) < b.radius * b.radius) hit = w;
+        return hit.has_value();
+      });
+    }
+    if (hit) {
+      const WallDef& wall = def.walls[*hit];
+      return problem(Where::ball, i, "pos",
+                     ball_name(b, i) + " (radius " + num(b.radius) + ") at " + vec(b.pos) + " overlaps " +
+                         wall_name(wall, *hit) + " from " + vec(wall.from) + " to " + vec(wall.to) +
+                         "; move the ball away from the wall or make it smaller");
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<DefProblem> validate(const WorldDef& def) {
+  if (auto p = check_scalars(def)) return p;
+  if (auto p = check_walls(def)) return p;
+  if (auto p = check_balls(def)) return p;
+  if (def.walls.size() + def.balls.size() >= std::numeric_limits<std::uint32_t>::max() / 4)
+    return problem(Where::world, 0, "balls", "too many objects (" + std::to_string(def.walls.size() + def.balls.size()) +
+                                                 "); the engine indexes walls and balls with 32 bits");
+  if (auto p = check_ids(def)) return p;
+  if (auto p = check_overlaps(def)) return p;
+  return std::nullopt;
+}
+
+std::vector<WallDef> arena_walls(const ArenaDef& arena) {
+  const double w = arena.width, h = arena.height;
+  return {
+      WallDef{std::string(arena_ids[0]), {0.0, 0.0}, {w, 0.0}},
+      WallDef{std::string(arena_ids[1]), {w, 0.0}, {w, h}},
+      WallDef{std::string(arena_ids[2]), {w, h}, {0.0, h}},
+      WallDef{std::string(arena_ids[3]), {0.0, h}, {0.0, 0.0}},
+  };
+}
+
+}  // namespace turtlegas::sim

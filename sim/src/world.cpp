@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/sim/world.hpp"
+
+#include "engine.hpp"
+
+namespace turtlegas::sim {
+
+class World::Impl {
+ public:
+  std::unique_ptr<detail::EngineBase> engine;
+};
+
+World::World(const WorldDef& def, Mode mode) : impl_(std::make_unique<Impl>()) {
+  impl_->engine = detail::make_engine(def, mode);
+}
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
+void World::advance_to(double t) { impl_->engine->advance_to(t); }
+void World::set_event_log(std::vector<Event>* log) { impl_->engine->set_event_log(log); }
+double World::time() const { return impl_->engine->time(); }
+Mode World::mode() const { return impl_->engine->mode(); }
+double World::dt() const { return impl_->engine->dt(); }
+double World::cell_size() const { return impl_->engine->cell_size(); }
+int World::cells_x() const { return impl_->engine->cells_x(); }
+int World::cells_y() const { return impl_->engine->cells_y(); }
+std::size_t World::ball_count() const { return impl_->engine->ball_count(); }
+BallState World::ball(std::size_t i) const { return impl_->engine->ball(i); }
+double World::radius(std::size_t i) const { return impl_->engine->radius(i); }
+double World::mass(std::size_t i) const { return impl_->engine->mass(i); }
+const std::vector<WallDef>& World::walls() const { return impl_->engine->walls(); }
+double World::energy() const { return impl_->engine->energy(); }
+const Stats& World::stats() const { return impl_->engine->stats(); }
+Overlap World::measure_overlap() const { return impl_->engine->measure_overlap(); }
+Overlap World::max_contact_overlap() const { return impl_->engine->max_contact_overlap(); }
+
+}  // namespace turtlegas::sim
