@@ -25,6 +25,11 @@
 //      repeat until no collision is left in the step (steps 2 and 3 of exact mode, without cells).
 //   3. Move every ball to the end of the step and apply the field kick v += a dt. Balls outside an
 //      open arena exit; a periodic arena wraps them.
+//
+// Turtles are bodies too (ids after the balls', in cell lists of their own): discs of infinite
+// mass that fly straight at the velocity their current command gives, never feel fields, and stop
+// dead at a contact (or bounce, if asked). The end of a command is one more candidate in a
+// turtle's prediction. Commands arrive from the runtime between calls to advance_to.
 #include "engine.hpp"
 
 #include <algorithm>
@@ -81,7 +86,9 @@ struct Body {
 };
 static_assert(sizeof(Body) == 64);
 
-enum class Partner : std::uint8_t { none, ball, wall, end };
+/// What a prediction is about. `body` partners are balls or turtles (ids are shared); `command`
+/// is the end of a turtle's own command.
+enum class Partner : std::uint8_t { none, body, wall, end, command };
 
 /// The earliest predicted collision of a ball, and when it leaves its cell (exact mode).
 struct Pending {
@@ -93,16 +100,32 @@ struct Pending {
   std::uint8_t cross_dir = 0;  ///< 0: -x, 1: +x, 2: -y, 3: +y
 };
 
-// Who a ball collided with last, packed as kind << 30 | index: with straight relative motion a
+// Who a body collided with last, packed as kind << 29 | index: with straight relative motion a
 // pair that has just collided cannot meet again before one of them has another event, so the
 // prediction skips it rather than trusting the sign of a round-off-sized approach speed.
 constexpr std::uint32_t last_code(Partner k, std::uint32_t index) {
-  return (static_cast<std::uint32_t>(k) << 30) | index;
+  return (static_cast<std::uint32_t>(k) << 29) | index;
 }
+
+/// A turtle's command in progress, in the engine's internal time.
+struct TurtleRun {
+  TurtleCommand::Kind kind = TurtleCommand::Kind::stop;
+  bool coasting = false;  ///< bouncing off after a contact, until the next control step
+  bool busy = false;
+  bool touched = false;
+  double amount = 0.0;
+  double t_start = 0.0;
+  double t_end = kNever;
+  double heading0 = 0.0;  ///< heading at t_start
+  double omega = 0.0;     ///< signed turn rate while turning
+  double speed = 0.0;
+  double turn_rate = 0.0;
+  double bounce = -1.0;
+};
 
 double path_length(Vec2 v, double dt) { return norm(v) * dt; }
 
-template <class Flight, bool kBallBall, bool kStep>
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
 class Engine final : public EngineBase {
  public:
   Engine(const WorldDef& def, Mode mode);
@@ -110,7 +133,7 @@ class Engine final : public EngineBase {
   void advance_to(double t) override;
   void set_event_log(std::vector<Event>* log) override { log_ = log; }
   double time() const override { return t_base_ + now_; }
-  std::size_t ball_count() const override { return body_.size(); }
+  std::size_t ball_count() const override { return nb_; }
   BallState ball(std::size_t i) const override {
     const Body& b = body_[i];
     const double dt = now_ - b.t;
@@ -119,6 +142,15 @@ class Engine final : public EngineBase {
   double radius(std::size_t i) const override { return body_[i].r; }
   double mass(std::size_t i) const override { return mass_[i]; }
   const std::vector<WallDef>& walls() const override { return wall_defs_; }
+  std::size_t turtle_count() const override { return run_.size(); }
+  TurtleState turtle(std::size_t k) const override;
+  double turtle_radius(std::size_t k) const override { return body_[nb_ + k].r; }
+  void command_turtle(std::size_t k, const TurtleCommand& command) override;
+  std::vector<TurtleContact> take_turtle_contacts() override {
+    std::vector<TurtleContact> out;
+    out.swap(contacts_);
+    return out;
+  }
   double energy() const override;
   const Stats& stats() const override { return stats_; }
   Overlap measure_overlap() const override;
@@ -130,6 +162,29 @@ class Engine final : public EngineBase {
   double dt() const override { return dt_; }
 
  private:
+  bool is_turtle(std::uint32_t id) const { return kTurtles && id >= nb_; }
+  /// The acceleration a body flies under: the field for balls, none for turtles.
+  Vec2 accel(std::uint32_t id) const { return is_turtle(id) ? Vec2{} : flight_.a; }
+  bool straight(std::uint32_t id) const { return !Flight::kAccelerates || is_turtle(id); }
+  Vec2 pos_at(const Body& b, std::uint32_t id, double dt) const {
+    return is_turtle(id) ? b.x + dt * b.v : flight_.pos(b.x, b.v, dt);
+  }
+  Vec2 vel_at(const Body& b, std::uint32_t id, double dt) const {
+    return is_turtle(id) ? b.v : flight_.vel(b.v, dt);
+  }
+  double heading_at(std::size_t k, double t) const {
+    const TurtleRun& r = run_[k];
+    return r.heading0 + r.omega * (std::min(t, r.t_end) - r.t_start);
+  }
+  Vec2 min_image(Vec2 d) const {
+    if (grid_.periodic()) {
+      // The arena is at least 3 cells (so 3 diameters) across: the nearest image is the one.
+      d.x -= width_ * std::round(d.x / width_);
+      d.y -= height_ * std::round(d.y / height_);
+    }
+    return d;
+  }
+
   // Bookkeeping.
   void link(std::uint32_t i, std::uint32_t cell);
   void unlink(std::uint32_t i);
@@ -145,7 +200,10 @@ class Engine final : public EngineBase {
   // Predict.
   void predict(std::uint32_t i);
   void predict_strip(std::uint32_t i, int dir);
+  void scan_cell(std::uint32_t i, const Body& bi, int cell, Vec2 shift, Pending& p) const;
   void consider_ball(std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift, Pending& p) const;
+  void consider_turtle(std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift, Pending& p) const;
+  void consider_ball_from_turtle(std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift, Pending& p) const;
   void consider_wall(std::uint32_t i, const Body& bi, std::uint32_t w, Vec2 shift, Pending& p) const;
   void consider_end(std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift, Pending& p) const;
   void predict_crossing(std::uint32_t i);
@@ -161,10 +219,14 @@ class Engine final : public EngineBase {
   void process(double limit);
   void collide(std::uint32_t i);
   void collide_balls(std::uint32_t i, std::uint32_t j);
+  void collide_with_turtle(std::uint32_t i, std::uint32_t j);
   void collide_wall(std::uint32_t i, std::uint32_t w);
   void collide_end(std::uint32_t i, std::uint32_t e);
+  void end_command(std::uint32_t i);
+  void touch(std::uint32_t id, EventKind kind, std::uint32_t other, Vec2 normal);
   void cross(std::uint32_t i);
   void remove(std::uint32_t i);
+  void repredict(std::uint32_t i);
   double restitution_for(std::uint32_t i) const;
   Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n) const;
   void after_change(std::uint32_t i);
@@ -183,12 +245,16 @@ class Engine final : public EngineBase {
   double dt_ = 0.0;
   Vec2 kick_{};
 
+  std::uint32_t nb_ = 0;     ///< balls are ids [0, nb_), turtles [nb_, body_.size())
   std::vector<Body> body_;
   std::vector<double> mass_;
   std::vector<std::uint32_t> last_;
   std::vector<double> last_time_;  ///< only when restitution < 1 (the TC rule)
   std::vector<Pending> pending_;
-  std::vector<std::uint32_t> head_;
+  std::vector<std::uint32_t> head_;         ///< balls by cell
+  std::vector<std::uint32_t> turtle_head_;  ///< turtles by cell (only when there are turtles)
+  std::vector<TurtleRun> run_;
+  std::vector<TurtleContact> contacts_;
   EventQueue heap_;
 
   std::vector<WallDef> wall_defs_;
@@ -204,7 +270,7 @@ class Engine final : public EngineBase {
   // Step mode.
   std::uint64_t step_index_ = 0;
   double rmax_ = 0.0;
-  double dmax_ = 0.0;              ///< largest path length of any ball in this step
+  double dmax_ = 0.0;              ///< largest path length of any body in this step
   std::vector<double> travel_;     ///< path length so far in this step
   mutable std::vector<std::uint32_t> stamp_;  ///< de-duplicates walls and ends in ring scans
   mutable std::uint32_t scan_ = 0;
@@ -214,8 +280,8 @@ class Engine final : public EngineBase {
   std::vector<Event>* log_ = nullptr;
 };
 
-template <class Flight, bool kBallBall, bool kStep>
-Engine<Flight, kBallBall, kStep>::Engine(const WorldDef& def, Mode) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+Engine<Flight, kBallBall, kStep, kTurtles>::Engine(const WorldDef& def, Mode) {
   if (auto problem = validate(def)) throw std::invalid_argument(problem->message);
   const EffectsDef& fx = def.effects;
   if constexpr (kStep) kick_ = fx.gravity;
@@ -248,14 +314,19 @@ Engine<Flight, kBallBall, kStep>::Engine(const WorldDef& def, Mode) {
   ends_.erase(std::unique(ends_.begin(), ends_.end(), [](const WallEnd& a, const WallEnd& b) { return a.p == b.p; }),
               ends_.end());
 
-  const std::size_t n = def.balls.size();
+  nb_ = static_cast<std::uint32_t>(def.balls.size());
+  const std::size_t n = def.balls.size() + def.turtles.size();
   double vmax = 0.0;
   for (const auto& b : def.balls) {
     rmax_ = std::max(rmax_, b.radius);
     vmax = std::max(vmax, norm(b.vel));
   }
-  // Cell size. Exact mode needs cells at least a diameter wide so that touching balls are always
-  // in neighbouring cells; step mode needs the memo's rule: a cell wider than any two balls' radii
+  for (const auto& t : def.turtles) {
+    rmax_ = std::max(rmax_, t.radius);
+    vmax = std::max(vmax, t.speed);
+  }
+  // Cell size. Exact mode needs cells at least a diameter wide so that touching bodies are always
+  // in neighbouring cells; step mode needs the memo's rule: a cell wider than any two bodies' radii
   // plus their paths in one step. Beyond that, aim for about two balls per cell.
   const double area = width_ * height_;
   const double rule = kStep ? 2.0 * (rmax_ + vmax * dt_) : 2.0 * rmax_;
@@ -266,7 +337,7 @@ Engine<Flight, kBallBall, kStep>::Engine(const WorldDef& def, Mode) {
       const std::string why = kStep
           ? "the memo's rule in step mode needs cells wider than twice (largest radius + largest speed x dt) = " +
                 std::to_string(rule) + "; set arena.cell >= that, use a smaller dt, or use --mode exact"
-          : "exact mode needs cells at least as wide as the largest ball (diameter " + std::to_string(rule) +
+          : "exact mode needs cells at least as wide as the largest ball or turtle (diameter " + std::to_string(rule) +
                 "); set arena.cell >= that";
       throw std::invalid_argument("arena.cell " + std::to_string(cell) + " is too small: " + why);
     }
@@ -284,23 +355,37 @@ Engine<Flight, kBallBall, kStep>::Engine(const WorldDef& def, Mode) {
                                 "); enlarge the arena or use smaller balls");
 
   body_.resize(n);
-  mass_.resize(n);
+  mass_.resize(nb_);
   last_.assign(n, kNone);
   if (inelastic_) last_time_.assign(n, -kNever);
   pending_.assign(n, Pending{});
   head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
+  if constexpr (kTurtles) turtle_head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
   heap_.reset(n);
   if constexpr (kStep) {
     travel_.assign(n, 0.0);
     stamp_.assign(walls_.size() * 9 + ends_.size() * 9, 0);
   }
-  for (std::uint32_t i = 0; i < n; ++i) {
+  for (std::uint32_t i = 0; i < nb_; ++i) {
     const BallDef& d = def.balls[i];
     body_[i].x = d.pos;
     body_[i].v = d.vel;
     body_[i].r = d.radius;
     mass_[i] = d.mass;
     link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(d.pos)));
+  }
+  run_.resize(def.turtles.size());
+  for (std::size_t k = 0; k < def.turtles.size(); ++k) {
+    const TurtleDef& d = def.turtles[k];
+    const auto id = static_cast<std::uint32_t>(nb_ + k);
+    body_[id].x = d.pos;
+    body_[id].r = d.radius;
+    TurtleRun& r = run_[k];
+    r.heading0 = d.heading;
+    r.speed = d.speed;
+    r.turn_rate = d.turn_rate;
+    r.bounce = d.bounce;
+    link(id, static_cast<std::uint32_t>(grid_.arena_cell_of(d.pos)));
   }
   rebase_every_ = std::max<std::uint64_t>(4 * n, 4096);
   if constexpr (kStep) {
@@ -314,43 +399,44 @@ Engine<Flight, kBallBall, kStep>::Engine(const WorldDef& def, Mode) {
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::link(std::uint32_t i, std::uint32_t cell) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::link(std::uint32_t i, std::uint32_t cell) {
   Body& b = body_[i];
+  std::uint32_t& head = is_turtle(i) ? turtle_head_[cell] : head_[cell];
   b.cell = cell;
   b.prev = kNone;
-  b.next = head_[cell];
+  b.next = head;
   if (b.next != kNone) body_[b.next].prev = i;
-  head_[cell] = i;
+  head = i;
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::unlink(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::unlink(std::uint32_t i) {
   Body& b = body_[i];
   if (b.prev != kNone) body_[b.prev].next = b.next;
-  else head_[b.cell] = b.next;
+  else (is_turtle(i) ? turtle_head_[b.cell] : head_[b.cell]) = b.next;
   if (b.next != kNone) body_[b.next].prev = b.prev;
   b.next = b.prev = kNone;
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::sync(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::sync(std::uint32_t i) {
   Body& b = body_[i];
   const double dt = now_ - b.t;
   if constexpr (kStep) travel_[i] += path_length(b.v, dt);
-  b.x = flight_.pos(b.x, b.v, dt);
-  b.v = flight_.vel(b.v, dt);
+  b.x = pos_at(b, i, dt);
+  b.v = vel_at(b, i, dt);
   b.t = now_;
 }
 
 // ---------------------------------------------------------------------------------------------
 // Predict
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::consider_ball(std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift,
-                                                     Pending& p) const {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::consider_ball(std::uint32_t i, const Body& bi, std::uint32_t j,
+                                                               Vec2 shift, Pending& p) const {
+  // i is a ball here, j a ball.
   if (j == i) return;
-  if (last_[i] == last_code(Partner::ball, j) && last_[j] == last_code(Partner::ball, i)) return;
   const Body& bj = body_[j];
   const double dtj = now_ - bj.t;
   // Under uniform gravity both balls fall alike, so their relative motion is a straight line.
@@ -358,20 +444,43 @@ void Engine<Flight, kBallBall, kStep>::consider_ball(std::uint32_t i, const Body
   const Vec2 v = flight_.vel(bj.v, dtj) - bi.v;
   const double t = now_ + toi_disc_disc(r, v, bi.r + bj.r);
   if (t < p.t_coll) {
+    // Checked only for a winner: most candidates miss, and last_[j] is a cache miss.
+    if (last_[i] == last_code(Partner::body, j) && last_[j] == last_code(Partner::body, i)) return;
     p.t_coll = t;
-    p.kind = Partner::ball;
+    p.kind = Partner::body;
     p.partner = j;
     p.partner_count = bj.count;
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::consider_wall(std::uint32_t i, const Body& bi, std::uint32_t w, Vec2 shift,
-                                                     Pending& p) const {
-  if (!Flight::kAccelerates && last_[i] == last_code(Partner::wall, w)) return;
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::consider_turtle(std::uint32_t i, const Body& bi, std::uint32_t j,
+                                                                 Vec2 shift, Pending& p) const {
+  // j is a turtle (straight flight); i a ball or a turtle.
+  if (j == i) return;
+  const Body& bj = body_[j];
+  const Vec2 rel = bi.x - (bj.x + (now_ - bj.t) * bj.v + shift);
+  const Vec2 v = bi.v - bj.v;
+  double dt;
+  if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(rel, v, flight_.a, bi.r + bj.r, p.t_coll - now_);
+  else dt = toi_disc_disc(rel, v, bi.r + bj.r);
+  const double t = now_ + dt;
+  if (t < p.t_coll) {
+    if (straight(i) && last_[i] == last_code(Partner::body, j) && last_[j] == last_code(Partner::body, i)) return;
+    p.t_coll = t;
+    p.kind = Partner::body;
+    p.partner = j;
+    p.partner_count = bj.count;
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::consider_wall(std::uint32_t i, const Body& bi, std::uint32_t w,
+                                                               Vec2 shift, Pending& p) const {
+  if (straight(i) && last_[i] == last_code(Partner::wall, w)) return;
   const Segment& s = walls_[w];
   // Relative to the wall's first end, so walls far from the origin lose nothing.
-  const double t = now_ + toi_disc_segment(bi.x - (s.p1 + shift), bi.v, flight_.a, s, bi.r);
+  const double t = now_ + toi_disc_segment(bi.x - (s.p1 + shift), bi.v, accel(i), s, bi.r);
   if (t < p.t_coll) {
     p.t_coll = t;
     p.kind = Partner::wall;
@@ -379,13 +488,13 @@ void Engine<Flight, kBallBall, kStep>::consider_wall(std::uint32_t i, const Body
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::consider_end(std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift,
-                                                    Pending& p) const {
-  if (!Flight::kAccelerates && last_[i] == last_code(Partner::end, e)) return;
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::consider_end(std::uint32_t i, const Body& bi, std::uint32_t e,
+                                                              Vec2 shift, Pending& p) const {
+  if (straight(i) && last_[i] == last_code(Partner::end, e)) return;
   const Vec2 rel = bi.x - (ends_[e].p + shift);
   double dt;
-  if constexpr (Flight::kAccelerates) dt = toi_disc_point_accel(rel, bi.v, flight_.a, bi.r, p.t_coll - now_);
+  if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(rel, bi.v, flight_.a, bi.r, p.t_coll - now_);
   else dt = toi_disc_point(rel, bi.v, bi.r);
   const double t = now_ + dt;
   if (t < p.t_coll) {
@@ -395,28 +504,69 @@ void Engine<Flight, kBallBall, kStep>::consider_end(std::uint32_t i, const Body&
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::predict(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::consider_ball_from_turtle(std::uint32_t i, const Body& bi,
+                                                                           std::uint32_t j, Vec2 shift,
+                                                                           Pending& p) const {
+  // i is a turtle (straight flight), j a ball (which may fall).
+  const Body& bj = body_[j];
+  const double dtj = now_ - bj.t;
+  const Vec2 rel = flight_.pos(bj.x, bj.v, dtj) + shift - bi.x;
+  const Vec2 v = flight_.vel(bj.v, dtj) - bi.v;
+  double dt;
+  if constexpr (Flight::kAccelerates) dt = toi_disc_point_accel(rel, v, flight_.a, bi.r + bj.r, p.t_coll - now_);
+  else dt = toi_disc_disc(rel, v, bi.r + bj.r);
+  const double t = now_ + dt;
+  if (t < p.t_coll) {
+    if (!Flight::kAccelerates && last_[i] == last_code(Partner::body, j) && last_[j] == last_code(Partner::body, i)) return;
+    p.t_coll = t;
+    p.kind = Partner::body;
+    p.partner = j;
+    p.partner_count = bj.count;
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::scan_cell(std::uint32_t i, const Body& bi, int cell, Vec2 shift,
+                                                           Pending& p) const {
+  // The bodies listed in one cell: balls (when the pair can collide) and turtles.
+  if (!is_turtle(i)) {
+    if constexpr (kBallBall)
+      for (std::uint32_t j = head_[cell]; j != kNone; j = body_[j].next) consider_ball(i, bi, j, shift, p);
+  } else {
+    for (std::uint32_t j = head_[cell]; j != kNone; j = body_[j].next) consider_ball_from_turtle(i, bi, j, shift, p);
+  }
+  if constexpr (kTurtles)
+    for (std::uint32_t j = turtle_head_[cell]; j != kNone; j = body_[j].next) consider_turtle(i, bi, j, shift, p);
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::predict(std::uint32_t i) {
   const Body& bi = body_[i];
   Pending& p = pending_[i];
   p.t_coll = kNever;
   p.kind = Partner::none;
+  if (is_turtle(i)) {
+    // The end of the turtle's own command is one more candidate.
+    const TurtleRun& r = run_[i - nb_];
+    if (r.t_end < kNever) {
+      p.t_coll = r.t_end;
+      p.kind = Partner::command;
+    }
+  }
   const int ix = grid_.ix_of(static_cast<int>(bi.cell)), iy = grid_.iy_of(static_cast<int>(bi.cell));
   if constexpr (!kStep) {
-    if constexpr (kBallBall) {
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const auto nb = grid_.neighbour(ix, iy, dx, dy);
-          for (std::uint32_t j = head_[nb.cell]; j != kNone; j = body_[j].next) consider_ball(i, bi, j, nb.shift, p);
-        }
-    }
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const auto nb = grid_.neighbour(ix, iy, dx, dy);
+        scan_cell(i, bi, nb.cell, nb.shift, p);
+      }
     for (auto it = grid_.near_walls_begin(bi.cell); it != grid_.near_walls_end(bi.cell); ++it)
       consider_wall(i, bi, it->item, grid_.shift(it->shift), p);
     for (auto it = grid_.near_ends_begin(bi.cell); it != grid_.near_ends_end(bi.cell); ++it)
       consider_end(i, bi, it->item, grid_.shift(it->shift), p);
-  }
-  if constexpr (kStep) {
-    // The memo's rule normally makes this the 3x3 neighbourhood; a ball sped up by a collision
+  } else {
+    // The memo's rule normally makes this the 3x3 neighbourhood; a body sped up by a collision
     // inside the step widens the search instead of missing a partner.
     const double step_end = dt_;
     const double d_i = travel_[i] + path_length(bi.v, step_end - now_);
@@ -425,20 +575,17 @@ void Engine<Flight, kBallBall, kStep>::predict(std::uint32_t i) {
     const int kw = step_rings(bi.r + d_i);
     const bool periodic = grid_.periodic();
     if (periodic && (2 * kb + 1 > grid_.nx() || 2 * kb + 1 > grid_.ny()))
-      throw std::runtime_error("step mode: a ball moves too far in one step for this periodic arena; use a smaller dt or --mode exact");
-    const int n1x = grid_.nx() + 1, n1y = grid_.ny() + 1;
-    if constexpr (kBallBall) {
-      for (int dy = -kb; dy <= kb; ++dy)
-        for (int dx = -kb; dx <= kb; ++dx) {
-          if (!periodic && (ix + dx < 1 || ix + dx > n1x - 1 || iy + dy < 1 || iy + dy > n1y - 1)) continue;
-          const auto nb = grid_.neighbour(ix, iy, dx, dy);
-          for (std::uint32_t j = head_[nb.cell]; j != kNone; j = body_[j].next) consider_ball(i, bi, j, nb.shift, p);
-        }
-    }
+      throw std::runtime_error("step mode: a body moves too far in one step for this periodic arena; use a smaller dt or --mode exact");
+    for (int dy = -kb; dy <= kb; ++dy)
+      for (int dx = -kb; dx <= kb; ++dx) {
+        if (!periodic && (ix + dx < 1 || ix + dx > grid_.nx() || iy + dy < 1 || iy + dy > grid_.ny())) continue;
+        const auto nb = grid_.neighbour(ix, iy, dx, dy);
+        scan_cell(i, bi, nb.cell, nb.shift, p);
+      }
     ++scan_;
     for (int dy = -kw; dy <= kw; ++dy)
       for (int dx = -kw; dx <= kw; ++dx) {
-        if (!periodic && (ix + dx < 0 || ix + dx > n1x || iy + dy < 0 || iy + dy > n1y)) continue;
+        if (!periodic && (ix + dx < 0 || ix + dx > grid_.nx() + 1 || iy + dy < 0 || iy + dy > grid_.ny() + 1)) continue;
         const auto nb = grid_.neighbour(ix, iy, dx, dy);
         const std::uint32_t s = grid_.shift_index(nb.shift);
         for (auto it = grid_.walls_begin(nb.cell); it != grid_.walls_end(nb.cell); ++it) {
@@ -461,8 +608,8 @@ void Engine<Flight, kBallBall, kStep>::predict(std::uint32_t i) {
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::predict_strip(std::uint32_t i, int dir) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::predict_strip(std::uint32_t i, int dir) {
   // The three cells that have just come within the 3x3 neighbourhood after a crossing in `dir`.
   const Body& bi = body_[i];
   Pending& p = pending_[i];
@@ -473,22 +620,27 @@ void Engine<Flight, kBallBall, kStep>::predict_strip(std::uint32_t i, int dir) {
     const int dx = ax != 0 ? ax : k;
     const int dy = ay != 0 ? ay : k;
     const auto nb = grid_.neighbour(ix, iy, dx, dy);
-    if constexpr (kBallBall)
-      for (std::uint32_t j = head_[nb.cell]; j != kNone; j = body_[j].next) consider_ball(i, bi, j, nb.shift, p);
+    scan_cell(i, bi, nb.cell, nb.shift, p);
     for (auto it = grid_.walls_begin(nb.cell); it != grid_.walls_end(nb.cell); ++it) consider_wall(i, bi, *it, nb.shift, p);
     for (auto it = grid_.ends_begin(nb.cell); it != grid_.ends_end(nb.cell); ++it) consider_end(i, bi, *it, nb.shift, p);
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::predict_crossing(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::predict_crossing(std::uint32_t i) {
   const Body& b = body_[i];
   Pending& p = pending_[i];
   const int ix = grid_.ix_of(static_cast<int>(b.cell)), iy = grid_.iy_of(static_cast<int>(b.cell));
   // Relative to the cell's edges, computed from the cell index rather than re-derived from the
-  // position, so a ball sitting on an edge by round-off is never assigned twice.
-  const AxisExit ex = flight_.exit_x(b.x.x, b.v.x, grid_.x_edge(ix - 1), grid_.x_edge(ix));
-  const AxisExit ey = flight_.exit_y(b.x.y, b.v.y, grid_.y_edge(iy - 1), grid_.y_edge(iy));
+  // position, so a body sitting on an edge by round-off is never assigned twice.
+  AxisExit ex, ey;
+  if (is_turtle(i)) {
+    ex = FreeFlight::exit(b.x.x, b.v.x, grid_.x_edge(ix - 1), grid_.x_edge(ix));
+    ey = FreeFlight::exit(b.x.y, b.v.y, grid_.y_edge(iy - 1), grid_.y_edge(iy));
+  } else {
+    ex = flight_.exit_x(b.x.x, b.v.x, grid_.x_edge(ix - 1), grid_.x_edge(ix));
+    ey = flight_.exit_y(b.x.y, b.v.y, grid_.y_edge(iy - 1), grid_.y_edge(iy));
+  }
   if (ex.t <= ey.t) {
     p.t_cross = now_ + ex.t;
     p.cross_dir = ex.upper ? 1 : 0;
@@ -501,8 +653,8 @@ void Engine<Flight, kBallBall, kStep>::predict_crossing(std::uint32_t i) {
 // ---------------------------------------------------------------------------------------------
 // Apply
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::process(double limit) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::process(double limit) {
   while (!heap_.empty() && heap_.top_key() <= limit) {
     const std::uint32_t i = heap_.top_id();
     now_ = heap_.top_key();
@@ -516,11 +668,18 @@ void Engine<Flight, kBallBall, kStep>::process(double limit) {
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::collide(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::repredict(std::uint32_t i) {
+  predict(i);
+  if constexpr (!kStep) predict_crossing(i);  // crossing times depend on the velocity just changed
+  schedule(i);
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::collide(std::uint32_t i) {
   const Pending p = pending_[i];
   switch (p.kind) {
-    case Partner::ball:
+    case Partner::body:
       if (body_[p.partner].count != p.partner_count) {
         ++stats_.stale;
         sync(i);
@@ -528,45 +687,46 @@ void Engine<Flight, kBallBall, kStep>::collide(std::uint32_t i) {
         schedule(i);
         return;
       }
-      collide_balls(i, p.partner);
+      if (is_turtle(i) || is_turtle(p.partner)) collide_with_turtle(i, p.partner);
+      else collide_balls(i, p.partner);
       return;
     case Partner::wall: collide_wall(i, p.partner); return;
     case Partner::end: collide_end(i, p.partner); return;
+    case Partner::command: end_command(i); return;
     case Partner::none: break;
   }
-  // A ball with nothing pending has an infinite key and is never popped.
+  // A body with nothing pending has an infinite key and is never popped.
   sync(i);
   predict(i);
   schedule(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-double Engine<Flight, kBallBall, kStep>::restitution_for(std::uint32_t i) const {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+double Engine<Flight, kBallBall, kStep, kTurtles>::restitution_for(std::uint32_t i) const {
   // The TC rule (Luding & McNamara): a ball that collided less than tc ago collides elastically,
   // so a cluster cannot collapse into infinitely many collisions in finite time.
   return now_ - last_time_[i] < tc_ ? 1.0 : e_;
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-Vec2 Engine<Flight, kBallBall, kStep>::bounce(std::uint32_t i, Vec2 v, Vec2 n) const {
-  // n: unit contact normal pointing from the obstacle to the ball. Approach speed w >= 0.
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+Vec2 Engine<Flight, kBallBall, kStep, kTurtles>::bounce(std::uint32_t i, Vec2 v, Vec2 n) const {
+  // n: unit contact normal pointing from the obstacle to the ball; v relative to the obstacle.
   // Walls take the plain restitution: the TC rule is for ball clusters; a ball pressed onto a wall
   // is kept from collapsing by the rest threshold below.
-  (void)i;
   const double w = -dot(v, n);
   double w_out = e_ * w;
   if constexpr (Flight::kAccelerates) {
     // The rest threshold: a ball pressed onto the obstacle by the field leaves it at least fast
     // enough to stay away for tc. Without it an inelastic ball would bounce infinitely often before
     // coming to rest, and a ball at rest would sink.
-    const double a_n = dot(flight_.a, n);
+    const double a_n = dot(accel(i), n);
     if (a_n < 0.0) w_out = std::max(w_out, -a_n * tc_ / 2.0);
   }
   return v + (w + w_out) * n;
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::after_change(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::after_change(std::uint32_t i) {
   ++body_[i].count;
   if (inelastic_) last_time_[i] = now_;
   if constexpr (kStep) {
@@ -575,18 +735,13 @@ void Engine<Flight, kBallBall, kStep>::after_change(std::uint32_t i) {
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::collide_balls(std::uint32_t i, std::uint32_t j) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::collide_balls(std::uint32_t i, std::uint32_t j) {
   sync(i);
   sync(j);
   Body& a = body_[i];
   Body& b = body_[j];
-  Vec2 F = b.x - a.x;
-  if (grid_.periodic()) {
-    // Minimum image: the arena is at least 3 cells (so 3 diameters) across.
-    F.x -= width_ * std::round(F.x / width_);
-    F.y -= height_ * std::round(F.y / height_);
-  }
+  const Vec2 F = min_image(b.x - a.x);
   const double sigma = a.r + b.r;
   note_contact(sigma - norm(F), std::min(a.r, b.r));
   double e = e_;
@@ -596,65 +751,213 @@ void Engine<Flight, kBallBall, kStep>::collide_balls(std::uint32_t i, std::uint3
   log(EventKind::ball_ball, i, j);
   after_change(i);
   after_change(j);
-  last_[i] = last_code(Partner::ball, j);
-  last_[j] = last_code(Partner::ball, i);
-  predict(i);
-  predict(j);
-  if constexpr (!kStep) {
-    // Crossing times depend on the velocities just changed.
-    predict_crossing(i);
-    predict_crossing(j);
-  }
-  schedule(i);
-  schedule(j);
+  last_[i] = last_code(Partner::body, j);
+  last_[j] = last_code(Partner::body, i);
+  repredict(i);
+  repredict(j);
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::collide_wall(std::uint32_t i, std::uint32_t w) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::touch(std::uint32_t id, EventKind kind, std::uint32_t other,
+                                                       Vec2 normal) {
+  // A turtle touched something: its command ends here (a dead stop, or a bounce that coasts to the
+  // next control step), and the contact waits for its touch sensors.
+  const std::size_t k = id - nb_;
+  TurtleRun& r = run_[k];
+  Body& b = body_[id];
+  if (r.busy) {
+    r.busy = false;
+    r.touched = true;
+    if (r.kind == TurtleCommand::Kind::turn) r.heading0 = heading_at(k, now_);
+    r.amount = r.kind == TurtleCommand::Kind::move ? r.speed * (now_ - r.t_start)
+               : r.kind == TurtleCommand::Kind::turn ? std::abs(r.omega) * (now_ - r.t_start)
+                                                     : now_ - r.t_start;
+    r.omega = 0.0;
+    r.t_end = kNever;
+  }
+  const double vn = dot(b.v, normal);
+  if (r.bounce >= 0.0 && vn < 0.0) {
+    b.v = b.v - ((1.0 + r.bounce) * vn) * normal;
+    // Coast until the next control step, where the program decides again.
+    const double t_ext = t_base_ + now_;
+    const double next_step = (std::floor(t_ext / dt_ + 1e-9) + 1.0) * dt_;
+    r.coasting = true;
+    r.t_end = next_step - t_base_;
+  } else {
+    b.v = {};
+    r.coasting = false;
+    r.t_end = kNever;
+  }
+  contacts_.push_back({t_base_ + now_, static_cast<std::uint32_t>(k), kind, other, normal});
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::collide_with_turtle(std::uint32_t i, std::uint32_t j) {
+  sync(i);
+  sync(j);
+  // Name the pair (turtle, other) with the turtle first.
+  const std::uint32_t t = is_turtle(i) ? i : j;
+  const std::uint32_t o = t == i ? j : i;
+  Body& bt = body_[t];
+  Body& bo = body_[o];
+  const Vec2 F = min_image(bo.x - bt.x);  // from the turtle to the other body
+  const double dist = norm(F);
+  note_contact(bt.r + bo.r - dist, std::min(bt.r, bo.r));
+  const Vec2 n = F / dist;
+  if (!is_turtle(o)) {
+    // A ball bounces off the turtle as off a moving wall of infinite mass.
+    bo.v = bt.v + bounce(o, bo.v - bt.v, n);
+    ++stats_.turtle_ball;
+    log(EventKind::turtle_ball, t - nb_, o);
+    touch(t, EventKind::turtle_ball, o, -n);
+  } else {
+    ++stats_.turtle_turtle;
+    log(EventKind::turtle_turtle, t - nb_, o - nb_);
+    touch(t, EventKind::turtle_turtle, o - nb_, -n);
+    touch(o, EventKind::turtle_turtle, t - nb_, n);
+  }
+  after_change(t);
+  after_change(o);
+  last_[t] = last_code(Partner::body, o);
+  last_[o] = last_code(Partner::body, t);
+  repredict(t);
+  repredict(o);
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::collide_wall(std::uint32_t i, std::uint32_t w) {
   sync(i);
   Body& a = body_[i];
   const Segment& s = walls_[w];
-  Vec2 rel = a.x - s.p1;
-  if (grid_.periodic()) {
-    rel.x -= width_ * std::round(rel.x / width_);
-    rel.y -= height_ * std::round(rel.y / height_);
-  }
-  const double d = dot(rel, s.n);
+  const double d = dot(min_image(a.x - s.p1), s.n);
   const Vec2 n = d >= 0.0 ? s.n : -s.n;
   note_contact(a.r - std::abs(d), a.r);
-  a.v = bounce(i, a.v, n);
-  ++stats_.ball_wall;
-  log(EventKind::ball_wall, i, w);
+  if (is_turtle(i)) {
+    ++stats_.turtle_wall;
+    log(EventKind::turtle_wall, i - nb_, w);
+    touch(i, EventKind::turtle_wall, w, n);
+  } else {
+    a.v = bounce(i, a.v, n);
+    ++stats_.ball_wall;
+    log(EventKind::ball_wall, i, w);
+  }
   after_change(i);
   last_[i] = last_code(Partner::wall, w);
-  predict(i);
-  if constexpr (!kStep) predict_crossing(i);
-  schedule(i);
+  repredict(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::collide_end(std::uint32_t i, std::uint32_t e) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::collide_end(std::uint32_t i, std::uint32_t e) {
   sync(i);
   Body& a = body_[i];
-  Vec2 F = a.x - ends_[e].p;
-  if (grid_.periodic()) {
-    F.x -= width_ * std::round(F.x / width_);
-    F.y -= height_ * std::round(F.y / height_);
-  }
+  const Vec2 F = min_image(a.x - ends_[e].p);
   const double dist = norm(F);
   note_contact(a.r - dist, a.r);
-  a.v = bounce(i, a.v, F / dist);
-  ++stats_.ball_wall_end;
-  log(EventKind::ball_wall_end, i, ends_[e].wall);
+  if (is_turtle(i)) {
+    ++stats_.turtle_wall_end;
+    log(EventKind::turtle_wall_end, i - nb_, ends_[e].wall);
+    touch(i, EventKind::turtle_wall_end, ends_[e].wall, F / dist);
+  } else {
+    a.v = bounce(i, a.v, F / dist);
+    ++stats_.ball_wall_end;
+    log(EventKind::ball_wall_end, i, ends_[e].wall);
+  }
   after_change(i);
   last_[i] = last_code(Partner::end, e);
-  predict(i);
-  if constexpr (!kStep) predict_crossing(i);
-  schedule(i);
+  repredict(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::cross(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::end_command(std::uint32_t i) {
+  // A turtle's command (or its coasting after a bounce) has run its course.
+  sync(i);
+  TurtleRun& r = run_[i - nb_];
+  if (r.kind == TurtleCommand::Kind::turn && r.busy) r.heading0 = heading_at(i - nb_, now_);
+  if (r.busy) r.amount = std::abs(r.amount);
+  r.busy = false;
+  r.coasting = false;
+  r.omega = 0.0;
+  r.t_end = kNever;
+  body_[i].v = {};
+  after_change(i);
+  last_[i] = kNone;
+  repredict(i);
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::command_turtle(std::size_t k, const TurtleCommand& c) {
+  if (k >= run_.size()) throw std::out_of_range("command_turtle: no turtle " + std::to_string(k));
+  const auto id = static_cast<std::uint32_t>(nb_ + k);
+  if (body_[id].cell == kNone) return;  // it has left the arena
+  sync(id);
+  TurtleRun& r = run_[k];
+  r.heading0 = heading_at(k, now_);
+  r.kind = c.kind;
+  r.coasting = false;
+  r.touched = false;
+  r.t_start = now_;
+  r.omega = 0.0;
+  r.amount = 0.0;
+  Body& b = body_[id];
+  b.v = {};
+  switch (c.kind) {
+    case TurtleCommand::Kind::stop:
+      r.busy = false;
+      r.t_end = kNever;
+      break;
+    case TurtleCommand::Kind::move: {
+      const double sign = c.amount >= 0.0 ? 1.0 : -1.0;
+      r.busy = c.amount != 0.0 && r.speed > 0.0;
+      r.t_end = r.busy ? now_ + std::abs(c.amount) / r.speed : kNever;
+      if (r.busy) b.v = (sign * r.speed) * Vec2{std::sin(r.heading0), std::cos(r.heading0)};
+      r.amount = c.amount;
+      break;
+    }
+    case TurtleCommand::Kind::turn:
+      r.busy = c.amount != 0.0 && r.turn_rate > 0.0;
+      r.omega = c.amount >= 0.0 ? r.turn_rate : -r.turn_rate;
+      r.t_end = r.busy ? now_ + std::abs(c.amount) / r.turn_rate : kNever;
+      if (!r.busy) r.omega = 0.0;
+      r.amount = c.amount;
+      break;
+    case TurtleCommand::Kind::wait:
+      r.busy = c.amount > 0.0;
+      r.t_end = r.busy ? now_ + c.amount : kNever;
+      r.amount = c.amount;
+      break;
+  }
+  // A new course: predictions made against the old one are stale, and "just collided, cannot
+  // meet again" no longer holds.
+  ++b.count;
+  last_[id] = kNone;
+  if constexpr (kStep) dmax_ = std::max(dmax_, travel_[id] + path_length(b.v, dt_ - now_));
+  repredict(id);
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+TurtleState Engine<Flight, kBallBall, kStep, kTurtles>::turtle(std::size_t k) const {
+  const auto id = static_cast<std::uint32_t>(nb_ + k);
+  const Body& b = body_[id];
+  const TurtleRun& r = run_[k];
+  TurtleState s;
+  s.pos = b.x + (now_ - b.t) * b.v;
+  s.vel = b.v;
+  s.heading = heading_at(k, now_);
+  s.busy = r.busy;
+  s.touched = r.touched;
+  if (r.busy) {
+    const double el = now_ - r.t_start;
+    s.done = r.kind == TurtleCommand::Kind::move ? r.speed * el
+             : r.kind == TurtleCommand::Kind::turn ? r.turn_rate * el
+                                                   : el;
+  } else {
+    s.done = std::abs(r.amount);
+  }
+  return s;
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::cross(std::uint32_t i) {
   ++stats_.cell_crossings;
   sync(i);
   Body& b = body_[i];
@@ -665,8 +968,9 @@ void Engine<Flight, kBallBall, kStep>::cross(std::uint32_t i) {
   if (ix < 1 || ix > grid_.nx() || iy < 1 || iy > grid_.ny()) {
     if (boundary_ != Boundary::periodic) {
       // The centre has left the arena. (With boundary walls this happens only if the walls were
-      // missed; the ball is removed rather than left to fly through the table.)
-      log(EventKind::exit, i, 0);
+      // missed; the body is removed rather than left to fly through the table.)
+      const bool turtle = is_turtle(i);
+      log(EventKind::exit, turtle ? i - nb_ : i, turtle ? 1 : 0);
       ++stats_.exits;
       remove(i);
       return;
@@ -683,21 +987,27 @@ void Engine<Flight, kBallBall, kStep>::cross(std::uint32_t i) {
   schedule(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::remove(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::remove(std::uint32_t i) {
   unlink(i);
   body_[i].cell = kNone;
   ++body_[i].count;  // predictions made against it are now stale
   heap_.remove(i);
+  if (is_turtle(i)) {
+    TurtleRun& r = run_[i - nb_];
+    r.busy = false;
+    r.t_end = kNever;
+    body_[i].v = {};
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
 // Time
 
-template <class Flight, bool kBallBall, bool kStep>
-double Engine<Flight, kBallBall, kStep>::rebase() {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+double Engine<Flight, kBallBall, kStep, kTurtles>::rebase() {
   // Keep internal times small: absolute times would lose a bit of position per doubling of t.
-  // All balls are brought to now, which becomes internal zero. Amortised O(1) per event.
+  // All bodies are brought to now, which becomes internal zero. Amortised O(1) per event.
   events_since_rebase_ = 0;
   const double shift = now_;
   if (shift == 0.0) return 0.0;
@@ -709,15 +1019,19 @@ double Engine<Flight, kBallBall, kStep>::rebase() {
     pending_[i].t_cross -= shift;
     if (inelastic_) last_time_[i] -= shift;
   }
+  for (TurtleRun& r : run_) {
+    r.t_start -= shift;
+    r.t_end -= shift;
+  }
   heap_.shift_keys(shift);
   t_base_ += shift;
   now_ = 0.0;
   return shift;
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::begin_step() {
-  // Internal time zero is the start of the step; all balls are there.
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::begin_step() {
+  // Internal time zero is the start of the step; all bodies are there.
   const std::size_t n = body_.size();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (body_[i].cell != kNone) unlink(i);
@@ -732,11 +1046,17 @@ void Engine<Flight, kBallBall, kStep>::begin_step() {
       b.x.x -= width_ * std::floor(b.x.x / width_);
       b.x.y -= height_ * std::floor(b.x.y / height_);
     } else if (b.x.x < 0.0 || b.x.x > width_ || b.x.y < 0.0 || b.x.y > height_) {
-      log(EventKind::exit, i, 0);
+      const bool turtle = is_turtle(i);
+      log(EventKind::exit, turtle ? i - nb_ : i, turtle ? 1 : 0);
       ++stats_.exits;
       b.cell = kNone;
       ++b.count;
       heap_.remove(i);
+      if (turtle) {
+        run_[i - nb_].busy = false;
+        run_[i - nb_].t_end = kNever;
+        b.v = {};
+      }
       continue;
     }
     link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(b.x)));
@@ -749,26 +1069,33 @@ void Engine<Flight, kBallBall, kStep>::begin_step() {
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::finish_step() {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::finish_step() {
   now_ = dt_;
   for (std::uint32_t i = 0; i < body_.size(); ++i) {
     if (body_[i].cell == kNone) continue;
     sync(i);
-    body_[i].v += dt_ * kick_;  // the memo: fields act as velocity kicks between steps
+    // The memo: fields act as velocity kicks between steps (not on turtles).
+    if (!is_turtle(i)) body_[i].v += dt_ * kick_;
   }
   // A kick changes every course, so "just collided, cannot meet again" no longer holds.
   if (kick_.x != 0.0 || kick_.y != 0.0) std::fill(last_.begin(), last_.end(), kNone);
   ++step_index_;
   ++stats_.steps;
   ++stats_.events;
+  for (TurtleRun& r : run_) {
+    r.t_start -= dt_;
+    r.t_end -= dt_;
+  }
+  if (inelastic_)
+    for (double& t : last_time_) t -= dt_;
   t_base_ = static_cast<double>(step_index_) * dt_;
   now_ = 0.0;
   begin_step();
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-void Engine<Flight, kBallBall, kStep>::advance_to(double t) {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+void Engine<Flight, kBallBall, kStep, kTurtles>::advance_to(double t) {
   if (!(t >= time())) throw std::invalid_argument("advance_to: time " + std::to_string(t) + " is before the world's time");
   if constexpr (kStep) {
     for (;;) {
@@ -791,11 +1118,11 @@ void Engine<Flight, kBallBall, kStep>::advance_to(double t) {
 // ---------------------------------------------------------------------------------------------
 // Validate
 
-template <class Flight, bool kBallBall, bool kStep>
-double Engine<Flight, kBallBall, kStep>::energy() const {
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+double Engine<Flight, kBallBall, kStep, kTurtles>::energy() const {
   const Vec2 g = kStep ? kick_ : flight_.a;
   double e = 0.0;
-  for (std::size_t i = 0; i < body_.size(); ++i) {
+  for (std::size_t i = 0; i < nb_; ++i) {
     const BallState s = ball(i);
     if (!s.alive) continue;
     e += 0.5 * mass_[i] * norm2(s.vel) - mass_[i] * dot(g, s.pos);
@@ -803,37 +1130,59 @@ double Engine<Flight, kBallBall, kStep>::energy() const {
   return e;
 }
 
-template <class Flight, bool kBallBall, bool kStep>
-Overlap Engine<Flight, kBallBall, kStep>::measure_overlap() const {
-  std::vector<Vec2> pos(body_.size());
-  std::vector<double> rad(body_.size());
-  std::vector<bool> alive(body_.size());
-  for (std::size_t i = 0; i < body_.size(); ++i) {
-    const BallState s = ball(i);
-    pos[i] = s.pos;
-    rad[i] = body_[i].r;
-    alive[i] = s.alive;
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+Overlap Engine<Flight, kBallBall, kStep, kTurtles>::measure_overlap() const {
+  const std::size_t n = body_.size();
+  std::vector<Vec2> pos(n);
+  std::vector<double> rad(n);
+  std::vector<bool> alive(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Body& b = body_[i];
+    pos[i] = pos_at(b, i, now_ - b.t);
+    rad[i] = b.r;
+    alive[i] = b.cell != kNone;
   }
   const bool periodic = boundary_ == Boundary::periodic;
-  // Without ball-ball collisions balls pass through each other by request; only walls count.
-  return reference::overlap(pos, rad, alive, walls_, periodic ? width_ : 0.0, periodic ? height_ : 0.0, kBallBall);
+  if (!kBallBall && nb_ > 0) {
+    // Balls pass through each other by request: measure walls for everyone, and pairs among the
+    // turtles and between turtles and balls.
+    Overlap worst = reference::overlap(pos, rad, alive, walls_, periodic ? width_ : 0.0, periodic ? height_ : 0.0, false);
+    for (std::uint32_t t = nb_; t < n; ++t) {
+      if (!alive[t]) continue;
+      for (std::uint32_t j = 0; j < n; ++j) {
+        if (j == t || !alive[j] || (j >= nb_ && j < t)) continue;
+        const double depth = rad[t] + rad[j] - norm(min_image(pos[j] - pos[t]));
+        if (depth > worst.depth) worst.depth = depth;
+        if (depth / std::min(rad[t], rad[j]) > worst.relative) worst.relative = depth / std::min(rad[t], rad[j]);
+      }
+    }
+    return worst;
+  }
+  return reference::overlap(pos, rad, alive, walls_, periodic ? width_ : 0.0, periodic ? height_ : 0.0, true);
+}
+
+template <class Flight, bool kBallBall, bool kTurtles>
+std::unique_ptr<EngineBase> make_for_mode(const WorldDef& def, Mode mode) {
+  if (mode == Mode::step) return std::make_unique<Engine<FreeFlight, kBallBall, true, kTurtles>>(def, mode);
+  return std::make_unique<Engine<Flight, kBallBall, false, kTurtles>>(def, mode);
 }
 
 template <class Flight, bool kBallBall>
-std::unique_ptr<EngineBase> make_for_mode(const WorldDef& def, Mode mode) {
-  if (mode == Mode::step) return std::make_unique<Engine<FreeFlight, kBallBall, true>>(def, mode);
-  return std::make_unique<Engine<Flight, kBallBall, false>>(def, mode);
+std::unique_ptr<EngineBase> make_with_turtles(const WorldDef& def, Mode mode) {
+  if (def.turtles.empty()) return make_for_mode<Flight, kBallBall, false>(def, mode);
+  return make_for_mode<Flight, kBallBall, true>(def, mode);
 }
 
 }  // namespace
 
 std::unique_ptr<EngineBase> make_engine(const WorldDef& def, Mode mode) {
+  // The physics is chosen here, once per scene: one instantiation per combination of effects.
   const bool gravity = def.effects.gravity.x != 0.0 || def.effects.gravity.y != 0.0;
   const bool ball_ball = def.effects.ball_ball;
   if (gravity) {
-    return ball_ball ? make_for_mode<GravityFlight, true>(def, mode) : make_for_mode<GravityFlight, false>(def, mode);
+    return ball_ball ? make_with_turtles<GravityFlight, true>(def, mode) : make_with_turtles<GravityFlight, false>(def, mode);
   }
-  return ball_ball ? make_for_mode<FreeFlight, true>(def, mode) : make_for_mode<FreeFlight, false>(def, mode);
+  return ball_ball ? make_with_turtles<FreeFlight, true>(def, mode) : make_with_turtles<FreeFlight, false>(def, mode);
 }
 
 }  // namespace turtlegas::sim::detail

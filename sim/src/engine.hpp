@@ -24,6 +24,11 @@ class EngineBase {
   virtual const Stats& stats() const = 0;
   virtual Overlap measure_overlap() const = 0;
   virtual Overlap max_contact_overlap() const = 0;
+  virtual std::size_t turtle_count() const = 0;
+  virtual TurtleState turtle(std::size_t i) const = 0;
+  virtual double turtle_radius(std::size_t i) const = 0;
+  virtual void command_turtle(std::size_t i, const TurtleCommand& command) = 0;
+  virtual std::vector<TurtleContact> take_turtle_contacts() = 0;
   virtual double cell_size() const = 0;
   virtual int cells_x() const = 0;
   virtual int cells_y() const = 0;

@@ -21,7 +21,7 @@ void EventQueue::reset(std::size_t ids) {
 }
 
 std::uint64_t EventQueue::bucket_of(double key) const {
-  const double b = std::floor((key - t0_) / width_);
+  const double b = std::floor((key - t0_) * inv_width_);
   if (!(b >= 0.0)) return 0;
   if (b >= static_cast<double>(year_)) return year_;
   return static_cast<std::uint64_t>(b);
@@ -127,6 +127,7 @@ void EventQueue::rebuild(double start) {
   const double mean_ahead = n > 0 ? sum / n : 0.0;
   width_ = mean_ahead > 0.0 ? 4.0 * mean_ahead / static_cast<double>(year_) : 1.0;
   if (!(width_ > 0.0) || !std::isfinite(width_)) width_ = 1.0;
+  inv_width_ = 1.0 / width_;
   t0_ = start;
   current_ = 0;
   for (std::uint32_t id : ids) insert(id);

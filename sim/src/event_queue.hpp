@@ -69,6 +69,7 @@ class EventQueue {
   std::size_t finite_ = 0;
   double t0_ = 0.0;          ///< start of bucket 0 of this year
   double width_ = 1.0;       ///< bucket width, seconds
+  double inv_width_ = 1.0;
   std::uint64_t current_ = 0;  ///< the bucket being served; keys before its end go to the heap
   std::uint64_t year_ = 0;     ///< number of buckets in a year
 };

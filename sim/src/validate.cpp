@@ -182,9 +182,55 @@ std::optional<DefProblem> check_walls(const WorldDef& def) {
   return std::nullopt;
 }
 
-std::optional<DefProblem> check_balls(const WorldDef& def) {
-  const ArenaDef& a = def.arena;
+/// Balls and turtles are both discs: numbered balls first, then turtles, for the checks that
+/// treat them alike (inside the arena, unique ids, overlaps).
+struct Discs {
+  const WorldDef& def;
+  std::size_t size() const { return def.balls.size() + def.turtles.size(); }
+  bool is_ball(std::size_t k) const { return k < def.balls.size(); }
+  Vec2 pos(std::size_t k) const { return is_ball(k) ? def.balls[k].pos : def.turtles[k - def.balls.size()].pos; }
+  double radius(std::size_t k) const {
+    return is_ball(k) ? def.balls[k].radius : def.turtles[k - def.balls.size()].radius;
+  }
+  const std::string& id(std::size_t k) const {
+    return is_ball(k) ? def.balls[k].id : def.turtles[k - def.balls.size()].id;
+  }
+  Where where(std::size_t k) const { return is_ball(k) ? Where::ball : Where::turtle; }
+  std::size_t index(std::size_t k) const { return is_ball(k) ? k : k - def.balls.size(); }
+  std::string name(std::size_t k) const {
+    const char* noun = is_ball(k) ? "ball" : "turtle";
+    return id(k).empty() ? std::string(noun) + " #" + std::to_string(index(k)) : std::string(noun) + " " + quoted(id(k));
+  }
+  DefProblem problem(std::size_t k, std::string field, std::string message) const {
+    return DefProblem{where(k), index(k), std::move(field), std::move(message)};
+  }
+};
+
+std::optional<DefProblem> check_placement(const Discs& d, std::size_t k) {
+  const ArenaDef& a = d.def.arena;
+  const Vec2 p = d.pos(k);
+  const double r = d.radius(k);
   const std::string arena_box = "[0, " + num(a.width) + "] x [0, " + num(a.height) + "]";
+  if (a.boundary == Boundary::walls) {
+    if (p.x - r < 0.0 || p.x + r > a.width || p.y - r < 0.0 || p.y + r > a.height)
+      return d.problem(k, "pos",
+                       d.name(k) + " (radius " + num(r) + ") at " + vec(p) +
+                           " sticks out of the arena walls; the whole disc must lie in " + arena_box +
+                           ", so move it inside or make it smaller");
+  } else if (p.x < 0.0 || p.x > a.width || p.y < 0.0 || p.y > a.height) {
+    return d.problem(k, "pos",
+                     d.name(k) + " at " + vec(p) + " is outside the arena " + arena_box +
+                         "; move its centre inside or enlarge the arena");
+  }
+  if (a.boundary == Boundary::periodic && (2.0 * r >= a.width || 2.0 * r >= a.height))
+    return d.problem(k, "radius",
+                     d.name(k) + " (radius " + num(r) +
+                         ") would touch its own periodic image; its diameter must be smaller than the arena's width and height");
+  return std::nullopt;
+}
+
+std::optional<DefProblem> check_balls(const WorldDef& def) {
+  const Discs d{def};
   for (std::size_t i = 0; i < def.balls.size(); ++i) {
     const BallDef& b = def.balls[i];
     if (!is_finite(b.pos))
@@ -197,24 +243,31 @@ std::optional<DefProblem> check_balls(const WorldDef& def) {
       return problem(Where::ball, i, "mass", ball_name(b, i) + ": mass must be > 0 (got " + num(b.mass) + ")");
     if (!std::isfinite(b.charge))
       return problem(Where::ball, i, "charge", ball_name(b, i) + ": charge must be finite (got " + num(b.charge) + ")");
+    if (auto p = check_placement(d, i)) return p;
+  }
+  return std::nullopt;
+}
 
-    const Vec2 p = b.pos;
-    if (a.boundary == Boundary::walls) {
-      const double r = b.radius;
-      if (p.x - r < 0.0 || p.x + r > a.width || p.y - r < 0.0 || p.y + r > a.height)
-        return problem(Where::ball, i, "pos",
-                       ball_name(b, i) + " (radius " + num(r) + ") at " + vec(p) +
-                           " sticks out of the arena walls; the whole disc must lie in " + arena_box +
-                           ", so move it inside or make it smaller");
-    } else if (p.x < 0.0 || p.x > a.width || p.y < 0.0 || p.y > a.height) {
-      return problem(Where::ball, i, "pos",
-                     ball_name(b, i) + " at " + vec(p) + " is outside the arena " + arena_box +
-                         "; move its centre inside or enlarge the arena");
-    }
-    if (a.boundary == Boundary::periodic && (2.0 * b.radius >= a.width || 2.0 * b.radius >= a.height))
-      return problem(Where::ball, i, "radius",
-                     ball_name(b, i) + " (radius " + num(b.radius) +
-                         ") would touch its own periodic image; its diameter must be smaller than the arena's width and height");
+std::optional<DefProblem> check_turtles(const WorldDef& def) {
+  const Discs d{def};
+  for (std::size_t i = 0; i < def.turtles.size(); ++i) {
+    const TurtleDef& t = def.turtles[i];
+    const std::size_t k = def.balls.size() + i;
+    const std::string name = d.name(k);
+    if (!is_finite(t.pos)) return problem(Where::turtle, i, "pos", name + ": pos must be finite (got " + vec(t.pos) + ")");
+    if (!std::isfinite(t.heading))
+      return problem(Where::turtle, i, "heading", name + ": heading must be finite (got " + num(t.heading) + ")");
+    if (!std::isfinite(t.radius) || t.radius <= 0.0)
+      return problem(Where::turtle, i, "radius", name + ": radius must be > 0 (got " + num(t.radius) + ")");
+    if (!std::isfinite(t.speed) || t.speed <= 0.0)
+      return problem(Where::turtle, i, "speed", name + ": speed must be > 0 units/s (got " + num(t.speed) + ")");
+    if (!std::isfinite(t.turn_rate) || t.turn_rate <= 0.0)
+      return problem(Where::turtle, i, "turn_rate", name + ": turn_rate must be > 0 (got " + num(t.turn_rate) + " rad/s)");
+    if (!std::isfinite(t.bounce) || t.bounce > 1.0)
+      return problem(Where::turtle, i, "bounce",
+                     name + ": bounce must be negative (stop dead at a contact, the memo's model) or a restitution in [0, 1] (got " +
+                         num(t.bounce) + ")");
+    if (auto p = check_placement(d, k)) return p;
   }
   return std::nullopt;
 }
@@ -222,21 +275,24 @@ std::optional<DefProblem> check_balls(const WorldDef& def) {
 const std::array<std::string_view, 4> arena_ids = {"arena-bottom", "arena-right", "arena-top", "arena-left"};
 
 std::optional<DefProblem> check_ids(const WorldDef& def) {
-  // Every named object in a fixed order: the arena's walls (boundary walls only), walls, balls.
-  // Empty ids are anonymous (scenes built in code need not name anything); the loader requires them.
+  // Every named object in a fixed order: the arena's walls (boundary walls only), walls, then
+  // balls and turtles. Empty ids are anonymous (scenes built in code need not name anything); the
+  // loader requires them.
+  const Discs d{def};
   const std::size_t arena_n = def.arena.boundary == Boundary::walls ? arena_ids.size() : 0;
-  const std::size_t total = arena_n + def.walls.size() + def.balls.size();
+  const std::size_t total = arena_n + def.walls.size() + d.size();
   auto id_of = [&](std::size_t k) -> std::string_view {
     if (k < arena_n) return arena_ids[k];
     k -= arena_n;
     if (k < def.walls.size()) return def.walls[k].id;
-    return def.balls[k - def.walls.size()].id;
+    return d.id(k - def.walls.size());
   };
   auto describe = [&](std::size_t k) -> std::string {
     if (k < arena_n) return "the arena wall of boundary \"walls\"";
     k -= arena_n;
     if (k < def.walls.size()) return "wall #" + std::to_string(k);
-    return "ball #" + std::to_string(k - def.walls.size());
+    k -= def.walls.size();
+    return (d.is_ball(k) ? "ball #" : "turtle #") + std::to_string(d.index(k));
   };
 
   // Open addressing over object numbers + 1 (0 is empty): a million ids in a few tens of ms, where
@@ -254,94 +310,99 @@ std::optional<DefProblem> check_ids(const WorldDef& def) {
         break;
       }
       if (id_of(table[slot] - 1) != id) continue;
+      const std::string message = "duplicate id " + quoted(id) + " (already used by " + describe(table[slot] - 1) +
+                                  "); every object needs its own id";
       const std::size_t i = k - arena_n;
-      const bool is_wall = i < def.walls.size();
-      return problem(is_wall ? Where::wall : Where::ball, is_wall ? i : i - def.walls.size(), "id",
-                     "duplicate id " + quoted(id) + " (already used by " + describe(table[slot] - 1) +
-                         "); every wall and ball needs its own id");
+      if (i < def.walls.size()) return problem(Where::wall, i, "id", message);
+      return d.problem(i - def.walls.size(), "id", message);
     }
   }
   return std::nullopt;
 }
 
-/// Ball-ball and ball-wall overlaps, with one grid over the arena grown by the largest radius (so
-/// every disc lies inside it). Walls are entered in every cell their segment crosses, balls in every
-/// cell their bounding box covers; a pair that overlaps then shares at least one cell. In a periodic
-/// arena a disc that crosses an edge is also entered (and tested) at its shifted images.
+/// Disc-disc and disc-wall overlaps, with one grid over the arena grown by the largest radius (so
+/// every disc lies inside it). Walls are entered in every cell their segment crosses, discs in
+/// every cell their bounding box covers; a pair that overlaps then shares at least one cell. In a
+/// periodic arena a disc that crosses an edge is also entered (and tested) at its shifted images.
+/// Two balls may overlap when ball-ball collisions are off; turtles always collide.
 std::optional<DefProblem> check_overlaps(const WorldDef& def) {
-  const std::size_t n = def.balls.size();
+  const Discs d{def};
+  const std::size_t n = d.size();
   if (n == 0) return std::nullopt;
   const ArenaDef& a = def.arena;
   const bool periodic = a.boundary == Boundary::periodic;
 
   double r_max = 0.0;
   std::vector<double> radii(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    radii[i] = def.balls[i].radius;
-    r_max = std::max(r_max, radii[i]);
+  for (std::size_t k = 0; k < n; ++k) {
+    radii[k] = d.radius(k);
+    r_max = std::max(r_max, radii[k]);
   }
-  // The median diameter as cell side keeps a few balls per cell even when a handful are huge.
+  // Twice the median diameter as cell side: a typical disc covers 1 to 4 cells, and a handful of
+  // huge discs cannot make the cells coarse.
   std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(n / 2), radii.end());
-  const double side = 2.0 * radii[n / 2];
+  const double side = 4.0 * radii[n / 2];
   radii = {};
 
   const Vec2 lo{-r_max, -r_max};
   const Vec2 hi{a.width + r_max, a.height + r_max};
-  CoverGrid grid(lo, hi, side, 4 * (n + def.walls.size()) + 1024);
+  const std::size_t max_cells = 4 * (n + def.walls.size()) + 1024;
 
-  // A ball's images: itself and, in a periodic arena, its copies shifted across each edge it crosses.
-  auto images = [&](const BallDef& b, std::array<Vec2, 4>& out) -> int {
-    out[0] = b.pos;
+  // A disc's images: itself and, in a periodic arena, its copies shifted across each edge it crosses.
+  auto images = [&](std::size_t k, std::array<Vec2, 4>& out) -> int {
+    const Vec2 p = d.pos(k);
+    const double r = d.radius(k);
+    out[0] = p;
     if (!periodic) return 1;
     double sx = 0.0, sy = 0.0;
-    if (b.pos.x - b.radius < 0.0) sx = a.width;
-    else if (b.pos.x + b.radius > a.width) sx = -a.width;
-    if (b.pos.y - b.radius < 0.0) sy = a.height;
-    else if (b.pos.y + b.radius > a.height) sy = -a.height;
-    int k = 1;
-    if (sx != 0.0) out[k++] = b.pos + Vec2{sx, 0.0};
-    if (sy != 0.0) out[k++] = b.pos + Vec2{0.0, sy};
-    if (sx != 0.0 && sy != 0.0) out[k++] = b.pos + Vec2{sx, sy};
-    return k;
+    if (p.x - r < 0.0) sx = a.width;
+    else if (p.x + r > a.width) sx = -a.width;
+    if (p.y - r < 0.0) sy = a.height;
+    else if (p.y + r > a.height) sy = -a.height;
+    int m = 1;
+    if (sx != 0.0) out[m++] = p + Vec2{sx, 0.0};
+    if (sy != 0.0) out[m++] = p + Vec2{0.0, sy};
+    if (sx != 0.0 && sy != 0.0) out[m++] = p + Vec2{sx, sy};
+    return m;
   };
-  auto box = [&](Vec2 p, double r) { return grid.cover(p - Vec2{r, r}, p + Vec2{r, r}); };
 
-  if (def.effects.ball_ball) {
-    // Items are ball * 4 + image, so a periodic pair is caught from whichever side crosses the edge.
+  const bool balls_collide = def.effects.ball_ball;
+  if (balls_collide || !def.turtles.empty()) {
+    CoverGrid grid(lo, hi, side, max_cells);
+    auto box = [&](Vec2 p, double r) { return grid.cover(p - Vec2{r, r}, p + Vec2{r, r}); };
+    // Items are disc * 4 + image, so a periodic pair is caught from whichever side crosses the edge.
     std::array<Vec2, 4> img{}, other{};
-    for (std::size_t i = 0; i < n; ++i) {
-      const BallDef& b = def.balls[i];
-      const int k = images(b, img);
+    for (std::size_t k = 0; k < n; ++k) {
+      const int m_count = images(k, img);
+      const double r = d.radius(k);
       std::optional<std::size_t> hit;
-      for (int m = 0; m < k && !hit; ++m) {
+      for (int m = 0; m < m_count && !hit; ++m) {
         const Vec2 p = img[m];
-        grid.any(box(p, b.radius), [&](std::uint32_t item) {
+        grid.any(box(p, r), [&](std::uint32_t item) {
           const std::size_t j = item / 4;
-          const BallDef& o = def.balls[j];
-          Vec2 q = o.pos;
+          if (!balls_collide && d.is_ball(j) && d.is_ball(k)) return false;
+          Vec2 q = d.pos(j);
           if (item % 4 != 0) {
-            images(o, other);
+            images(j, other);
             q = other[item % 4];
           }
-          const double s = b.radius + o.radius;
+          const double s = r + d.radius(j);
           if (norm2(p - q) < s * s) hit = j;
           return hit.has_value();
         });
       }
-      if (hit) {
-        const BallDef& o = def.balls[*hit];
-        return problem(Where::ball, i, "pos",
-                       ball_name(b, i) + " at " + vec(b.pos) + " overlaps " + ball_name(o, *hit) + " at " +
-                           vec(o.pos) + " (radii " + num(b.radius) + " + " + num(o.radius) +
-                           "); move them apart or make them smaller");
-      }
-      for (int m = 0; m < k; ++m)
-        grid.insert(box(img[m], b.radius), static_cast<std::uint32_t>(i * 4 + static_cast<std::size_t>(m)));
+      if (hit)
+        return d.problem(k, "pos",
+                         d.name(k) + " at " + vec(d.pos(k)) + " overlaps " + d.name(*hit) + " at " + vec(d.pos(*hit)) +
+                             " (radii " + num(r) + " + " + num(d.radius(*hit)) +
+                             "); move them apart or make them smaller");
+      for (int m = 0; m < m_count; ++m)
+        grid.insert(box(img[m], r), static_cast<std::uint32_t>(k * 4 + static_cast<std::size_t>(m)));
     }
   }
 
   if (def.walls.empty()) return std::nullopt;
-  CoverGrid walls_grid(lo, hi, side, 4 * (n + def.walls.size()) + 1024);
+  CoverGrid walls_grid(lo, hi, side, max_cells);
   for (std::size_t w = 0; w < def.walls.size(); ++w) {
     // Enter the segment column by column: in each column of cells, the cells between the lowest and
     // highest y the segment reaches there. The padding absorbs rounding at cell borders.
@@ -351,16 +412,10 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
     const int x0 = walls_grid.cx(p.x - pad), x1 = walls_grid.cx(q.x + pad);
     for (int ix = x0; ix <= x1; ++ix) {
       double ya = p.y, yb = q.y;
-      if (q.x > p.x && ix != x0 && ix != x1) {
-        // An interior column: the segment spans it from its left to its right border.
+      if (q.x > p.x) {
         const double slope = (q.y - p.y) / (q.x - p.x);
-        ya = p.y + slope * (walls_grid.cell_x0(ix) - p.x);
-        yb = p.y + slope * (walls_grid.cell_x0(ix) + walls_grid.cell_w() - p.x);
-      } else if (q.x > p.x) {
-        // An end column: from the end point to the border it crosses (or the other end point).
-        const double slope = (q.y - p.y) / (q.x - p.x);
-        const double xa = ix == x0 ? p.x : std::max(p.x, walls_grid.cell_x0(ix));
-        const double xb = ix == x1 ? q.x : std::min(q.x, walls_grid.cell_x0(ix) + walls_grid.cell_w());
+        const double xa = std::clamp(walls_grid.cell_x0(ix), p.x, q.x);
+        const double xb = std::clamp(walls_grid.cell_x0(ix) + walls_grid.cell_w(), p.x, q.x);
         ya = ix == x0 ? p.y : p.y + slope * (xa - p.x);
         yb = ix == x1 ? q.y : p.y + slope * (xb - p.x);
       }
@@ -369,24 +424,24 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
     }
   }
   std::array<Vec2, 4> img{};
-  for (std::size_t i = 0; i < n; ++i) {
-    const BallDef& b = def.balls[i];
-    const int k = images(b, img);
+  for (std::size_t k = 0; k < n; ++k) {
+    const int m_count = images(k, img);
+    const double r = d.radius(k);
     std::optional<std::size_t> hit;
-    for (int m = 0; m < k && !hit; ++m) {
+    for (int m = 0; m < m_count && !hit; ++m) {
       const Vec2 p = img[m];
-      walls_grid.any(box(p, b.radius), [&](std::uint32_t w) {
+      walls_grid.any(walls_grid.cover(p - Vec2{r, r}, p + Vec2{r, r}), [&](std::uint32_t w) {
         const WallDef& wall = def.walls[w];
-        if (segment_distance2(p, wall.from, wall.to) < b.radius * b.radius) hit = w;
+        if (segment_distance2(p, wall.from, wall.to) < r * r) hit = w;
         return hit.has_value();
       });
     }
     if (hit) {
       const WallDef& wall = def.walls[*hit];
-      return problem(Where::ball, i, "pos",
-                     ball_name(b, i) + " (radius " + num(b.radius) + ") at " + vec(b.pos) + " overlaps " +
-                         wall_name(wall, *hit) + " from " + vec(wall.from) + " to " + vec(wall.to) +
-                         "; move the ball away from the wall or make it smaller");
+      return d.problem(k, "pos",
+                       d.name(k) + " (radius " + num(r) + ") at " + vec(d.pos(k)) + " overlaps " + wall_name(wall, *hit) +
+                           " from " + vec(wall.from) + " to " + vec(wall.to) +
+                           "; move it away from the wall or make it smaller");
     }
   }
   return std::nullopt;
@@ -398,9 +453,11 @@ std::optional<DefProblem> validate(const WorldDef& def) {
   if (auto p = check_scalars(def)) return p;
   if (auto p = check_walls(def)) return p;
   if (auto p = check_balls(def)) return p;
-  if (def.walls.size() + def.balls.size() >= std::numeric_limits<std::uint32_t>::max() / 4)
-    return problem(Where::world, 0, "balls", "too many objects (" + std::to_string(def.walls.size() + def.balls.size()) +
-                                                 "); the engine indexes walls and balls with 32 bits");
+  if (auto p = check_turtles(def)) return p;
+  const std::size_t objects = def.walls.size() + def.balls.size() + def.turtles.size();
+  if (objects >= std::numeric_limits<std::uint32_t>::max() / 4)
+    return problem(Where::world, 0, "balls",
+                   "too many objects (" + std::to_string(objects) + "); the engine indexes them with 32 bits");
   if (auto p = check_ids(def)) return p;
   if (auto p = check_overlaps(def)) return p;
   return std::nullopt;

@@ -30,6 +30,11 @@ BallState World::ball(std::size_t i) const { return impl_->engine->ball(i); }
 double World::radius(std::size_t i) const { return impl_->engine->radius(i); }
 double World::mass(std::size_t i) const { return impl_->engine->mass(i); }
 const std::vector<WallDef>& World::walls() const { return impl_->engine->walls(); }
+std::size_t World::turtle_count() const { return impl_->engine->turtle_count(); }
+TurtleState World::turtle(std::size_t i) const { return impl_->engine->turtle(i); }
+double World::turtle_radius(std::size_t i) const { return impl_->engine->turtle_radius(i); }
+void World::command_turtle(std::size_t i, const TurtleCommand& command) { impl_->engine->command_turtle(i, command); }
+std::vector<TurtleContact> World::take_turtle_contacts() { return impl_->engine->take_turtle_contacts(); }
 double World::energy() const { return impl_->engine->energy(); }
 const Stats& World::stats() const { return impl_->engine->stats(); }
 Overlap World::measure_overlap() const { return impl_->engine->measure_overlap(); }

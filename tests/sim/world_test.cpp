@@ -7,6 +7,7 @@
 
 #include "scenes.hpp"
 #include "turtlegas/sim/reference.hpp"
+#include "turtlegas/sim/toi.hpp"
 #include "turtlegas/sim/world.hpp"
 
 using namespace turtlegas::sim;

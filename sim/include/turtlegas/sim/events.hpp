@@ -11,8 +11,15 @@ enum class EventKind : std::uint8_t {
   ball_ball,      ///< a and b are ball indices
   ball_wall,      ///< a is a ball, b a wall index (contact foot on the segment, ends included)
   ball_wall_end,  ///< a is a ball, b the index of the wall that owns the end point
-  exit,           ///< a is a ball that left the arena (boundary `none`); b unused
+  exit,           ///< a left the arena (boundary `none`): a ball (b == 0) or a turtle (b == 1)
+  turtle_wall,      ///< a is a turtle index, b a wall index
+  turtle_wall_end,  ///< a is a turtle, b the index of the wall that owns the end point
+  turtle_turtle,    ///< a and b are turtle indices (a is the one whose prediction it was)
+  turtle_ball,      ///< a is a turtle, b a ball
 };
+
+/// True for the kinds whose `a` is a turtle.
+constexpr bool involves_turtle(EventKind k) { return k >= EventKind::turtle_wall; }
 
 /// The name used in the event log (`ball-ball`, ...).
 constexpr std::string_view to_string(EventKind k) {
@@ -21,11 +28,15 @@ constexpr std::string_view to_string(EventKind k) {
     case EventKind::ball_wall: return "ball-wall";
     case EventKind::ball_wall_end: return "ball-wall-end";
     case EventKind::exit: return "exit";
+    case EventKind::turtle_wall: return "turtle-wall";
+    case EventKind::turtle_wall_end: return "turtle-wall-end";
+    case EventKind::turtle_turtle: return "turtle-turtle";
+    case EventKind::turtle_ball: return "turtle-ball";
   }
   return "?";
 }
 
-/// One logged event. Indices refer to WorldDef::balls and World::walls().
+/// One logged event. Indices refer to WorldDef::balls, WorldDef::turtles and World::walls().
 struct Event {
   double t = 0.0;  ///< seconds
   EventKind kind = EventKind::ball_ball;

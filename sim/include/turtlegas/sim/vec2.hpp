@@ -26,7 +26,7 @@ constexpr double dot(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
 /// z-component of the 3-D cross product (a.x b.y - a.y b.x).
 constexpr double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
 constexpr double norm2(Vec2 a) { return dot(a, a); }
-inline double norm(Vec2 a) { return std::hypot(a.x, a.y); }
+inline double norm(Vec2 a) { return std::sqrt(norm2(a)); }
 /// Left-hand perpendicular: a rotated by +90 degrees.
 constexpr Vec2 perp(Vec2 a) { return {-a.y, a.x}; }
 inline bool is_finite(Vec2 a) { return std::isfinite(a.x) && std::isfinite(a.y); }

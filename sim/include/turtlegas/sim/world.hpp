@@ -17,11 +17,17 @@ struct Stats {
   std::uint64_t ball_wall = 0;
   std::uint64_t ball_wall_end = 0;
   std::uint64_t exits = 0;
+  std::uint64_t turtle_wall = 0;
+  std::uint64_t turtle_wall_end = 0;
+  std::uint64_t turtle_turtle = 0;
+  std::uint64_t turtle_ball = 0;
   std::uint64_t cell_crossings = 0;  ///< exact mode
   std::uint64_t stale = 0;           ///< predictions found invalid when their time came
   std::uint64_t steps = 0;           ///< step mode: completed steps
   std::uint64_t events = 0;          ///< everything taken off the event queue
-  std::uint64_t collisions() const { return ball_ball + ball_wall + ball_wall_end; }
+  std::uint64_t collisions() const {
+    return ball_ball + ball_wall + ball_wall_end + turtle_wall + turtle_wall_end + turtle_turtle + turtle_ball;
+  }
 };
 
 /// Position and velocity of one ball at the world's current time.
@@ -29,6 +35,39 @@ struct BallState {
   Vec2 pos;
   Vec2 vel;
   bool alive = true;  ///< false once the ball has exited
+};
+
+/// What a turtle is told to do. The runtime issues commands at control-step boundaries.
+struct TurtleCommand {
+  enum class Kind {
+    stop,  ///< stand still, indefinitely
+    move,  ///< drive `amount` world units along the heading (negative: backwards)
+    turn,  ///< turn in place by `amount` radians (positive: clockwise, "right"); never collides
+    wait,  ///< stand still for `amount` seconds
+  };
+  Kind kind = Kind::stop;
+  double amount = 0.0;
+};
+
+/// A turtle's state at the world's current time.
+struct TurtleState {
+  Vec2 pos;
+  double heading = 0.0;  ///< radians, Logo convention
+  Vec2 vel;
+  bool busy = false;     ///< its current command is still running
+  /// Of the current (or last) command: distance driven (units, >= 0), angle turned (radians,
+  /// >= 0) or time waited (s).
+  double done = 0.0;
+  bool touched = false;  ///< the current (or last) command was cut short by a contact
+};
+
+/// A contact involving a turtle, for its touch sensors.
+struct TurtleContact {
+  double t = 0.0;         ///< seconds
+  std::uint32_t turtle = 0;
+  EventKind kind = EventKind::turtle_wall;  ///< turtle_wall, turtle_wall_end, turtle_turtle or turtle_ball
+  std::uint32_t other = 0;  ///< wall, ball or turtle index
+  Vec2 normal;            ///< unit vector from the obstacle towards the turtle's centre
 };
 
 /// Overlap found by World::measure_overlap, in world units and as a fraction of the smaller radius.
@@ -73,6 +112,14 @@ class World {
   double mass(std::size_t i) const;
   /// All walls, the scene's followed by the arena's (boundary `walls`).
   const std::vector<WallDef>& walls() const;
+
+  std::size_t turtle_count() const;
+  TurtleState turtle(std::size_t i) const;
+  double turtle_radius(std::size_t i) const;
+  /// Starts a command for turtle i at the current time, replacing whatever it was doing.
+  void command_turtle(std::size_t i, const TurtleCommand& command);
+  /// Contacts involving turtles since the last call, in time order.
+  std::vector<TurtleContact> take_turtle_contacts();
 
   /// Kinetic plus gravitational potential energy of the live balls; the potential of a ball is
   /// -m g.x, zero at the origin.

@@ -63,6 +63,20 @@ struct BallDef {
   double charge = 0.0;
 };
 
+/// A turtle's body: a disc that moves only as its program commands (see World::command_turtle).
+/// Fields do not act on turtles: they drive on the floor of the plane.
+struct TurtleDef {
+  std::string id;
+  Vec2 pos;
+  double heading = 0.0;           ///< radians, Logo convention: 0 points to +y, clockwise positive
+  double radius = 10.0;           ///< world units
+  double speed = 30.0;            ///< forward speed, units/s
+  double turn_rate = 1.5707963267948966;  ///< radians/s
+  /// Negative (the default): the turtle stops dead at a contact (the memo's model). In [0, 1]: it
+  /// bounces off with this restitution instead and coasts until the next control step.
+  double bounce = -1.0;
+};
+
 /// A whole scene, independent of any file format.
 struct WorldDef {
   std::string name;
@@ -72,13 +86,14 @@ struct WorldDef {
   EffectsDef effects;
   std::vector<WallDef> walls;
   std::vector<BallDef> balls;
+  std::vector<TurtleDef> turtles;
 };
 
 /// A problem with a WorldDef, naming the offending object.
 struct DefProblem {
-  enum class Where { world, arena, effects, wall, ball };
+  enum class Where { world, arena, effects, wall, ball, turtle };
   Where where = Where::world;
-  std::size_t index = 0;  ///< index into walls or balls, when `where` is one of them
+  std::size_t index = 0;  ///< index into walls, balls or turtles, when `where` is one of them
   std::string field;      ///< the offending field ("radius", "pos", ...), may be empty
   std::string message;    ///< one line, says what is wrong and how to fix it
 };

@@ -1,0 +1,242 @@
+// SPDX-License-Identifier: MIT
+// Turtles in the physics: commanded motion, dead stops at contact, contacts for the touch sensors.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "scenes.hpp"
+#include "turtlegas/sim/toi.hpp"
+#include "turtlegas/sim/world.hpp"
+
+using namespace turtlegas::sim;
+using namespace turtlegas::test;
+
+namespace {
+
+const Mode kModes[] = {Mode::exact, Mode::step};
+const char* name(Mode m) { return m == Mode::exact ? "exact" : "step"; }
+constexpr double kDeg = M_PI / 180.0;
+
+TurtleDef turtle(std::string id, Vec2 pos, double heading_deg, double radius = 10, double speed = 30) {
+  TurtleDef t;
+  t.id = std::move(id);
+  t.pos = pos;
+  t.heading = heading_deg * kDeg;
+  t.radius = radius;
+  t.speed = speed;
+  t.turn_rate = 90 * kDeg;
+  return t;
+}
+
+TurtleCommand move(double d) { return {TurtleCommand::Kind::move, d}; }
+TurtleCommand turn(double deg) { return {TurtleCommand::Kind::turn, deg * kDeg}; }
+
+}  // namespace
+
+TEST_CASE("forward stops exactly at the contact, with the contact normal", "[turtle]") {
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(400, 200);
+    d.walls.push_back({"east", {100, 0}, {100, 200}});
+    d.turtles.push_back(turtle("t", {50, 50}, 90));  // heading 90: +x
+    World w(d, mode);
+    w.command_turtle(0, move(1000));
+    w.advance_to(3.0);
+    const TurtleState s = w.turtle(0);
+    // Contact when the centre is one radius from the wall: x = 90, after 40 units = 4/3 s.
+    CHECK(s.pos.x == Approx(90).epsilon(1e-14));
+    CHECK(s.pos.y == Approx(50).epsilon(1e-14));
+    CHECK_FALSE(s.busy);
+    CHECK(s.touched);
+    CHECK(s.done == Approx(40).epsilon(1e-12));
+    CHECK(norm(s.vel) == 0.0);
+    const auto contacts = w.take_turtle_contacts();
+    REQUIRE(contacts.size() == 1);
+    CHECK(contacts[0].kind == EventKind::turtle_wall);
+    CHECK(contacts[0].other == 0);
+    CHECK(contacts[0].t == Approx(4.0 / 3.0).epsilon(1e-12));
+    CHECK(contacts[0].normal.x == Approx(-1));
+    CHECK(contacts[0].normal.y == Approx(0).margin(1e-15));
+    CHECK(w.take_turtle_contacts().empty());
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}
+
+TEST_CASE("a command completes between boundaries and the turtle waits there", "[turtle]") {
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(400, 400);
+    d.turtles.push_back(turtle("t", {100, 100}, 0));  // heading 0: +y
+    World w(d, mode);
+    w.command_turtle(0, move(25));
+    w.advance_to(0.5);
+    CHECK(w.turtle(0).busy);
+    CHECK(w.turtle(0).done == Approx(15));
+    w.advance_to(2.0);
+    const TurtleState s = w.turtle(0);
+    CHECK_FALSE(s.busy);
+    CHECK_FALSE(s.touched);
+    CHECK(s.done == Approx(25));
+    CHECK(s.pos.y == Approx(125).epsilon(1e-14));
+    CHECK(s.pos.x == Approx(100).epsilon(1e-14));
+    w.command_turtle(0, move(-5));  // back
+    w.advance_to(3.0);
+    CHECK(w.turtle(0).pos.y == Approx(120).epsilon(1e-14));
+  }
+}
+
+TEST_CASE("turning takes time at the turn rate and never collides", "[turtle]") {
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(400, 400);
+    d.walls.push_back({"w", {50, 0}, {50, 400}});
+    d.turtles.push_back(turtle("t", {60, 100}, 0));  // touching the wall
+    World w(d, mode);
+    w.command_turtle(0, turn(360));
+    w.advance_to(2.0);
+    CHECK(w.turtle(0).heading == Approx(180 * kDeg));
+    CHECK(w.turtle(0).busy);
+    w.advance_to(5.0);
+    CHECK(w.turtle(0).heading == Approx(360 * kDeg));
+    CHECK_FALSE(w.turtle(0).busy);
+    CHECK(w.take_turtle_contacts().empty());
+    CHECK(w.stats().collisions() == 0);
+    // Left is a negative turn.
+    w.command_turtle(0, turn(-90));
+    w.advance_to(7.0);
+    CHECK(w.turtle(0).heading == Approx(270 * kDeg));
+  }
+}
+
+TEST_CASE("touching: driving into the wall stops at once, driving away does not", "[turtle]") {
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(400, 400);
+    d.walls.push_back({"w", {50, 0}, {50, 400}});
+    d.turtles.push_back(turtle("t", {60, 100}, 270));  // touching, facing the wall (-x)
+    World w(d, mode);
+    w.command_turtle(0, move(10));
+    w.advance_to(1.0);
+    CHECK(w.turtle(0).touched);
+    CHECK(w.turtle(0).done == Approx(0).margin(1e-12));
+    CHECK(w.turtle(0).pos.x == Approx(60));
+    CHECK(w.take_turtle_contacts().size() == 1);
+    w.command_turtle(0, move(-10));  // backwards, away from the wall
+    w.advance_to(2.0);
+    CHECK_FALSE(w.turtle(0).touched);
+    CHECK(w.turtle(0).pos.x == Approx(70));
+    CHECK(w.take_turtle_contacts().empty());
+  }
+}
+
+TEST_CASE("two turtles meeting head on both stop at contact", "[turtle]") {
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(400, 400);
+    d.turtles.push_back(turtle("a", {100, 200}, 90));
+    d.turtles.push_back(turtle("b", {200, 200}, 270));
+    World w(d, mode);
+    w.command_turtle(0, move(100));
+    w.command_turtle(1, move(100));
+    w.advance_to(3.0);
+    CHECK(w.turtle(0).pos.x == Approx(140));
+    CHECK(w.turtle(1).pos.x == Approx(160));
+    CHECK(w.turtle(0).touched);
+    CHECK(w.turtle(1).touched);
+    auto contacts = w.take_turtle_contacts();
+    REQUIRE(contacts.size() == 2);
+    CHECK(contacts[0].kind == EventKind::turtle_turtle);
+    CHECK(contacts[0].normal.x == -contacts[1].normal.x);
+    CHECK(w.stats().turtle_turtle == 1);
+  }
+}
+
+TEST_CASE("a ball bounces off a turtle as off a moving wall", "[turtle]") {
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(400, 400);
+    d.turtles.push_back(turtle("t", {200, 200}, 90, 10, 20));  // moving +x at 20
+    d.balls.push_back(ball("b", {260, 200}, {-10, 0}, 2));
+    World w(d, mode);
+    w.command_turtle(0, move(100));
+    w.advance_to(3.0);
+    // Closing speed 30 over a gap of 48: contact at 1.6 s. The ball leaves at 20 + (20 + 10) = 50
+    // (reflected in the turtle's frame); the turtle stops dead.
+    CHECK(w.stats().turtle_ball == 1);
+    CHECK(w.ball(0).vel.x == Approx(50));
+    CHECK(w.turtle(0).touched);
+    CHECK(w.turtle(0).pos.x == Approx(232));
+    const auto c = w.take_turtle_contacts();
+    REQUIRE(c.size() == 1);
+    CHECK(c[0].kind == EventKind::turtle_ball);
+    CHECK(c[0].t == Approx(1.6));
+  }
+}
+
+TEST_CASE("a turtle with bounce set rebounds and coasts to the next control step", "[turtle]") {
+  WorldDef d = box(400, 200);
+  d.dt = 0.1;
+  d.walls.push_back({"east", {100, 0}, {100, 200}});
+  TurtleDef t = turtle("t", {80, 50}, 90);
+  t.bounce = 0.5;
+  d.turtles.push_back(t);
+  World w(d, Mode::exact);
+  w.command_turtle(0, move(1000));
+  w.advance_to(1.0);
+  // Contact at x = 90 after 1/3 s; back at 15 units/s until t = 0.4, so 1/15 s of coasting.
+  CHECK(w.turtle(0).pos.x == Approx(90 - 15.0 / 15.0).epsilon(1e-9));
+  CHECK(norm(w.turtle(0).vel) == 0.0);
+  CHECK(w.turtle(0).touched);
+}
+
+TEST_CASE("a hundred turtles driven at random stay apart and inside", "[turtle][stress]") {
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(1000, 1000);
+    d.walls.push_back({"x1", {200, 200}, {500, 300}});
+    d.walls.push_back({"x2", {700, 100}, {650, 700}});
+    d.walls.push_back({"x3", {300, 800}, {600, 650}});
+    for (int k = 0; k < 100; ++k) {
+      const double x = 50 + 90 * (k % 10) + 20, y = 50 + 90 * (k / 10) + 15;
+      d.turtles.push_back(turtle("t" + std::to_string(k), {x, y}, 0, 6, 40));
+    }
+    // Keep only turtles clear of the walls.
+    std::vector<TurtleDef> keep;
+    for (const auto& t : d.turtles) {
+      bool clear = true;
+      for (const auto& wd : d.walls) {
+        const Segment s = make_segment(wd.from, wd.to);
+        const double foot = std::clamp(dot(t.pos - s.p1, s.u), 0.0, s.len);
+        clear = clear && norm(t.pos - s.p1 - foot * s.u) > t.radius;
+      }
+      if (clear) keep.push_back(t);
+    }
+    d.turtles = keep;
+    World w(d, mode);
+    std::mt19937_64 rng(7);
+    auto uniform = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+    std::uint64_t touches = 0;
+    for (int step = 1; step <= 3000; ++step) {
+      for (std::size_t k = 0; k < w.turtle_count(); ++k) {
+        const TurtleState s = w.turtle(k);
+        if (s.busy) continue;
+        if (s.touched || uniform() < 0.3) w.command_turtle(k, turn(uniform() * 360 - 180));
+        else w.command_turtle(k, move(uniform() * 200));
+      }
+      w.advance_to(step * d.dt);
+      touches += w.take_turtle_contacts().size();
+    }
+    CHECK(touches > 500);
+    CHECK(w.measure_overlap().relative <= 1e-9);
+    CHECK(w.stats().exits == 0);
+    for (std::size_t k = 0; k < w.turtle_count(); ++k) {
+      const TurtleState s = w.turtle(k);
+      REQUIRE(is_finite(s.pos));
+      REQUIRE(s.pos.x >= 6 - 1e-9);
+      REQUIRE(s.pos.x <= 994 + 1e-9);
+      REQUIRE(s.pos.y >= 6 - 1e-9);
+      REQUIRE(s.pos.y <= 994 + 1e-9);
+    }
+  }
+}
