@@ -1,0 +1,241 @@
+// SPDX-License-Identifier: MIT
+// The world server: programs as coroutines, commands, touch interrupts, isolation of faults.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+
+#include "turtlegas/turtle/turtle.hpp"
+#include "turtlegas/turtle/world_server.hpp"
+
+using namespace turtlegas;
+using namespace turtlegas::turtle;
+
+namespace {
+
+sim::WorldDef arena() {
+  sim::WorldDef d;
+  d.arena.width = 400;
+  d.arena.height = 400;
+  d.arena.boundary = sim::Boundary::walls;
+  d.dt = 0.1;
+  return d;
+}
+
+sim::TurtleDef body(std::string id, sim::Vec2 pos, double heading_deg) {
+  sim::TurtleDef t;
+  t.id = std::move(id);
+  t.pos = pos;
+  t.heading = heading_deg * M_PI / 180.0;
+  t.radius = 10;
+  t.speed = 50;
+  t.turn_rate = M_PI;  // 180 degrees per second
+  return t;
+}
+
+TurtleProgram program(std::string controller, std::string params = "{}") {
+  TurtleProgram p;
+  p.controller = std::move(controller);
+  p.params = nlohmann::json::parse(params);
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("the script controller drives a turtle", "[runtime]") {
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("t1", {100, 100}, 0));
+  WorldServer s(d, {program("script", R"({"commands": [["forward", 100], ["right", 90], ["forward", 50]]})")},
+                base_registry());
+  s.run_until(10.0);
+  const auto info = s.turtle(0);
+  CHECK(info.state.pos.x == Approx(150));
+  CHECK(info.state.pos.y == Approx(200));
+  CHECK(info.state.heading == Approx(M_PI / 2));
+  CHECK(info.finished);
+  CHECK(info.fault.empty());
+}
+
+TEST_CASE("a touch cuts a command short, fires the right sensor, arrives on the next step", "[runtime]") {
+  sim::WorldDef d = arena();
+  d.walls.push_back({"w", {202, 0}, {202, 400}});
+  d.turtles.push_back(body("t1", {100, 100}, 90));  // facing the wall at x = 202
+  Registry r = base_registry();
+  struct Seen {
+    Result moved;
+    double handler_time = -1, resumed_time = -1;
+    std::string order;
+  };
+  static Seen seen;
+  seen = {};
+  r.add("probe", [](Turtle& t, const Params&) {
+    t.on_touch([&](const Touch& touch) {
+      seen.handler_time = t.time();
+      seen.order += "handler;";
+      CHECK(touch.front());
+    });
+    seen.moved = t.forward(500);
+    seen.resumed_time = t.time();
+    seen.order += "resumed;";
+  });
+  WorldServer s(d, {program("probe")}, r);
+  std::vector<LogEvent> log;
+  s.set_event_log(&log);
+  s.run_until(5.0);
+  // Contact at x = 192, after 92 units at 50/s: t = 1.84, inside the step that ends at 1.9; the
+  // interrupt is delivered at that boundary.
+  REQUIRE(seen.moved.touched());
+  CHECK(seen.moved.done() == Approx(92));
+  CHECK(seen.moved.touch().front());
+  CHECK_FALSE(seen.moved.touch().left());
+  CHECK(seen.moved.touch().bearing == Approx(0).margin(1e-9));
+  CHECK(seen.moved.touch().what == "w");
+  CHECK(seen.moved.touch().t == Approx(1.84));
+  CHECK(seen.order == "handler;resumed;");
+  CHECK(seen.resumed_time > seen.moved.touch().t);
+  CHECK(seen.resumed_time == Approx(1.9));  // the next boundary, never the same instant
+  bool saw_touch = false;
+  for (const auto& e : log)
+    if (e.kind == "touch") {
+      saw_touch = true;
+      CHECK(e.a == "t1");
+      CHECK(e.b == "w");
+      CHECK(e.sensors == std::vector<std::string>{"front"});
+    }
+  CHECK(saw_touch);
+}
+
+TEST_CASE("sensors follow the heading: a wall touched in front is on the left after a right turn", "[runtime]") {
+  sim::WorldDef d = arena();
+  d.walls.push_back({"w", {50, 0}, {50, 400}});
+  d.turtles.push_back(body("t1", {100, 100}, 0));  // facing +y; the wall is 50 to the left
+  Registry r = base_registry();
+  static std::vector<Touch> after_turn;
+  static Result moved;
+  r.add("sidestep", [](Turtle& t, const Params&) {
+    t.left(90);             // now facing -x, towards the wall
+    moved = t.forward(100);  // stops at x = 60
+    t.right(90);            // facing +y again
+    after_turn = t.touching();
+  });
+  WorldServer s(d, {program("sidestep")}, r);
+  s.run_until(5.0);
+  CHECK(s.turtle(0).state.pos.x == Approx(60));
+  REQUIRE(moved.touched());
+  CHECK(moved.touch().front());
+  REQUIRE(after_turn.size() == 1);
+  CHECK(after_turn[0].left());
+  CHECK_FALSE(after_turn[0].front());
+  CHECK(after_turn[0].bearing == Approx(270));
+}
+
+TEST_CASE("a throwing program stops its turtle only", "[runtime][isolation]") {
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("bad", {100, 100}, 0));
+  d.turtles.push_back(body("good", {300, 100}, 0));
+  Registry r = base_registry();
+  r.add("thrower", [](Turtle& t, const Params&) {
+    t.forward(10);
+    throw std::runtime_error("kaboom");
+  });
+  WorldServer s(d, {program("thrower"), program("script", R"({"commands": [["forward", 100]]})")}, r);
+  std::vector<LogEvent> log;
+  s.set_event_log(&log);
+  s.run_until(5.0);
+  CHECK(s.turtle(0).fault.find("kaboom") != std::string::npos);
+  CHECK(s.turtle(0).state.pos.y == Approx(110));
+  CHECK(s.turtle(1).state.pos.y == Approx(200));
+  CHECK(s.turtle(1).fault.empty());
+  bool logged = false;
+  for (const auto& e : log) logged = logged || (e.kind == "fault" && e.a == "bad");
+  CHECK(logged);
+}
+
+namespace {
+int recurse(int n) {
+  volatile char pad[512];
+  pad[0] = static_cast<char>(n);
+  return n == 0 ? pad[0] : recurse(n + 1) + pad[0];
+}
+}  // namespace
+
+TEST_CASE("a stack overflow is a clear error for that turtle, and the world runs on", "[runtime][isolation]") {
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("deep", {100, 100}, 0));
+  d.turtles.push_back(body("good", {300, 100}, 0));
+  Registry r = base_registry();
+  r.add("deep", [](Turtle& t, const Params&) {
+    t.forward(10);
+    recurse(1);
+  });
+  WorldServer s(d, {program("deep"), program("script", R"({"commands": [["forward", 100]]})")}, r);
+  s.run_until(5.0);
+  CHECK(s.turtle(0).fault.find("overflowed its stack") != std::string::npos);
+  CHECK(s.turtle(1).state.pos.y == Approx(200));
+  s.run_until(6.0);  // still running
+  CHECK(s.time() == Approx(6.0));
+}
+
+TEST_CASE("a busy-looping program ends the run with a clear error", "[runtime][isolation]") {
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("spin", {100, 100}, 0));
+  Registry r = base_registry();
+  r.add("spin", [](Turtle& t, const Params&) {
+    t.forward(10);
+    volatile std::uint64_t n = 0;
+    for (;;) n = n + 1;
+  });
+  ServerOptions o;
+  o.program_budget = 0.2;
+  WorldServer s(d, {program("spin")}, r, o);
+  CHECK_THROWS_WITH(s.run_until(5.0), Catch::Contains("turtle 'spin'") && Catch::Contains("busy loop"));
+}
+
+TEST_CASE("a program that returns leaves its turtle parked", "[runtime]") {
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("t", {100, 100}, 0));
+  WorldServer s(d, {program("script", R"({"commands": [["forward", 20]]})")}, base_registry());
+  s.run_until(3.0);
+  CHECK(s.turtle(0).finished);
+  CHECK(s.turtle(0).state.pos.y == Approx(120));
+  CHECK_FALSE(s.turtle(0).state.busy);
+}
+
+TEST_CASE("an unknown controller names the known ones", "[runtime]") {
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("t", {100, 100}, 0));
+  CHECK_THROWS_WITH(WorldServer(d, {program("wandr")}, base_registry()),
+                    Catch::Contains("controller 'wandr' is not registered; known: script"));
+}
+
+TEST_CASE("runs are deterministic", "[runtime][determinism]") {
+  auto run = [] {
+    sim::WorldDef d = arena();
+    d.walls.push_back({"mid", {200, 50}, {200, 350}});
+    Registry r = base_registry();
+    r.add("random_walk", [](Turtle& t, const Params&) {
+      for (;;) {
+        auto m = t.forward(20 + 100 * t.uniform());
+        if (m.touched()) t.back(5);
+        t.right(360 * t.uniform() - 180);
+      }
+    });
+    for (int k = 0; k < 8; ++k)
+      d.turtles.push_back(body("t" + std::to_string(k), {(k < 4 ? 40.0 : 240.0) + 40 * (k % 4), 200}, 45.0 * k));
+    std::vector<TurtleProgram> programs(8, program("random_walk"));
+    WorldServer s(d, programs, r);
+    std::vector<LogEvent> log;
+    s.set_event_log(&log);
+    s.run_until(30.0);
+    return log;
+  };
+  const auto a = run(), b = run();
+  REQUIRE(a.size() == b.size());
+  CHECK(a.size() > 50);
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    CHECK(std::memcmp(&a[k].t, &b[k].t, sizeof(double)) == 0);
+    CHECK(a[k].kind == b[k].kind);
+    CHECK(a[k].a == b[k].a);
+    CHECK(a[k].b == b[k].b);
+  }
+}

@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/world/svg_snapshot.hpp"
+
+#include <sstream>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+namespace sim = turtlegas::sim;
+namespace tw = turtlegas::world;
+
+namespace {
+
+std::size_t count(const std::string& s, const std::string& part) {
+  std::size_t n = 0;
+  for (std::size_t at = s.find(part); at != std::string::npos; at = s.find(part, at + 1)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("an SVG snapshot draws the arena, walls and balls with +y up") {
+  sim::WorldDef def;
+  def.name = "a <small> & simple scene";
+  def.arena.width = 200;
+  def.arena.height = 100;
+  def.arena.boundary = sim::Boundary::walls;
+  def.walls.push_back({"w", {50, 10}, {50, 90}});
+  for (int i = 0; i < 5; ++i) {
+    sim::BallDef b;
+    b.id = "b" + std::to_string(i);
+    b.pos = {20.0 + 30 * i, 50};
+    b.vel = {10.0 * i, 0};
+    b.radius = 3;
+    def.balls.push_back(b);
+  }
+  const tw::Snapshot snap = tw::snapshot_of(def);
+  CHECK(snap.walls.size() == 5);  // the scene's wall and the four arena walls
+  CHECK(snap.balls.size() == 5);
+
+  std::ostringstream out;
+  tw::write_svg(out, snap, 400.0);
+  const std::string svg = out.str();
+  CHECK(svg.starts_with("<?xml"));
+  CHECK(svg.find("</svg>") != std::string::npos);
+  CHECK(count(svg, "<circle") == 5);
+  CHECK(count(svg, "<line ") == 5);
+  CHECK(svg.find("a &lt;small&gt; &amp; simple scene") != std::string::npos);
+  CHECK(svg.find("t = 0 s") != std::string::npos);
+  CHECK(svg.find("scale(2 -2)") != std::string::npos);  // 400 px for the 200-unit side, y flipped
+  CHECK(svg.find("linearGradient") != std::string::npos);
+  // The slowest ball gets the bottom of the palette, the fastest the top.
+  CHECK(svg.find("fill=\"#440154\"") != std::string::npos);
+  CHECK(svg.find("fill=\"#fde725\"") != std::string::npos);
+}

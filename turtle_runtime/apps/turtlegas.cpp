@@ -1,0 +1,462 @@
+// SPDX-License-Identifier: MIT
+// The turtlegas command-line program: `turtlegas run` and `turtlegas check` (see docs/design.md,
+// "Command line", for the contract this file keeps).
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "turtlegas/sim/world.hpp"
+#include "turtlegas/world/svg_snapshot.hpp"
+#include "turtlegas/world/world_file.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace sim = turtlegas::sim;
+namespace tw = turtlegas::world;
+using Clock = std::chrono::steady_clock;
+
+constexpr int exit_ok = 0;
+constexpr int exit_failure = 1;
+constexpr int exit_bad_input = 2;
+
+/// A problem with the command line or the world file: exit code 2.
+struct BadInput : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Shortest decimal that reads back as the same double (at most 17 significant digits).
+void append_number(std::string& out, double v) {
+  std::array<char, 32> buf{};
+  auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  out.append(buf.data(), r.ptr);
+}
+
+void append_json_string(std::string& out, std::string_view s) {
+  out += '"';
+  for (char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          std::array<char, 8> buf{};
+          std::snprintf(buf.data(), buf.size(), "\\u%04x", static_cast<unsigned>(c));
+          out += buf.data();
+        } else {
+          out += c;
+        }
+    }
+  }
+  out += '"';
+}
+
+/// An output file written under a temporary name in the same directory and renamed over the
+/// target only by commit(), so a failed or interrupted run never leaves a file that looks whole.
+class AtomicFile {
+ public:
+  AtomicFile(fs::path target, std::string_view option) : target_(std::move(target)) {
+    const fs::path dir = target_.parent_path().empty() ? fs::path(".") : target_.parent_path();
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+      throw BadInput(std::string(option) + ": directory '" + dir.string() + "' does not exist; create it first");
+    if (fs::is_directory(target_, ec))
+      throw BadInput(std::string(option) + ": '" + target_.string() + "' is a directory; give a file name");
+    tmp_ = dir / ("." + target_.filename().string() + ".tmp-" + std::to_string(::getpid()));
+    out_.open(tmp_, std::ios::binary | std::ios::trunc);
+    if (!out_) throw BadInput(std::string(option) + ": cannot write in '" + dir.string() + "'; check its permissions");
+  }
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  ~AtomicFile() {
+    if (committed_) return;
+    out_.close();
+    std::error_code ec;
+    fs::remove(tmp_, ec);
+  }
+
+  std::ofstream& stream() { return out_; }
+
+  void commit() {
+    out_.close();
+    if (out_.fail()) throw std::runtime_error("could not finish writing '" + target_.string() + "' (disk full?)");
+    fs::rename(tmp_, target_);
+    committed_ = true;
+  }
+
+ private:
+  fs::path target_;
+  fs::path tmp_;
+  std::ofstream out_;
+  bool committed_ = false;
+};
+
+struct RunOptions {
+  std::string world;
+  double until = 0.0;
+  std::string mode = "exact";
+  std::optional<double> dt;
+  std::string events, state_out, stats_json, svg;
+  bool stats = false;
+};
+
+/// The event log as JSON lines, written in chunks while the world runs.
+class EventWriter {
+ public:
+  EventWriter(AtomicFile& file, const sim::WorldDef& def, const sim::World& world)
+      : file_(file), def_(def), world_(world) {}
+
+  void write(const std::vector<sim::Event>& events) {
+    buf_.clear();
+    for (const sim::Event& e : events) {
+      buf_ += "{\"t\": ";
+      append_number(buf_, e.t);
+      buf_ += ", \"kind\": \"";
+      buf_ += sim::to_string(e.kind);
+      buf_ += "\", \"a\": ";
+      const bool turtle_a = sim::involves_turtle(e.kind) || (e.kind == sim::EventKind::exit && e.b == 1);
+      append_json_string(buf_, turtle_a ? def_.turtles[e.a].id : def_.balls[e.a].id);
+      const std::string* b = nullptr;
+      switch (e.kind) {
+        case sim::EventKind::ball_ball:
+        case sim::EventKind::turtle_ball: b = &def_.balls[e.b].id; break;
+        case sim::EventKind::ball_wall:
+        case sim::EventKind::ball_wall_end:
+        case sim::EventKind::turtle_wall:
+        case sim::EventKind::turtle_wall_end: b = &world_.walls()[e.b].id; break;
+        case sim::EventKind::turtle_turtle: b = &def_.turtles[e.b].id; break;
+        case sim::EventKind::exit: break;  // b only says what kind of body left
+      }
+      if (b) {
+        buf_ += ", \"b\": ";
+        append_json_string(buf_, *b);
+      }
+      buf_ += "}\n";
+    }
+    file_.stream().write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+  }
+
+ private:
+  AtomicFile& file_;
+  const sim::WorldDef& def_;
+  const sim::World& world_;
+  std::string buf_;
+};
+
+/// Simulated time / until on stderr, refreshed in place, only on a terminal and only once a run
+/// has taken long enough for it to help.
+class Progress {
+ public:
+  explicit Progress(double until) : until_(until), start_(Clock::now()), enabled_(::isatty(STDERR_FILENO) != 0) {}
+
+  void update(double t, std::uint64_t events) {
+    if (!enabled_) return;
+    const auto now = Clock::now();
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    if (elapsed < 2.0 || now - last_ < std::chrono::milliseconds(200)) return;
+    last_ = now;
+    const double pct = until_ > 0.0 ? 100.0 * t / until_ : 100.0;
+    std::fprintf(stderr, "\r  t = %.6g / %.6g s  %5.1f%%  %.3g events/s ", t, until_, pct,
+                 static_cast<double>(events) / elapsed);
+    std::fflush(stderr);
+    shown_ = true;
+  }
+  ~Progress() { clear(); }
+  void clear() {
+    if (shown_) std::fputs("\r\033[K", stderr), std::fflush(stderr);
+    shown_ = false;
+  }
+
+ private:
+  double until_;
+  Clock::time_point start_;
+  Clock::time_point last_{};
+  bool enabled_;
+  bool shown_ = false;
+};
+
+sim::WorldDef load(const std::string& file) {
+  try {
+    return tw::load_world_file(file);
+  } catch (const tw::WorldFileError& e) {
+    throw BadInput(e.what());
+  }
+}
+
+/// The engine rejects a scene it cannot run (a cell size against the memo's rule, say) with
+/// std::invalid_argument: that is the world file's fault, so exit code 2.
+sim::World make_world(const sim::WorldDef& def, sim::Mode mode, const std::string& file) {
+  try {
+    return sim::World(def, mode);
+  } catch (const std::invalid_argument& e) {
+    throw BadInput(file + ": " + (mode == sim::Mode::exact ? "exact" : "step") + " mode: " + e.what());
+  }
+}
+
+std::string count_summary(const sim::WorldDef& def) {
+  auto plural = [](std::size_t n, const char* noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); };
+  std::string s = plural(def.balls.size(), "ball") + ", " + plural(def.walls.size(), "wall");
+  if (def.arena.boundary == sim::Boundary::walls) s += " (+4 arena walls)";
+  return s;
+}
+
+const char* boundary_name(sim::Boundary b) {
+  switch (b) {
+    case sim::Boundary::none: return "none";
+    case sim::Boundary::walls: return "walls";
+    case sim::Boundary::periodic: return "periodic";
+  }
+  return "?";
+}
+
+std::string fmt(double v) {
+  std::array<char, 32> buf{};
+  std::snprintf(buf.data(), buf.size(), "%.6g", v);
+  return buf.data();
+}
+
+int check_command(const std::string& file) {
+  const sim::WorldDef def = load(file);
+  const sim::World exact = make_world(def, sim::Mode::exact, file);
+  const sim::World step = make_world(def, sim::Mode::step, file);
+  std::printf("%s: ok: \"%s\", %s, arena %s x %s (boundary %s), cell %s (%d x %d), dt %s s\n", file.c_str(),
+              def.name.c_str(), count_summary(def).c_str(), fmt(def.arena.width).c_str(), fmt(def.arena.height).c_str(),
+              boundary_name(def.arena.boundary), fmt(step.cell_size()).c_str(), step.cells_x(), step.cells_y(),
+              fmt(def.dt).c_str());
+  return exit_ok;
+}
+
+int run_command(const RunOptions& opt) {
+  if (!std::isfinite(opt.until) || opt.until < 0.0)
+    throw BadInput("--until must be a finite time >= 0 in seconds (got " + fmt(opt.until) + ")");
+  if (opt.dt && (!std::isfinite(*opt.dt) || *opt.dt <= 0.0))
+    throw BadInput("--dt must be a finite time > 0 in seconds (got " + fmt(*opt.dt) + ")");
+  const sim::Mode mode = opt.mode == "step" ? sim::Mode::step : sim::Mode::exact;
+
+  // Outputs are opened before the run, so a bad path costs nothing.
+  std::optional<AtomicFile> events_file, state_file, stats_file, svg_file;
+  if (!opt.events.empty()) events_file.emplace(opt.events, "--events");
+  if (!opt.state_out.empty()) state_file.emplace(opt.state_out, "--state-out");
+  if (!opt.stats_json.empty()) stats_file.emplace(opt.stats_json, "--stats-json");
+  if (!opt.svg.empty()) svg_file.emplace(opt.svg, "--svg");
+
+  sim::WorldDef def = load(opt.world);
+  if (opt.dt) def.dt = *opt.dt;
+  sim::World world = make_world(def, mode, opt.world);
+  const double energy_start = world.energy();
+
+  std::vector<sim::Event> events;
+  std::optional<EventWriter> writer;
+  if (events_file) {
+    writer.emplace(*events_file, def, world);
+    world.set_event_log(&events);
+  }
+
+  // Advance in chunks so the event buffer stays bounded and progress can be shown; the engine's
+  // physics does not depend on where a run is cut. Chunks start at a quarter step, short enough
+  // for a million balls, and adapt to about 0.1 s of wall time.
+  Progress progress(opt.until);
+  const auto start = Clock::now();
+  double t = world.time();
+  double chunk = std::min((opt.until - t) / 64.0, def.dt / 4.0);
+  while (t < opt.until) {
+    double next = std::min(opt.until, t + chunk);
+    if (!(next > t)) next = opt.until;
+    const auto chunk_start = Clock::now();
+    world.advance_to(next);
+    const double took = std::chrono::duration<double>(Clock::now() - chunk_start).count();
+    if (writer) writer->write(events);
+    if (took > 0.25 || events.size() > (1u << 20)) chunk /= 2.0;
+    else if (took < 0.05 && events.size() < (1u << 18)) chunk *= 2.0;
+    events.clear();
+    t = next;
+    progress.update(t, world.stats().events);
+  }
+  const double wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  progress.clear();
+  world.set_event_log(nullptr);
+
+  const sim::Stats& st = world.stats();
+  const sim::Overlap now = world.measure_overlap(), seen = world.max_contact_overlap();
+  const double max_overlap = std::max(now.depth, seen.depth);
+  const double max_overlap_relative = std::max(now.relative, seen.relative);
+  const double energy_end = world.energy();
+  std::size_t live = 0;
+  for (std::size_t i = 0; i < world.ball_count(); ++i) live += world.ball(i).alive ? 1 : 0;
+
+  if (events_file) events_file->commit();
+
+  if (state_file) {
+    std::string buf = "{\"t\": ";
+    append_number(buf, world.time());
+    buf += ", \"balls\": [";
+    bool first = true;
+    for (std::size_t i = 0; i < world.ball_count(); ++i) {
+      const sim::BallState b = world.ball(i);
+      if (!b.alive) continue;
+      buf += first ? "\n  " : ",\n  ";
+      first = false;
+      buf += "{\"id\": ";
+      append_json_string(buf, def.balls[i].id);
+      buf += ", \"pos\": [";
+      append_number(buf, b.pos.x);
+      buf += ", ";
+      append_number(buf, b.pos.y);
+      buf += "], \"vel\": [";
+      append_number(buf, b.vel.x);
+      buf += ", ";
+      append_number(buf, b.vel.y);
+      buf += "]}";
+      if (buf.size() > (1u << 20)) {
+        state_file->stream() << buf;
+        buf.clear();
+      }
+    }
+    buf += first ? "], \"turtles\": [" : "\n], \"turtles\": [";
+    for (std::size_t i = 0; i < world.turtle_count(); ++i) {
+      const sim::TurtleState tu = world.turtle(i);
+      buf += i == 0 ? "\n  " : ",\n  ";
+      buf += "{\"id\": ";
+      append_json_string(buf, def.turtles[i].id);
+      buf += ", \"pos\": [";
+      append_number(buf, tu.pos.x);
+      buf += ", ";
+      append_number(buf, tu.pos.y);
+      // Radians inside, degrees in files (Logo convention: 0 is +y, clockwise).
+      buf += "], \"heading\": ";
+      append_number(buf, tu.heading * (180.0 / std::numbers::pi));
+      buf += "}";
+    }
+    buf += world.turtle_count() == 0 ? "]}\n" : "\n]}\n";
+    state_file->stream() << buf;
+    state_file->commit();
+  }
+
+  const char* mode_name = mode == sim::Mode::exact ? "exact" : "step";
+  const double per_second = wall_seconds > 0.0 ? static_cast<double>(st.collisions()) / wall_seconds : 0.0;
+  if (stats_file) {
+    const nlohmann::json j = {
+        {"world", opt.world},
+        {"name", def.name},
+        {"mode", mode_name},
+        {"until", opt.until},
+        {"dt", def.dt},
+        {"seed", def.seed},
+        {"balls", def.balls.size()},
+        {"balls_alive", live},
+        {"walls", world.walls().size()},
+        {"cell_size", world.cell_size()},
+        {"collisions", st.collisions()},
+        {"ball_ball", st.ball_ball},
+        {"ball_wall", st.ball_wall},
+        {"ball_wall_end", st.ball_wall_end},
+        {"exits", st.exits},
+        {"turtle_wall", st.turtle_wall},
+        {"turtle_wall_end", st.turtle_wall_end},
+        {"turtle_turtle", st.turtle_turtle},
+        {"turtle_ball", st.turtle_ball},
+        {"cell_crossings", st.cell_crossings},
+        {"stale", st.stale},
+        {"steps", st.steps},
+        {"events", st.events},
+        {"wall_seconds", wall_seconds},
+        {"collisions_per_second", per_second},
+        {"energy_start", energy_start},
+        {"energy_end", energy_end},
+        {"max_overlap", max_overlap},
+        {"max_overlap_relative", max_overlap_relative},
+    };
+    stats_file->stream() << j.dump(2) << '\n';
+    stats_file->commit();
+  }
+
+  if (svg_file) {
+    tw::write_svg(svg_file->stream(), tw::snapshot_of(world, def));
+    svg_file->commit();
+  }
+
+  if (opt.stats) {
+    const double de = energy_start != 0.0 ? (energy_end - energy_start) / std::abs(energy_start) : energy_end - energy_start;
+    std::printf("%s (%s): %s, %s mode, t = 0 -> %s s\n", def.name.c_str(), opt.world.c_str(), count_summary(def).c_str(),
+                mode_name, fmt(world.time()).c_str());
+    std::printf("  collisions   %llu  (ball-ball %llu, ball-wall %llu, ball-wall-end %llu)\n",
+                static_cast<unsigned long long>(st.collisions()), static_cast<unsigned long long>(st.ball_ball),
+                static_cast<unsigned long long>(st.ball_wall), static_cast<unsigned long long>(st.ball_wall_end));
+    std::printf("  exits        %llu  (%zu balls left)\n", static_cast<unsigned long long>(st.exits), live);
+    std::printf("  events       %llu  (cell crossings %llu, stale %llu, steps %llu)\n",
+                static_cast<unsigned long long>(st.events), static_cast<unsigned long long>(st.cell_crossings),
+                static_cast<unsigned long long>(st.stale), static_cast<unsigned long long>(st.steps));
+    std::printf("  wall time    %.3f s  (%s collisions/s)\n", wall_seconds, fmt(per_second).c_str());
+    std::printf("  energy       %s -> %s  (relative change %.3g)\n", fmt(energy_start).c_str(), fmt(energy_end).c_str(), de);
+    std::printf("  max overlap  %s  (%.3g of a radius)\n", fmt(max_overlap).c_str(), max_overlap_relative);
+  }
+  return exit_ok;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  auto log = spdlog::stderr_color_st("turtlegas");
+  log->set_pattern("%^%l%$: %v");
+  spdlog::set_default_logger(log);
+
+  CLI::App app{"turtlegas: a 2-D gas of discs and walls (after MIT AI Memo 272, the GAS program)"};
+  app.require_subcommand(1);
+
+  RunOptions opt;
+  CLI::App* run = app.add_subcommand("run", "Simulate a world file until time T");
+  run->add_option("world", opt.world, "World file (format turtlegas-world/1)")->required();
+  run->add_option("--until", opt.until, "Simulated time to stop at, seconds")->required();
+  run->add_option("--mode", opt.mode, "exact (event-driven) or step (the memo's fixed steps)")
+      ->check(CLI::IsMember({"exact", "step"}))
+      ->capture_default_str();
+  double dt = 0.0;
+  CLI::Option* dt_option = run->add_option("--dt", dt, "Step in seconds (overrides the world file's dt)");
+  run->add_option("--events", opt.events, "Write the event log here (JSON lines)");
+  run->add_option("--state-out", opt.state_out, "Write the final state here (JSON)");
+  run->add_flag("--stats", opt.stats, "Print a summary of the run");
+  run->add_option("--stats-json", opt.stats_json, "Write the run's statistics here (JSON)");
+  run->add_option("--svg", opt.svg, "Write an SVG picture of the final state here");
+
+  std::string check_world;
+  CLI::App* check = app.add_subcommand("check", "Load and validate a world file, and build it in both modes");
+  check->add_option("world", check_world, "World file (format turtlegas-world/1)")->required();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? exit_ok : exit_bad_input;
+  }
+  if (*dt_option) opt.dt = dt;
+
+  try {
+    if (*check) return check_command(check_world);
+    return run_command(opt);
+  } catch (const BadInput& e) {
+    spdlog::error("{}", e.what());
+    return exit_bad_input;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return exit_failure;
+  }
+}

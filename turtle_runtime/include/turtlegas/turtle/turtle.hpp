@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: MIT
+// The one header a controller program needs.
+//
+// A controller is a plain function that runs as the turtle's own coroutine. Each motion command
+// suspends the program until the command completes in simulated time or a touch cuts it short,
+// and returns what happened:
+//
+//   void wall_follower(turtlegas::turtle::Turtle& t, const turtlegas::turtle::Params& p) {
+//     const double back_off = p.get("back_off", 5.0);
+//     for (;;) {
+//       auto moved = t.forward(1000);          // suspends until done or touched
+//       if (moved.touched()) {
+//         t.back(back_off);
+//         t.left(moved.touch().front() ? 90 : 30);
+//       }
+//     }
+//   }
+//
+// Angles are degrees at this interface (Logo convention: heading 0 points to +y, right turns are
+// clockwise); distances are world units, times seconds.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "turtlegas/sim/vec2.hpp"
+
+namespace turtlegas::turtle {
+
+/// A controller's parameters: the world file's `params` object.
+class Params {
+ public:
+  Params() = default;
+  explicit Params(nlohmann::json json) : json_(std::move(json)) {}
+  /// The value of `key` converted to T, or `fallback` when absent. A present value of the wrong
+  /// type throws std::invalid_argument naming the key.
+  template <class T>
+  T get(const std::string& key, T fallback) const {
+    if (!json_.is_object() || !json_.contains(key)) return fallback;
+    try {
+      return json_.at(key).get<T>();
+    } catch (const nlohmann::json::exception&) {
+      throw std::invalid_argument("params." + key + " has the wrong type: " + json_.at(key).dump());
+    }
+  }
+  double get(const std::string& key, double fallback) const { return get<double>(key, fallback); }
+  bool has(const std::string& key) const { return json_.is_object() && json_.contains(key); }
+  const nlohmann::json& json() const { return json_; }
+
+ private:
+  nlohmann::json json_ = nlohmann::json::object();
+};
+
+/// One touch: which sensors fired, where the contact was and what was touched.
+struct Touch {
+  std::vector<bool> sensors;  ///< one flag per sensor, in the turtle's sensor order
+  std::vector<std::string> sensor_names;
+  double bearing = 0.0;       ///< degrees clockwise from the heading to the contact point, [0, 360)
+  std::string what;           ///< id of the wall, ball or turtle touched
+  std::string kind;           ///< "wall", "wall-end", "turtle" or "ball"
+  double t = 0.0;             ///< seconds, the time of contact
+  /// With the default four sensors (front, right, back, left):
+  bool front() const { return fired("front"); }
+  bool right() const { return fired("right"); }
+  bool back() const { return fired("back"); }
+  bool left() const { return fired("left"); }
+  bool fired(const std::string& sensor_name) const;
+  bool any() const;
+};
+
+/// What a command did.
+class Result {
+ public:
+  Result() = default;
+  Result(double done, std::optional<Touch> touch) : done_(done), touch_(std::move(touch)) {}
+  /// Distance driven (units), angle turned (degrees) or time waited (s), always >= 0.
+  double done() const { return done_; }
+  /// Whether a touch cut the command short.
+  bool touched() const { return touch_.has_value(); }
+  /// The touch that cut it short; only when touched().
+  const Touch& touch() const { return *touch_; }
+
+ private:
+  double done_ = 0.0;
+  std::optional<Touch> touch_;
+};
+
+class Agent;  // the runtime's side of a turtle
+
+/// The handle a controller program drives its turtle with. Valid for the program's lifetime.
+class Turtle {
+ public:
+  explicit Turtle(Agent& agent) : agent_(&agent) {}
+
+  Result forward(double distance);
+  Result back(double distance);
+  Result left(double degrees);
+  Result right(double degrees);
+  Result wait(double seconds);
+  /// Gives up the rest of this control step without a command.
+  void yield();
+  void pen_up();
+  void pen_down();
+  bool pen_is_down() const;
+
+  /// The touches in contact now (sensors computed for the current heading); empty if none.
+  std::vector<Touch> touching() const;
+  /// Installs an interrupt handler: called for each touch, in the turtle's program, before the
+  /// program resumes from the command the touch cut short. Replaces any previous handler.
+  void on_touch(std::function<void(const Touch&)> handler);
+
+  /// Odometry: distance driven in all (units) and heading (degrees, Logo convention).
+  double odometer() const;
+  double heading() const;
+  /// Global position, only where the world grants it (`"gps": true` on the turtle).
+  std::optional<sim::Vec2> position() const;
+  /// Simulated time, seconds.
+  double time() const;
+  const std::string& id() const;
+  /// A per-turtle random stream seeded from the world's seed and the turtle's id: programs that
+  /// draw from it are deterministic.
+  double uniform();  ///< in [0, 1)
+  /// A line for the run's log, tagged with the turtle's id.
+  void log(const std::string& message);
+
+ private:
+  Agent* agent_;
+};
+
+/// A controller program.
+using Controller = std::function<void(Turtle&, const Params&)>;
+
+}  // namespace turtlegas::turtle

@@ -1,0 +1,133 @@
+// SPDX-License-Identifier: MIT
+// The world server: the one owner of all bodies and of time. It runs the turtles' programs as
+// coroutines between physics steps.
+//
+// Order of one control step, at t = k dt (AI Memo 272, "On simulating turtles"):
+//   1. Contacts that involved turtles during the previous step become touch interrupts.
+//   2. Turtles are taken in world-file order. A turtle whose command is still running is left
+//      alone. Any other turtle first receives its interrupts (its on_touch handler runs for each,
+//      and each is logged as a `touch` event), then its program runs until it issues its next
+//      command (or yields, or returns); the command starts at once, at t.
+//   3. The physics advances every body to (k+1) dt, earliest collision first. A turtle that
+//      touches something stops at the contact point at the exact contact time; its command ends
+//      there and the interrupt waits for the next step.
+// Pacing (wall clock) never enters: the same world, seed and programs give the same event log.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "turtlegas/sim/world.hpp"
+#include "turtlegas/turtle/turtle.hpp"
+
+namespace turtlegas::turtle {
+
+/// A touch sensor: fires for contacts whose bearing lies in [from, to) degrees clockwise from the
+/// heading (the arc may wrap through 0).
+struct SensorArc {
+  std::string name;
+  double from = 0.0;
+  double to = 0.0;
+};
+
+/// The default four sensors: front [-45, 45), right [45, 135), back [135, 225), left [225, 315).
+std::vector<SensorArc> default_sensors();
+/// n equal arcs, the first centred on the heading, named s0..s{n-1}.
+std::vector<SensorArc> equal_sensors(int n);
+
+/// How a turtle's program is set up (the world file's turtle entry, beyond its body).
+struct TurtleProgram {
+  std::string controller = "script";
+  nlohmann::json params = nlohmann::json::object();
+  std::vector<SensorArc> sensors = default_sensors();
+  bool pen_down = false;
+  bool gps = false;  ///< whether the program may read its global position
+};
+
+/// Controllers by name. The runtime knows `script`; controllers/ adds the rest.
+class Registry {
+ public:
+  void add(std::string name, Controller controller, std::string summary = {});
+  const Controller* find(const std::string& name) const;
+  std::vector<std::string> names() const;
+  const std::string& summary(const std::string& name) const;
+
+ private:
+  std::map<std::string, std::pair<Controller, std::string>> entries_;
+};
+
+/// The built-in `script` controller: runs `params.commands`, a list of [name, amount] pairs
+/// (forward, back, left, right, wait; pendown and penup take no amount).
+void script_controller(Turtle& t, const Params& p);
+
+/// A registry holding `script` only.
+Registry base_registry();
+
+struct ServerOptions {
+  sim::Mode mode = sim::Mode::exact;
+  std::size_t stack_bytes = 32 * 1024;  ///< each program's stack, plus a guard page
+  /// Wall-clock seconds a program may run without issuing a command before the run is stopped as a
+  /// busy loop. Wall clock, not simulated time: it only ever ends a run, never changes one.
+  double program_budget = 2.0;
+};
+
+/// One line of the run's event log, with ids resolved; `touch` events carry sensors and bearing.
+struct LogEvent {
+  double t = 0.0;
+  std::string kind;
+  std::string a;
+  std::string b;
+  std::vector<std::string> sensors;  ///< touch only
+  double bearing = 0.0;              ///< touch only, degrees
+  std::string message;               ///< `fault` events: what went wrong
+};
+
+/// The busy-loop stop: a program ran past its budget without issuing a command.
+struct BusyLoopError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+class WorldServer {
+ public:
+  /// programs[i] belongs to def.turtles[i]. Throws std::invalid_argument for a controller that is
+  /// not registered (naming the known ones) or bad sensor arcs.
+  WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> programs, const Registry& registry,
+              ServerOptions options = {});
+  ~WorldServer();
+  WorldServer(const WorldServer&) = delete;
+  WorldServer& operator=(const WorldServer&) = delete;
+
+  /// Runs control steps until time t (seconds). Throws BusyLoopError if a program hangs.
+  void run_until(double t);
+  double time() const;
+  const sim::World& world() const;
+
+  /// When set, events are appended to *log (nullptr stops).
+  void set_event_log(std::vector<LogEvent>* log);
+
+  struct TurtleInfo {
+    std::string id;
+    sim::TurtleState state;
+    bool pen_down = false;
+    bool finished = false;  ///< the program returned (the turtle is parked)
+    std::string fault;      ///< non-empty when the program failed (threw, overflowed its stack)
+    std::vector<sim::Vec2> trail;  ///< pen-down path, in world units
+  };
+  std::size_t turtle_count() const;
+  TurtleInfo turtle(std::size_t i) const;
+  /// Bytes of program stack actually reserved per turtle (stack plus guard page).
+  std::size_t stack_reservation() const;
+
+  class Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace turtlegas::turtle

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstddef>
+#include <exception>
+#include <functional>
+#include <memory>
+
+namespace turtlegas::turtle::detail {
+
+/// A cooperative coroutine with its own stack and a guard page below it (Boost.Context's fiber on
+/// a protected stack; this file pair is the only place that includes Boost.Context).
+///
+/// Two faults are contained rather than left to take the process down: running into the guard
+/// page (a stack overflow) and running past a wall-clock budget without suspending (a busy loop).
+/// Both are caught by a signal handler on an alternate stack, which jumps back to the resume()
+/// that started the slice; the fiber is then abandoned (its stack is leaked, never unwound) and
+/// resume() reports what happened.
+class Fiber {
+ public:
+  enum class Outcome {
+    suspended,       ///< the body called suspend()
+    finished,        ///< the body returned (or threw: see error())
+    stack_overflow,  ///< the body ran into its guard page
+    over_budget,     ///< the body ran past the budget without suspending
+  };
+
+  Fiber(std::function<void()> body, std::size_t stack_bytes);
+  ~Fiber();
+  Fiber(const Fiber&) = delete;
+  Fiber& operator=(const Fiber&) = delete;
+
+  /// Runs the body until it suspends or ends. budget_seconds <= 0 means no budget.
+  Outcome resume(double budget_seconds);
+  /// From inside the body: back to whoever resumed it.
+  void suspend();
+  bool done() const;
+  /// What the body threw, if it ended by throwing.
+  std::exception_ptr error() const;
+  /// Bytes reserved for the stack, guard page included.
+  std::size_t reserved_bytes() const;
+
+  /// The fiber running now, if any.
+  static Fiber* current();
+
+  class Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace turtlegas::turtle::detail

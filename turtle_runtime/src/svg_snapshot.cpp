@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/world/svg_snapshot.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <ostream>
+
+namespace turtlegas::world {
+namespace {
+
+/// Six significant digits: a pixel is far coarser, and the file stays small.
+std::string fmt(double v) {
+  std::array<char, 32> buf{};
+  std::snprintf(buf.data(), buf.size(), "%.6g", v);
+  return buf.data();
+}
+
+std::string xml_escape(std::string_view s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+/// Viridis at five stops: perceptually even and readable in grey.
+constexpr std::array<std::array<int, 3>, 5> palette = {{
+    {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
+
+std::string colour(double u) {
+  u = std::clamp(u, 0.0, 1.0) * (palette.size() - 1);
+  const auto k = std::min(static_cast<std::size_t>(u), palette.size() - 2);
+  const double f = u - static_cast<double>(k);
+  std::array<char, 8> buf{};
+  int rgb[3];
+  for (int c = 0; c < 3; ++c) rgb[c] = static_cast<int>(std::lround(palette[k][c] + f * (palette[k + 1][c] - palette[k][c])));
+  std::snprintf(buf.data(), buf.size(), "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
+  return buf.data();
+}
+
+}  // namespace
+
+Snapshot snapshot_of(const sim::WorldDef& def) {
+  Snapshot s;
+  s.title = def.name;
+  s.arena = def.arena;
+  s.walls = def.walls;
+  if (def.arena.boundary == sim::Boundary::walls)
+    for (auto& w : sim::arena_walls(def.arena)) s.walls.push_back(std::move(w));
+  s.balls.reserve(def.balls.size());
+  for (const auto& b : def.balls) s.balls.push_back({b.pos, b.vel, b.radius});
+  return s;
+}
+
+void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
+  const double aw = snap.arena.width, ah = snap.arena.height;
+  const double scale = width_px / std::max(aw, ah);
+  const double margin = 12.0, title_h = 30.0, legend_w = 90.0;
+  const double w = aw * scale + 2 * margin + legend_w;
+  const double h = std::max(ah * scale, 160.0) + title_h + 2 * margin;
+  const double top = title_h + margin;
+
+  // Colours span 0 to the 99th-percentile speed, so one fast outlier does not wash out the rest.
+  std::vector<double> speeds;
+  speeds.reserve(snap.balls.size());
+  for (const auto& b : snap.balls) speeds.push_back(sim::norm(b.vel));
+  double v_max = 0.0;
+  if (!speeds.empty()) {
+    const auto k = static_cast<std::ptrdiff_t>((speeds.size() - 1) * 99 / 100);
+    std::vector<double> sorted = speeds;
+    std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
+    v_max = sorted[static_cast<std::size_t>(k)];
+  }
+  const double v_scale = v_max > 0.0 ? v_max : 1.0;
+
+  const std::string title = xml_escape(snap.title.empty() ? std::string("turtlegas") : snap.title);
+  out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << fmt(w) << "\" height=\"" << fmt(h)
+      << "\" viewBox=\"0 0 " << fmt(w) << ' ' << fmt(h) << "\" font-family=\"sans-serif\">\n"
+      << "<title>" << title << " at t = " << fmt(snap.time) << " s</title>\n"
+      << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+      << "<text x=\"" << fmt(margin) << "\" y=\"" << fmt(margin + 14) << "\" font-size=\"16\">" << title
+      << " — t = " << fmt(snap.time) << " s, " << snap.balls.size() << " balls</text>\n";
+
+  // World coordinates inside the group: +y up, one world unit = scale pixels.
+  out << "<g transform=\"translate(" << fmt(margin) << ' ' << fmt(top + ah * scale) << ") scale(" << fmt(scale)
+      << ' ' << fmt(-scale) << ")\">\n"
+      << "<rect x=\"0\" y=\"0\" width=\"" << fmt(aw) << "\" height=\"" << fmt(ah)
+      << "\" fill=\"#f7f7f7\" stroke=\"#999\" stroke-width=\"1\" vector-effect=\"non-scaling-stroke\"/>\n";
+  for (const auto& wall : snap.walls)
+    out << "<line x1=\"" << fmt(wall.from.x) << "\" y1=\"" << fmt(wall.from.y) << "\" x2=\"" << fmt(wall.to.x)
+        << "\" y2=\"" << fmt(wall.to.y)
+        << "\" stroke=\"#222\" stroke-width=\"2\" stroke-linecap=\"round\" vector-effect=\"non-scaling-stroke\"/>\n";
+  for (std::size_t i = 0; i < snap.balls.size(); ++i) {
+    const auto& b = snap.balls[i];
+    out << "<circle cx=\"" << fmt(b.pos.x) << "\" cy=\"" << fmt(b.pos.y) << "\" r=\"" << fmt(b.radius)
+        << "\" fill=\"" << colour(speeds[i] / v_scale) << "\"/>\n";
+  }
+  out << "</g>\n";
+
+  // Legend: a vertical colour bar from 0 (bottom) to v_max (top).
+  const double lx = margin + aw * scale + 24.0, ly = top + 16.0, lh = 120.0;
+  out << "<defs><linearGradient id=\"speed\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">";
+  for (std::size_t k = 0; k < palette.size(); ++k) {
+    const double u = static_cast<double>(k) / (palette.size() - 1);
+    out << "<stop offset=\"" << fmt(u) << "\" stop-color=\"" << colour(u) << "\"/>";
+  }
+  out << "</linearGradient></defs>\n"
+      << "<text x=\"" << fmt(lx - 8) << "\" y=\"" << fmt(ly - 6) << "\" font-size=\"12\">speed</text>\n"
+      << "<rect x=\"" << fmt(lx) << "\" y=\"" << fmt(ly) << "\" width=\"14\" height=\"" << fmt(lh)
+      << "\" fill=\"url(#speed)\" stroke=\"#999\"/>\n"
+      << "<text x=\"" << fmt(lx + 18) << "\" y=\"" << fmt(ly + 10) << "\" font-size=\"11\">&#8805; " << fmt(v_max)
+      << "</text>\n"
+      << "<text x=\"" << fmt(lx + 18) << "\" y=\"" << fmt(ly + lh) << "\" font-size=\"11\">0</text>\n"
+      << "</svg>\n";
+}
+
+}  // namespace turtlegas::world

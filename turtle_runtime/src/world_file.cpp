@@ -1,0 +1,505 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/world/world_file.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <initializer_list>
+#include <sstream>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "gas.hpp"
+
+namespace turtlegas::world {
+namespace {
+
+using json = nlohmann::json;
+using sim::Vec2;
+
+std::string prefix(const std::string& file, const std::string& path, const std::string& reason, std::size_t line,
+                   std::size_t column) {
+  if (line > 0) return file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + reason;
+  if (!path.empty()) return file + ": " + path + ": " + reason;
+  return file + ": " + reason;
+}
+
+std::string num(double v) {
+  std::array<char, 32> buf{};
+  auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  return std::string(buf.data(), r.ptr);
+}
+
+// Appended piecewise: GCC 12 gives a false -Wrestrict for "literal" + std::string (bug 105329).
+std::string vec(Vec2 v) {
+  std::string s = "[";
+  s += num(v.x);
+  s += ", ";
+  s += num(v.y);
+  s += ']';
+  return s;
+}
+
+/// A JSON-pointer reference token: `~` and `/` escaped as RFC 6901 has it.
+std::string token(std::string_view key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else out += c;
+  }
+  return out;
+}
+
+std::string at(const std::string& path, std::string_view key) { return path + "/" + token(key); }
+std::string at(const std::string& path, std::size_t index) { return path + "/" + std::to_string(index); }
+
+/// "a string", "an array", ...: what nlohmann calls the type, with its article.
+std::string kind_of(const json& v) {
+  const std::string name = v.type_name();
+  if (v.is_null()) return "null";
+  if (v.is_boolean()) return "true or false";
+  const bool vowel = !name.empty() && std::strchr("aeiou", name[0]) != nullptr;
+  return (vowel ? "an " : "a ") + name;
+}
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+/// Features that later versions add to the format: named so that a file written for them fails
+/// with a clear message rather than as an unknown key.
+constexpr std::array<std::string_view, 5> reserved_keys = {"turtles", "views", "expect", "game", "draw"};
+
+constexpr std::array<std::string_view, 4> arena_wall_ids = {"arena-bottom", "arena-right", "arena-top", "arena-left"};
+
+/// Reads one parsed document into a WorldDef, remembering where each ball came from so that a
+/// problem found later (by sim::validate) can be reported at its JSON path.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& reason) const {
+    throw WorldFileError(file_, path, reason);
+  }
+
+  sim::WorldDef read(const json& doc, std::string_view default_name);
+
+ private:
+  void expect_object(const json& v, const std::string& path, std::string_view what) const {
+    if (!v.is_object()) fail(path, std::string(what) + " must be a JSON object ({...}), got " + kind_of(v));
+  }
+  void expect_array(const json& v, const std::string& path, std::string_view what) const {
+    if (!v.is_array()) fail(path, std::string(what) + " must be a JSON array ([...]), got " + kind_of(v));
+  }
+
+  /// Rejects keys outside `known`, except private `x-` keys.
+  void check_keys(const json& obj, const std::string& path, std::string_view what,
+                  std::initializer_list<std::string_view> known) const {
+    for (const auto& [key, value] : obj.items()) {
+      if (key.starts_with("x-") || std::find(known.begin(), known.end(), key) != known.end()) continue;
+      std::string list, best;
+      std::size_t best_distance = 3;  // suggest only close misspellings
+      for (std::string_view k : known) {
+        list += (list.empty() ? "" : ", ") + std::string(k);
+        const std::size_t dist = edit_distance(key, k);
+        if (dist < best_distance) best_distance = dist, best = k;
+      }
+      std::string reason = "unknown key \"" + key + "\" in " + std::string(what);
+      if (!best.empty()) reason += "; did you mean \"" + best + "\"?";
+      reason += " (known keys: " + list + "; keys starting with x- are ignored)";
+      fail(at(path, key), reason);
+    }
+  }
+
+  const json* find(const json& obj, std::string_view key) const {
+    auto it = obj.find(key);
+    return it == obj.end() ? nullptr : &*it;
+  }
+  const json& require(const json& obj, const std::string& path, std::string_view key, std::string_view what) const {
+    if (const json* v = find(obj, key)) return *v;
+    fail(path, std::string(what) + " needs \"" + std::string(key) + "\"");
+  }
+
+  double number(const json& v, const std::string& path) const {
+    if (!v.is_number()) fail(path, "expected a number, got " + kind_of(v));
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) fail(path, "expected a finite number, got " + num(d));
+    return d;
+  }
+  double positive(const json& v, const std::string& path, std::string_view name) const {
+    const double d = number(v, path);
+    if (!(d > 0.0)) fail(path, std::string(name) + " must be > 0 (got " + num(d) + ")");
+    return d;
+  }
+  /// A non-negative integer; 1e6 is accepted as well as 1000000.
+  std::uint64_t natural(const json& v, const std::string& path) const {
+    if (v.is_number_unsigned()) return v.get<std::uint64_t>();
+    if (v.is_number_integer()) fail(path, "expected an integer >= 0, got " + std::to_string(v.get<std::int64_t>()));
+    if (v.is_number_float()) {
+      const double d = v.get<double>();
+      if (d >= 0.0 && d < 0x1.0p64 && std::floor(d) == d) return static_cast<std::uint64_t>(d);
+      fail(path, "expected an integer >= 0, got " + num(d));
+    }
+    fail(path, "expected an integer >= 0, got " + kind_of(v));
+  }
+  bool boolean(const json& v, const std::string& path) const {
+    if (!v.is_boolean()) fail(path, "expected true or false, got " + kind_of(v));
+    return v.get<bool>();
+  }
+  std::string string(const json& v, const std::string& path) const {
+    if (!v.is_string()) fail(path, "expected a string, got " + kind_of(v));
+    return v.get<std::string>();
+  }
+  Vec2 vec2(const json& v, const std::string& path) const {
+    if (!v.is_array()) fail(path, "expected [x, y] (an array of 2 numbers), got " + kind_of(v));
+    if (v.size() != 2) fail(path, "expected [x, y] (an array of 2 numbers), got an array of " + std::to_string(v.size()));
+    return {number(v[0], at(path, 0)), number(v[1], at(path, 1))};
+  }
+  std::string id(const json& obj, const std::string& path, std::string_view what) {
+    const std::string p = at(path, "id");
+    std::string s = string(require(obj, path, "id", what), p);
+    if (s.empty()) fail(p, "id must not be empty");
+    auto [it, fresh] = ids_.emplace(s, p);
+    if (!fresh) {
+      if (it->second.empty())
+        fail(p, "id \"" + s + "\" is taken by an arena wall of boundary \"walls\"; choose another id");
+      fail(p, "duplicate id \"" + s + "\" (already used at " + it->second + "); every wall and ball needs its own id");
+    }
+    return s;
+  }
+
+  void read_arena(const json& v, sim::ArenaDef& arena);
+  void read_effects(const json& v, sim::EffectsDef& effects);
+  void read_walls(const json& v, std::vector<sim::WallDef>& walls);
+  void read_balls(const json& v, std::vector<sim::BallDef>& balls);
+  std::vector<detail::GasSpec> read_gases(const json& v, const sim::WorldDef& def);
+  std::string path_of(const sim::DefProblem& p) const;
+  void check_gas_ids(const std::vector<detail::GasSpec>& gases) const;
+
+  std::string file_;
+  std::unordered_map<std::string, std::string> ids_;  // id -> JSON path of its "id" ("" for arena walls)
+  std::size_t explicit_balls_ = 0;
+  std::vector<std::size_t> gas_first_;  // index in WorldDef::balls of each gas entry's first ball
+};
+
+void Reader::read_arena(const json& v, sim::ArenaDef& arena) {
+  const std::string path = "/arena";
+  expect_object(v, path, "arena");
+  check_keys(v, path, "arena", {"width", "height", "cell", "boundary"});
+  if (const json* w = find(v, "width")) arena.width = positive(*w, at(path, "width"), "arena width");
+  if (const json* h = find(v, "height")) arena.height = positive(*h, at(path, "height"), "arena height");
+  if (const json* c = find(v, "cell")) arena.cell = positive(*c, at(path, "cell"), "arena cell");
+  if (const json* b = find(v, "boundary")) {
+    const std::string s = string(*b, at(path, "boundary"));
+    if (s == "none") arena.boundary = sim::Boundary::none;
+    else if (s == "walls") arena.boundary = sim::Boundary::walls;
+    else if (s == "periodic") arena.boundary = sim::Boundary::periodic;
+    else fail(at(path, "boundary"), "boundary must be \"none\", \"walls\" or \"periodic\" (got \"" + s + "\")");
+  }
+}
+
+void Reader::read_effects(const json& v, sim::EffectsDef& e) {
+  const std::string path = "/effects";
+  expect_object(v, path, "effects");
+  check_keys(v, path, "effects", {"gravity", "electric", "magnetic", "restitution", "ball_ball", "tc"});
+  if (const json* g = find(v, "gravity")) e.gravity = vec2(*g, at(path, "gravity"));
+  if (const json* el = find(v, "electric")) {
+    e.electric = vec2(*el, at(path, "electric"));
+    if (e.electric != Vec2{})
+      fail(at(path, "electric"), "effects.electric is not simulated yet (only gravity is); remove it or set it to [0, 0]");
+  }
+  if (const json* m = find(v, "magnetic")) {
+    e.magnetic = number(*m, at(path, "magnetic"));
+    if (e.magnetic != 0.0)
+      fail(at(path, "magnetic"), "effects.magnetic is not simulated yet (only gravity is); remove it or set it to 0");
+  }
+  if (const json* r = find(v, "restitution")) {
+    e.restitution = number(*r, at(path, "restitution"));
+    if (!(e.restitution >= 0.0 && e.restitution <= 1.0))
+      fail(at(path, "restitution"),
+           "restitution must be in [0, 1] (got " + num(e.restitution) + "); 1 is elastic, 0 perfectly inelastic");
+  }
+  if (const json* b = find(v, "ball_ball")) e.ball_ball = boolean(*b, at(path, "ball_ball"));
+  if (const json* t = find(v, "tc")) e.tc = positive(*t, at(path, "tc"), "tc");
+}
+
+void Reader::read_walls(const json& v, std::vector<sim::WallDef>& walls) {
+  const std::string path = "/walls";
+  expect_array(v, path, "walls");
+  walls.reserve(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::string p = at(path, i);
+    const json& w = v[i];
+    expect_object(w, p, "a wall");
+    check_keys(w, p, "a wall", {"id", "from", "to"});
+    sim::WallDef def;
+    def.id = id(w, p, "a wall");
+    def.from = vec2(require(w, p, "from", "a wall"), at(p, "from"));
+    def.to = vec2(require(w, p, "to", "a wall"), at(p, "to"));
+    walls.push_back(std::move(def));
+  }
+}
+
+void Reader::read_balls(const json& v, std::vector<sim::BallDef>& balls) {
+  const std::string path = "/balls";
+  expect_array(v, path, "balls");
+  balls.reserve(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::string p = at(path, i);
+    const json& b = v[i];
+    expect_object(b, p, "a ball");
+    check_keys(b, p, "a ball", {"id", "pos", "vel", "radius", "mass", "charge"});
+    sim::BallDef def;
+    def.id = id(b, p, "a ball");
+    def.pos = vec2(require(b, p, "pos", "a ball"), at(p, "pos"));
+    if (const json* x = find(b, "vel")) def.vel = vec2(*x, at(p, "vel"));
+    def.radius = positive(require(b, p, "radius", "a ball"), at(p, "radius"), "radius");
+    if (const json* x = find(b, "mass")) def.mass = positive(*x, at(p, "mass"), "mass");
+    if (const json* x = find(b, "charge")) def.charge = number(*x, at(p, "charge"));
+    balls.push_back(std::move(def));
+  }
+}
+
+std::vector<detail::GasSpec> Reader::read_gases(const json& v, const sim::WorldDef& def) {
+  const std::string path = "/gas";
+  expect_array(v, path, "gas");
+  std::vector<detail::GasSpec> out;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const std::string p = at(path, k);
+    const json& g = v[k];
+    expect_object(g, p, "a gas");
+    check_keys(g, p, "a gas", {"count", "radius", "mass", "speed", "region", "seed", "id_prefix"});
+    detail::GasSpec gas;
+    const std::uint64_t count = natural(require(g, p, "count", "a gas"), at(p, "count"));
+    constexpr std::uint64_t max_count = 100'000'000;
+    if (count > max_count)
+      fail(at(p, "count"), "count " + std::to_string(count) + " is more than this loader places (" +
+                               std::to_string(max_count) + "); split the gas or use fewer, larger balls");
+    gas.count = static_cast<std::size_t>(count);
+    gas.radius = positive(require(g, p, "radius", "a gas"), at(p, "radius"), "radius");
+    if (const json* x = find(g, "mass")) gas.mass = positive(*x, at(p, "mass"), "mass");
+    gas.speed = number(require(g, p, "speed", "a gas"), at(p, "speed"));
+    if (gas.speed < 0.0) fail(at(p, "speed"), "speed must be >= 0 (got " + num(gas.speed) + "); directions are random");
+    gas.lo = {0.0, 0.0};
+    gas.hi = {def.arena.width, def.arena.height};
+    if (const json* r = find(g, "region")) {
+      const std::string rp = at(p, "region");
+      const std::string shape = "expected [[x0, y0], [x1, y1]] (two corners), got ";
+      if (!r->is_array()) fail(rp, shape + kind_of(*r));
+      if (r->size() != 2) fail(rp, shape + "an array of " + std::to_string(r->size()));
+      gas.lo = vec2((*r)[0], at(rp, 0));
+      gas.hi = vec2((*r)[1], at(rp, 1));
+      if (!(gas.lo.x < gas.hi.x && gas.lo.y < gas.hi.y))
+        fail(rp, "region " + vec(gas.lo) + " to " + vec(gas.hi) +
+                     " is empty; give the lower-left corner first: [[x0, y0], [x1, y1]] with x0 < x1 and y0 < y1");
+    }
+    // Entry k defaults to the world seed + k, so two default gases do not repeat each other.
+    gas.seed = def.seed + k;
+    if (const json* s = find(g, "seed")) gas.seed = natural(*s, at(p, "seed"));
+    gas.id_prefix = k == 0 ? "g" : "g" + std::to_string(k) + "-";
+    if (const json* x = find(g, "id_prefix")) gas.id_prefix = string(*x, at(p, "id_prefix"));
+
+    Vec2 lo, hi;
+    detail::centre_range(gas, def.arena, lo, hi);
+    if (lo.x > hi.x || lo.y > hi.y)
+      fail(at(p, "region"), "balls of radius " + num(gas.radius) + " do not fit in region [" + vec(gas.lo) + ", " +
+                                vec(gas.hi) + "] inside the arena; enlarge the region or reduce radius");
+    out.push_back(std::move(gas));
+  }
+  return out;
+}
+
+/// The number n if `digits` is n written as place_gas writes it (decimal, no leading zero).
+std::optional<std::uint64_t> gas_number(std::string_view digits) {
+  if (digits.empty() || digits.size() > 18 || (digits.size() > 1 && digits[0] == '0')) return std::nullopt;
+  std::uint64_t n = 0;
+  for (char c : digits) {
+    if (c < '0' || c > '9') return std::nullopt;
+    n = n * 10 + static_cast<std::uint64_t>(c - '0');
+  }
+  return n;
+}
+
+void Reader::check_gas_ids(const std::vector<detail::GasSpec>& gases) const {
+  // Gas k's ids are id_prefix + n for n < count. One collides with an explicit id when that id is
+  // the prefix followed by such an n.
+  for (std::size_t k = 0; k < gases.size(); ++k) {
+    const detail::GasSpec& g = gases[k];
+    if (g.count == 0) continue;
+    for (const auto& [id, path] : ids_) {
+      if (!id.starts_with(g.id_prefix)) continue;
+      const auto n = gas_number(std::string_view(id).substr(g.id_prefix.size()));
+      if (!n || *n >= g.count) continue;
+      fail(at("/gas", k), "this gas's id \"" + id + "\" is already used " +
+                              (path.empty() ? std::string("by an arena wall") : "at " + path) +
+                              "; set an id_prefix that no other id starts with");
+    }
+  }
+  // Two gases collide when one prefix is the other followed by digits t, so that
+  // short + (t + m) == long + m; the smallest such number of the shorter one is t followed by 0.
+  for (std::size_t a = 0; a < gases.size(); ++a)
+    for (std::size_t b = 0; b < gases.size(); ++b) {
+      const detail::GasSpec &ga = gases[a], &gb = gases[b];
+      if (a == b || ga.count == 0 || gb.count == 0 || !gb.id_prefix.starts_with(ga.id_prefix)) continue;
+      if (ga.id_prefix == gb.id_prefix && a > b) continue;  // reported once, at the later gas
+      bool clash = ga.id_prefix == gb.id_prefix;
+      if (!clash) {
+        const auto t = gas_number(std::string_view(gb.id_prefix).substr(ga.id_prefix.size()));
+        clash = t && *t != 0 && *t * 10 < ga.count;
+      }
+      if (clash)
+        fail(at("/gas", std::max(a, b)), "the ids of gases " + std::to_string(std::min(a, b)) + " and " +
+                                             std::to_string(std::max(a, b)) + " (prefixes \"" + ga.id_prefix +
+                                             "\" and \"" + gb.id_prefix + "\") overlap; give each gas its own id_prefix");
+    }
+}
+
+std::string Reader::path_of(const sim::DefProblem& p) const {
+  using Where = sim::DefProblem::Where;
+  auto with_field = [&](std::string base) { return p.field.empty() ? base : at(base, p.field); };
+  switch (p.where) {
+    case Where::world: return p.field.empty() ? "" : at("", p.field);
+    case Where::arena: return with_field("/arena");
+    case Where::effects: return with_field("/effects");
+    case Where::wall: return with_field(at("/walls", p.index));
+    case Where::ball: {
+      if (p.index < explicit_balls_) return with_field(at("/balls", p.index));
+      const auto k = static_cast<std::size_t>(std::upper_bound(gas_first_.begin(), gas_first_.end(), p.index) -
+                                              gas_first_.begin()) - 1;
+      return at("/gas", k);
+    }
+    case Where::turtle: return with_field(at("/turtles", p.index));
+  }
+  return "";
+}
+
+sim::WorldDef Reader::read(const json& doc, std::string_view default_name) {
+  if (!doc.is_object()) fail("", "a world file must be a JSON object ({\"format\": \"turtlegas-world/1\", ...}), got " + kind_of(doc));
+  const json* format = find(doc, "format");
+  if (!format) fail("", "missing \"format\"; add \"format\": \"" + std::string(world_format) + "\" to the top-level object");
+  if (!format->is_string() || format->get<std::string>() != world_format)
+    fail("/format", "unsupported format " + format->dump() + "; this turtlegas reads \"" + std::string(world_format) + "\"");
+  for (std::string_view key : reserved_keys)
+    if (doc.contains(key))
+      fail(at("", key), "\"" + std::string(key) + "\" is not supported yet by this version of turtlegas; remove it (or rename it \"x-" +
+                            std::string(key) + "\" to keep it in the file)");
+  check_keys(doc, "", "the world", {"format", "name", "seed", "dt", "arena", "effects", "walls", "balls", "gas"});
+
+  sim::WorldDef def;
+  def.name = std::string(default_name);
+  if (const json* v = find(doc, "name")) def.name = string(*v, "/name");
+  if (const json* v = find(doc, "seed")) def.seed = natural(*v, "/seed");
+  if (const json* v = find(doc, "dt")) def.dt = positive(*v, "/dt", "dt");
+  if (const json* v = find(doc, "arena")) read_arena(*v, def.arena);
+  if (const json* v = find(doc, "effects")) read_effects(*v, def.effects);
+  if (def.arena.boundary == sim::Boundary::walls)
+    for (std::string_view id : arena_wall_ids) ids_.emplace(std::string(id), "");
+  if (const json* v = find(doc, "walls")) read_walls(*v, def.walls);
+  if (const json* v = find(doc, "balls")) read_balls(*v, def.balls);
+  explicit_balls_ = def.balls.size();
+
+  // The scene without its gases first: gases are placed around the walls and balls, which must
+  // therefore be sound.
+  if (auto problem = sim::validate(def)) fail(path_of(*problem), problem->message);
+
+  if (const json* v = find(doc, "gas")) {
+    const std::vector<detail::GasSpec> gases = read_gases(*v, def);
+    std::size_t total = def.balls.size();
+    for (const auto& g : gases) total += g.count;
+    def.balls.reserve(total);
+    for (std::size_t k = 0; k < gases.size(); ++k) {
+      const detail::GasSpec& gas = gases[k];
+      gas_first_.push_back(def.balls.size());
+      const std::size_t placed = detail::place_gas(def, gas);
+      if (placed < gas.count)
+        fail(at("/gas", k), "could only place " + std::to_string(placed) + " of " + std::to_string(gas.count) +
+                                " balls of radius " + num(gas.radius) + " in region [" + vec(gas.lo) + ", " +
+                                vec(gas.hi) + "]; enlarge the region or reduce count/radius");
+    }
+    // Gases are placed clear of everything (and World validates again when it is built), so only
+    // their generated ids remain to be checked; that needs only their prefixes, not a million strings.
+    check_gas_ids(gases);
+  }
+  return def;
+}
+
+/// Line and column (1-based, column in bytes) of the byte that nlohmann's parser stopped at.
+std::pair<std::size_t, std::size_t> line_and_column(std::string_view text, std::size_t byte) {
+  // nlohmann counts bytes from 1 and may point one past the end at end of input.
+  const std::size_t pos = std::min(byte == 0 ? 0 : byte - 1, text.size());
+  std::size_t line = 1, line_start = 0;
+  for (std::size_t i = 0; i < pos; ++i)
+    if (text[i] == '\n') ++line, line_start = i + 1;
+  return {line, pos - line_start + 1};
+}
+
+}  // namespace
+
+WorldFileError::WorldFileError(std::string file_, std::string json_path_, std::string reason_, std::size_t line_,
+                               std::size_t column_)
+    : std::runtime_error(prefix(file_, json_path_, reason_, line_, column_)),
+      file(std::move(file_)),
+      json_path(std::move(json_path_)),
+      reason(std::move(reason_)),
+      line(line_),
+      column(column_) {}
+
+sim::WorldDef parse_world(std::string_view text, std::string_view file_name) {
+  const std::string file(file_name);
+  json doc;
+  try {
+    doc = json::parse(text.begin(), text.end());
+  } catch (const json::parse_error& e) {
+    // nlohmann's message is "[json.exception.parse_error.101] parse error at line 3, column 5: what";
+    // keep only "what" and put the position in the usual FILE:LINE:COLUMN form.
+    std::string what = e.what();
+    const std::size_t head = what.find("parse error");
+    const std::size_t colon = head == std::string::npos ? std::string::npos : what.find(": ", head);
+    if (colon != std::string::npos) what = what.substr(colon + 2);
+    const auto [line, column] = line_and_column(text, e.byte);
+    throw WorldFileError(file, "", "invalid JSON: " + what, line, column);
+  } catch (const json::exception& e) {
+    // Number overflow ("1e999") and the like: no position, and no "[json.exception...] " tag.
+    std::string what = e.what();
+    if (what.starts_with("[json.exception") && what.find("] ") != std::string::npos) what.erase(0, what.find("] ") + 2);
+    throw WorldFileError(file, "", "invalid JSON: " + what);
+  }
+  std::string stem = std::filesystem::path(file).stem().string();
+  return Reader(file).read(doc, stem);
+}
+
+sim::WorldDef load_world_file(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) throw WorldFileError(file, "", "no such file; check the path");
+  if (std::filesystem::is_directory(status)) throw WorldFileError(file, "", "is a directory, not a world file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw WorldFileError(file, "", std::string("cannot open: ") + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw WorldFileError(file, "", std::string("cannot read: ") + std::strerror(errno));
+  return parse_world(text.str(), file);
+}
+
+}  // namespace turtlegas::world

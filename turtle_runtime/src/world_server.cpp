@@ -1,0 +1,443 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/turtle/world_server.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "fiber.hpp"
+
+namespace turtlegas::turtle {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+double wrap_degrees(double a) {
+  a = std::fmod(a, 360.0);
+  return a < 0 ? a + 360.0 : a;
+}
+
+// FNV-1a: a stable hash, so that per-turtle random streams do not depend on the library.
+std::uint64_t fnv1a(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::string kind_word(sim::EventKind k) {
+  switch (k) {
+    case sim::EventKind::turtle_wall: return "wall";
+    case sim::EventKind::turtle_wall_end: return "wall-end";
+    case sim::EventKind::turtle_turtle: return "turtle";
+    case sim::EventKind::turtle_ball: return "ball";
+    default: return "?";
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Sensors, registry, the script controller
+
+std::vector<SensorArc> default_sensors() {
+  return {{"front", -45, 45}, {"right", 45, 135}, {"back", 135, 225}, {"left", 225, 315}};
+}
+
+std::vector<SensorArc> equal_sensors(int n) {
+  if (n < 1) throw std::invalid_argument("a turtle needs at least one sensor (got " + std::to_string(n) + ")");
+  std::vector<SensorArc> arcs;
+  const double w = 360.0 / n;
+  for (int k = 0; k < n; ++k) arcs.push_back({"s" + std::to_string(k), k * w - w / 2, k * w + w / 2});
+  return arcs;
+}
+
+bool Touch::fired(const std::string& sensor_name) const {
+  for (std::size_t k = 0; k < sensors.size() && k < sensor_names.size(); ++k)
+    if (sensor_names[k] == sensor_name) return sensors[k];
+  return false;
+}
+
+bool Touch::any() const { return std::any_of(sensors.begin(), sensors.end(), [](bool b) { return b; }); }
+
+void Registry::add(std::string name, Controller controller, std::string summary) {
+  entries_[std::move(name)] = {std::move(controller), std::move(summary)};
+}
+
+const Controller* Registry::find(const std::string& name) const {
+  auto it = entries_.find(name);
+  return it == entries_.end() ? nullptr : &it->second.first;
+}
+
+std::vector<std::string> Registry::names() const {
+  std::vector<std::string> out;
+  for (const auto& [name, entry] : entries_) out.push_back(name);
+  return out;
+}
+
+const std::string& Registry::summary(const std::string& name) const {
+  static const std::string none;
+  auto it = entries_.find(name);
+  return it == entries_.end() ? none : it->second.second;
+}
+
+void script_controller(Turtle& t, const Params& p) {
+  const nlohmann::json& commands = p.json().contains("commands") ? p.json().at("commands") : nlohmann::json::array();
+  if (!commands.is_array()) throw std::invalid_argument("params.commands must be a list of [command, amount]");
+  for (std::size_t k = 0; k < commands.size(); ++k) {
+    const nlohmann::json& c = commands[k];
+    const std::string where = "params.commands[" + std::to_string(k) + "]";
+    if (!c.is_array() || c.empty() || !c[0].is_string())
+      throw std::invalid_argument(where + " must be [command, amount], e.g. [\"forward\", 100]");
+    const std::string name = c[0].get<std::string>();
+    if (name == "pendown") { t.pen_down(); continue; }
+    if (name == "penup") { t.pen_up(); continue; }
+    if (c.size() != 2 || !c[1].is_number())
+      throw std::invalid_argument(where + ": '" + name + "' needs one number, e.g. [\"" + name + "\", 100]");
+    const double amount = c[1].get<double>();
+    if (name == "forward") t.forward(amount);
+    else if (name == "back") t.back(amount);
+    else if (name == "left") t.left(amount);
+    else if (name == "right") t.right(amount);
+    else if (name == "wait") t.wait(amount);
+    else
+      throw std::invalid_argument(where + ": unknown command '" + name +
+                                  "'; known: forward, back, left, right, wait, pendown, penup");
+  }
+}
+
+Registry base_registry() {
+  Registry r;
+  r.add("script", script_controller, "runs params.commands, a fixed list of [command, amount]");
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Agents: the runtime's side of each turtle
+
+class Agent {
+ public:
+  WorldServer::Impl* server = nullptr;
+  std::size_t index = 0;
+  std::string id;
+  TurtleProgram program;
+  Controller controller;
+  Params params;
+  std::unique_ptr<detail::Fiber> fiber;
+  std::mt19937_64 rng;
+
+  // The handshake with the scheduler.
+  std::optional<sim::TurtleCommand> command;  // issued by the program, taken by the scheduler
+  std::vector<Touch> inbox;                   // touches to deliver when the program resumes
+  std::function<void(const Touch&)> handler;
+  std::vector<std::pair<sim::Vec2, Touch>> in_contact;  // world-frame normals of contacts in force
+
+  bool pen_down = false;
+  std::vector<sim::Vec2> trail;
+  double odometer = 0.0;
+  bool started = false;
+  bool finished = false;
+  std::string fault;
+
+  Result issue(sim::TurtleCommand c);
+  Touch make_touch(const sim::TurtleContact& c) const;
+};
+
+class WorldServer::Impl {
+ public:
+  sim::WorldDef def;
+  sim::World world;
+  ServerOptions options;
+  std::vector<std::unique_ptr<Agent>> agents;
+  std::vector<sim::Event> sim_log;
+  std::vector<LogEvent>* log = nullptr;
+  std::uint64_t step = 0;        // index of the next control boundary
+  bool boundary_done = false;    // whether the programs have run at boundary `step`
+
+  Impl(const sim::WorldDef& d, ServerOptions o) : def(d), world(d, o.mode), options(o) {}
+
+  double boundary_time(std::uint64_t k) const { return static_cast<double>(k) * def.dt; }
+  void control_step();
+  void run_program(Agent& a);
+  void drain_sim_events();
+  void emit(LogEvent e) {
+    if (log) log->push_back(std::move(e));
+  }
+  std::string other_id(sim::EventKind kind, std::uint32_t other) const {
+    switch (kind) {
+      case sim::EventKind::turtle_turtle: return def.turtles[other].id;
+      case sim::EventKind::turtle_ball: return def.balls[other].id;
+      default: return world.walls()[other].id;
+    }
+  }
+  std::vector<bool> sensors_for(const Agent& a, double bearing) const {
+    std::vector<bool> fired;
+    for (const SensorArc& s : a.program.sensors) {
+      const double span = s.to - s.from;
+      fired.push_back(wrap_degrees(bearing - s.from) < (span >= 360.0 ? 360.0 : wrap_degrees(span)));
+    }
+    return fired;
+  }
+};
+
+Touch Agent::make_touch(const sim::TurtleContact& c) const {
+  // The contact point lies against the normal (which points from the obstacle to the turtle).
+  const sim::Vec2 d = -c.normal;
+  const double heading_deg = server->world.turtle(index).heading / kDeg;
+  Touch t;
+  t.bearing = wrap_degrees(std::atan2(d.x, d.y) / kDeg - heading_deg);
+  t.sensors = server->sensors_for(*this, t.bearing);
+  for (const SensorArc& s : program.sensors) t.sensor_names.push_back(s.name);
+  t.what = server->other_id(c.kind, c.other);
+  t.kind = kind_word(c.kind);
+  t.t = c.t;
+  return t;
+}
+
+Result Agent::issue(sim::TurtleCommand c) {
+  if (detail::Fiber::current() != fiber.get())
+    throw std::logic_error("turtle '" + id + "': commands must be issued from its own program");
+  command = c;
+  fiber->suspend();
+  // Resumed by the scheduler: the command has ended. Interrupts first, then the answer.
+  const sim::TurtleState s = server->world.turtle(index);
+  std::optional<Touch> cut;
+  std::vector<Touch> delivered;
+  delivered.swap(inbox);
+  if (s.touched && !delivered.empty()) cut = delivered.front();
+  if (c.kind == sim::TurtleCommand::Kind::move) odometer += s.done;
+  if (pen_down) trail.push_back(s.pos);
+  if (handler)
+    for (const Touch& t : delivered) handler(t);
+  const double done = c.kind == sim::TurtleCommand::Kind::turn ? s.done / kDeg : s.done;
+  return Result(done, std::move(cut));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The controller API
+
+Result Turtle::forward(double distance) { return agent_->issue({sim::TurtleCommand::Kind::move, distance}); }
+Result Turtle::back(double distance) { return agent_->issue({sim::TurtleCommand::Kind::move, -distance}); }
+Result Turtle::right(double degrees) { return agent_->issue({sim::TurtleCommand::Kind::turn, degrees * kDeg}); }
+Result Turtle::left(double degrees) { return agent_->issue({sim::TurtleCommand::Kind::turn, -degrees * kDeg}); }
+Result Turtle::wait(double seconds) { return agent_->issue({sim::TurtleCommand::Kind::wait, seconds}); }
+void Turtle::yield() { agent_->issue({sim::TurtleCommand::Kind::stop, 0.0}); }
+void Turtle::pen_up() { agent_->pen_down = false; }
+void Turtle::pen_down() {
+  if (!agent_->pen_down) agent_->trail.push_back(agent_->server->world.turtle(agent_->index).pos);
+  agent_->pen_down = true;
+}
+bool Turtle::pen_is_down() const { return agent_->pen_down; }
+void Turtle::on_touch(std::function<void(const Touch&)> handler) { agent_->handler = std::move(handler); }
+double Turtle::odometer() const { return agent_->odometer; }
+double Turtle::heading() const { return wrap_degrees(agent_->server->world.turtle(agent_->index).heading / kDeg); }
+std::optional<sim::Vec2> Turtle::position() const {
+  if (!agent_->program.gps) return std::nullopt;
+  return agent_->server->world.turtle(agent_->index).pos;
+}
+double Turtle::time() const { return agent_->server->world.time(); }
+const std::string& Turtle::id() const { return agent_->id; }
+double Turtle::uniform() { return static_cast<double>(agent_->rng() >> 11) * 0x1.0p-53; }
+void Turtle::log(const std::string& message) { spdlog::info("turtle '{}' t={:.6g}: {}", agent_->id, time(), message); }
+
+std::vector<Touch> Turtle::touching() const {
+  // Contacts in force, with their sensors worked out for the heading the turtle has now.
+  std::vector<Touch> out;
+  const double heading_deg = agent_->server->world.turtle(agent_->index).heading / kDeg;
+  for (const auto& [normal, touch] : agent_->in_contact) {
+    Touch t = touch;
+    const sim::Vec2 d = -normal;
+    t.bearing = wrap_degrees(std::atan2(d.x, d.y) / kDeg - heading_deg);
+    t.sensors = agent_->server->sensors_for(*agent_, t.bearing);
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The scheduler
+
+WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> programs, const Registry& registry,
+                         ServerOptions options)
+    : impl_(std::make_unique<Impl>(def, options)) {
+  if (programs.size() != def.turtles.size())
+    throw std::invalid_argument("WorldServer: " + std::to_string(programs.size()) + " programs for " +
+                                std::to_string(def.turtles.size()) + " turtles");
+  for (std::size_t k = 0; k < programs.size(); ++k) {
+    auto a = std::make_unique<Agent>();
+    a->server = impl_.get();
+    a->index = k;
+    a->id = def.turtles[k].id;
+    a->program = std::move(programs[k]);
+    const Controller* c = registry.find(a->program.controller);
+    if (!c) {
+      std::string known;
+      for (const auto& n : registry.names()) known += (known.empty() ? "" : ", ") + n;
+      throw std::invalid_argument("turtle '" + a->id + "': controller '" + a->program.controller +
+                                  "' is not registered; known: " + known);
+    }
+    if (a->program.sensors.empty()) throw std::invalid_argument("turtle '" + a->id + "' has no sensors");
+    a->controller = *c;
+    a->params = Params(a->program.params);
+    a->pen_down = a->program.pen_down;
+    if (a->pen_down) a->trail.push_back(def.turtles[k].pos);
+    a->rng.seed(def.seed ^ fnv1a(a->id));
+    impl_->agents.push_back(std::move(a));
+  }
+  impl_->world.set_event_log(&impl_->sim_log);
+}
+
+WorldServer::~WorldServer() = default;
+
+void WorldServer::Impl::run_program(Agent& a) {
+  if (!a.started) {
+    a.started = true;
+    Agent* agent = &a;
+    a.fiber = std::make_unique<detail::Fiber>(
+        [agent] {
+          Turtle t(*agent);
+          agent->controller(t, agent->params);
+        },
+        options.stack_bytes);
+  }
+  const auto outcome = a.fiber->resume(options.program_budget);
+  const double now = world.time();
+  auto park = [&](const std::string& fault) {
+    a.finished = true;
+    a.fault = fault;
+    world.command_turtle(a.index, {sim::TurtleCommand::Kind::stop, 0.0});
+    if (!fault.empty()) {
+      spdlog::error("turtle '{}' stopped at t={:.6g}: {}", a.id, now, fault);
+      emit({now, "fault", a.id, {}, {}, 0.0, fault});
+    }
+  };
+  switch (outcome) {
+    case detail::Fiber::Outcome::suspended:
+      if (a.command) {
+        world.command_turtle(a.index, *a.command);
+        if (a.command->kind == sim::TurtleCommand::Kind::move && a.command->amount != 0.0) a.in_contact.clear();
+        a.command.reset();
+      }
+      return;
+    case detail::Fiber::Outcome::finished:
+      if (auto err = a.fiber->error()) {
+        std::string what = "its program threw a non-standard exception";
+        try {
+          std::rethrow_exception(err);
+        } catch (const std::exception& e) {
+          what = std::string("its program threw: ") + e.what();
+        } catch (...) {
+        }
+        park(what);
+      } else {
+        park({});  // the program returned: the turtle stays parked where it is
+      }
+      return;
+    case detail::Fiber::Outcome::stack_overflow:
+      park("its program overflowed its stack (" + std::to_string(options.stack_bytes / 1024) +
+           " KiB); deep recursion or large locals? raise the stack size with --stack-kib");
+      return;
+    case detail::Fiber::Outcome::over_budget:
+      a.finished = true;
+      a.fault = "busy loop";
+      throw BusyLoopError("turtle '" + a.id + "': its program ran for more than " +
+                          std::to_string(options.program_budget) +
+                          " s of wall time without issuing a command (a busy loop?); the run stops at t=" +
+                          std::to_string(now));
+  }
+}
+
+void WorldServer::Impl::control_step() {
+  // 1. Contacts of the previous step become interrupts.
+  const double now = world.time();
+  for (const sim::TurtleContact& c : world.take_turtle_contacts()) {
+    Agent& a = *agents[c.turtle];
+    Touch t = a.make_touch(c);
+    LogEvent e{now, "touch", a.id, t.what, {}, t.bearing, {}};
+    for (std::size_t k = 0; k < t.sensors.size(); ++k)
+      if (t.sensors[k]) e.sensors.push_back(a.program.sensors[k].name);
+    emit(std::move(e));
+    a.in_contact.emplace_back(c.normal, t);
+    if (!a.finished) a.inbox.push_back(std::move(t));
+  }
+  // 2. Programs, in world-file order, each until its next command.
+  for (auto& ap : agents) {
+    Agent& a = *ap;
+    if (a.finished) continue;
+    if (a.started && world.turtle(a.index).busy) continue;
+    run_program(a);
+  }
+}
+
+void WorldServer::Impl::drain_sim_events() {
+  if (log)
+    for (const sim::Event& e : sim_log) {
+      LogEvent out{e.t, std::string(sim::to_string(e.kind)), {}, {}, {}, 0.0, {}};
+      switch (e.kind) {
+        case sim::EventKind::ball_ball:
+          out.a = def.balls[e.a].id;
+          out.b = def.balls[e.b].id;
+          break;
+        case sim::EventKind::ball_wall:
+        case sim::EventKind::ball_wall_end:
+          out.a = def.balls[e.a].id;
+          out.b = world.walls()[e.b].id;
+          break;
+        case sim::EventKind::exit: out.a = e.b == 1 ? def.turtles[e.a].id : def.balls[e.a].id; break;
+        default:
+          out.a = def.turtles[e.a].id;
+          out.b = other_id(e.kind, e.b);
+      }
+      emit(std::move(out));
+    }
+  sim_log.clear();
+}
+
+void WorldServer::run_until(double t) {
+  Impl& s = *impl_;
+  for (;;) {
+    if (!s.boundary_done) {
+      s.control_step();
+      s.boundary_done = true;
+    }
+    const double next = s.boundary_time(s.step + 1);
+    if (next <= t) {
+      s.world.advance_to(next);
+      s.drain_sim_events();
+      ++s.step;
+      s.boundary_done = false;
+      continue;
+    }
+    if (t > s.world.time()) s.world.advance_to(t);
+    s.drain_sim_events();
+    return;
+  }
+}
+
+double WorldServer::time() const { return impl_->world.time(); }
+const sim::World& WorldServer::world() const { return impl_->world; }
+void WorldServer::set_event_log(std::vector<LogEvent>* log) { impl_->log = log; }
+std::size_t WorldServer::turtle_count() const { return impl_->agents.size(); }
+
+WorldServer::TurtleInfo WorldServer::turtle(std::size_t i) const {
+  const Agent& a = *impl_->agents[i];
+  TurtleInfo info{a.id, impl_->world.turtle(i), a.pen_down, a.finished, a.fault, a.trail};
+  if (a.pen_down) info.trail.push_back(info.state.pos);
+  return info;
+}
+
+std::size_t WorldServer::stack_reservation() const {
+  for (const auto& a : impl_->agents)
+    if (a->fiber) return a->fiber->reserved_bytes();
+  return 0;
+}
+
+}  // namespace turtlegas::turtle
