@@ -27,23 +27,6 @@ bool segment_meets_box(Vec2 p, Vec2 q, double x0, double y0, double x1, double y
   return true;
 }
 
-// Turns (cell, item) pairs into compressed rows: start offsets per cell plus the items, sorted and
-// without repeats. Two passes over the pairs, no per-cell containers, so empty cells cost 4 bytes.
-template <class T>
-void compress(std::size_t cells, std::vector<std::pair<std::uint32_t, T>>& pairs,
-              std::vector<std::uint32_t>& start, std::vector<T>& items) {
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  start.assign(cells + 1, 0);
-  for (const auto& pr : pairs) ++start[pr.first + 1];
-  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
-  items.clear();
-  items.reserve(pairs.size());
-  for (const auto& pr : pairs) items.push_back(pr.second);
-  pairs.clear();
-  pairs.shrink_to_fit();
-}
-
 }  // namespace
 
 CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
@@ -59,6 +42,7 @@ CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
     for (int sx = 0; sx < 3; ++sx) shifts_[sy * 3 + sx] = {(sx - 1) * width, (sy - 1) * height};
 
   const auto n = static_cast<std::size_t>(cell_count());
+  (void)n;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> wl, el;
   // A little slack so that a wall running exactly along a grid line is listed on both sides.
   const double sx = 1e-9 * cw_, sy = 1e-9 * ch_;
@@ -106,10 +90,40 @@ CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
   };
   spread(wl, nw);
   spread(el, ne);
-  compress(n, wl, wall_start_, wall_items_);
-  compress(n, el, end_start_, end_items_);
-  compress(n, nw, near_wall_start_, near_walls_);
-  compress(n, ne, near_end_start_, near_ends_);
+  slot_.assign(n, 0);
+  records_.assign(1, Ranges{});
+  store(wl, wall_items_, &Ranges::walls);
+  store(el, end_items_, &Ranges::ends);
+  store(nw, near_walls_, &Ranges::near_walls);
+  store(ne, near_ends_, &Ranges::near_ends);
+}
+
+CellGrid::Ranges& CellGrid::record_for(std::uint32_t cell) {
+  if (slot_[cell] == 0) {
+    slot_[cell] = static_cast<std::uint32_t>(records_.size());
+    records_.emplace_back();
+  }
+  return records_[slot_[cell]];
+}
+
+// Sorts (cell, item) pairs, drops repeats and lays them out as one contiguous range per cell.
+template <class T>
+void CellGrid::store(std::vector<std::pair<std::uint32_t, T>>& pairs, std::vector<T>& items,
+                     std::uint32_t (Ranges::*range)[2]) {
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  items.clear();
+  items.reserve(pairs.size());
+  for (std::size_t k = 0; k < pairs.size();) {
+    const std::uint32_t cell = pairs[k].first;
+    const auto first = static_cast<std::uint32_t>(items.size());
+    for (; k < pairs.size() && pairs[k].first == cell; ++k) items.push_back(pairs[k].second);
+    Ranges& r = record_for(cell);
+    (r.*range)[0] = first;
+    (r.*range)[1] = static_cast<std::uint32_t>(items.size());
+  }
+  pairs.clear();
+  pairs.shrink_to_fit();
 }
 
 int CellGrid::arena_cell_of(Vec2 p) const {
@@ -137,9 +151,8 @@ std::uint32_t CellGrid::shift_index(Vec2 s) const {
 }
 
 std::size_t CellGrid::memory_bytes() const {
-  return sizeof(std::uint32_t) * (wall_start_.capacity() + wall_items_.capacity() + end_start_.capacity() +
-                                  end_items_.capacity() + near_wall_start_.capacity() + near_end_start_.capacity()) +
-         sizeof(Near) * (near_walls_.capacity() + near_ends_.capacity());
+  return sizeof(std::uint32_t) * (slot_.capacity() + wall_items_.capacity() + end_items_.capacity()) +
+         sizeof(Ranges) * records_.capacity() + sizeof(Near) * (near_walls_.capacity() + near_ends_.capacity());
 }
 
 }  // namespace turtlegas::sim::detail

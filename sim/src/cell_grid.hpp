@@ -55,10 +55,10 @@ class CellGrid {
   Neighbour neighbour(int ix, int iy, int dx, int dy) const;
 
   /// Walls passing through a cell, and wall ends inside it.
-  const std::uint32_t* walls_begin(int cell) const { return wall_items_.data() + wall_start_[cell]; }
-  const std::uint32_t* walls_end(int cell) const { return wall_items_.data() + wall_start_[cell + 1]; }
-  const std::uint32_t* ends_begin(int cell) const { return end_items_.data() + end_start_[cell]; }
-  const std::uint32_t* ends_end(int cell) const { return end_items_.data() + end_start_[cell + 1]; }
+  const std::uint32_t* walls_begin(int cell) const { return wall_items_.data() + ranges(cell).walls[0]; }
+  const std::uint32_t* walls_end(int cell) const { return wall_items_.data() + ranges(cell).walls[1]; }
+  const std::uint32_t* ends_begin(int cell) const { return end_items_.data() + ranges(cell).ends[0]; }
+  const std::uint32_t* ends_end(int cell) const { return end_items_.data() + ranges(cell).ends[1]; }
 
   /// Walls and ends within the 3x3 neighbourhood of an arena cell, each listed once with the
   /// shift (index into shifts()) under which it is seen; built for exact mode's full rescans.
@@ -67,10 +67,10 @@ class CellGrid {
     std::uint32_t shift;
     friend auto operator<=>(const Near&, const Near&) = default;
   };
-  const Near* near_walls_begin(int cell) const { return near_walls_.data() + near_wall_start_[cell]; }
-  const Near* near_walls_end(int cell) const { return near_walls_.data() + near_wall_start_[cell + 1]; }
-  const Near* near_ends_begin(int cell) const { return near_ends_.data() + near_end_start_[cell]; }
-  const Near* near_ends_end(int cell) const { return near_ends_.data() + near_end_start_[cell + 1]; }
+  const Near* near_walls_begin(int cell) const { return near_walls_.data() + ranges(cell).near_walls[0]; }
+  const Near* near_walls_end(int cell) const { return near_walls_.data() + ranges(cell).near_walls[1]; }
+  const Near* near_ends_begin(int cell) const { return near_ends_.data() + ranges(cell).near_ends[0]; }
+  const Near* near_ends_end(int cell) const { return near_ends_.data() + ranges(cell).near_ends[1]; }
   Vec2 shift(std::uint32_t k) const { return shifts_[k]; }
   std::uint32_t shift_index(Vec2 s) const;
 
@@ -80,8 +80,23 @@ class CellGrid {
   int nx_ = 1, ny_ = 1;
   double cw_ = 1.0, ch_ = 1.0, width_ = 1.0, height_ = 1.0;
   bool periodic_ = false;
-  std::vector<std::uint32_t> wall_start_, wall_items_, end_start_, end_items_;
-  std::vector<std::uint32_t> near_wall_start_, near_end_start_;
+  // Most cells are far from every wall, so the lists are stored sparsely: each cell holds the
+  // index of its record of ranges, and record 0 (all ranges empty) serves every cell without walls.
+  // That keeps the table at 4 bytes per cell.
+  struct Ranges {
+    std::uint32_t walls[2] = {0, 0};
+    std::uint32_t ends[2] = {0, 0};
+    std::uint32_t near_walls[2] = {0, 0};
+    std::uint32_t near_ends[2] = {0, 0};
+  };
+  const Ranges& ranges(int cell) const { return records_[slot_[static_cast<std::size_t>(cell)]]; }
+  Ranges& record_for(std::uint32_t cell);
+  template <class T>
+  void store(std::vector<std::pair<std::uint32_t, T>>& pairs, std::vector<T>& items, std::uint32_t (Ranges::*range)[2]);
+
+  std::vector<std::uint32_t> slot_;
+  std::vector<Ranges> records_;
+  std::vector<std::uint32_t> wall_items_, end_items_;
   std::vector<Near> near_walls_, near_ends_;
   Vec2 shifts_[9];
 };

@@ -327,7 +327,7 @@ Engine<Flight, kBallBall, kStep, kTurtles>::Engine(const WorldDef& def, Mode) {
   }
   // Cell size. Exact mode needs cells at least a diameter wide so that touching bodies are always
   // in neighbouring cells; step mode needs the memo's rule: a cell wider than any two bodies' radii
-  // plus their paths in one step. Beyond that, aim for about two balls per cell.
+  // plus their paths in one step.
   const double area = width_ * height_;
   const double rule = kStep ? 2.0 * (rmax_ + vmax * dt_) : 2.0 * rmax_;
   double cell = 0.0;
@@ -342,7 +342,9 @@ Engine<Flight, kBallBall, kStep, kTurtles>::Engine(const WorldDef& def, Mode) {
       throw std::invalid_argument("arena.cell " + std::to_string(cell) + " is too small: " + why);
     }
   } else {
-    const double density_cell = n > 0 ? std::sqrt(2.0 * area / static_cast<double>(n)) : std::max(width_, height_) / 16.0;
+    // About 0.3 balls per cell: measured fastest in exact mode from area fraction 0.05 to 0.3
+    // (fewer balls per cell means fewer candidates per prediction but more cell crossings).
+    const double density_cell = n > 0 ? std::sqrt(0.3 * area / static_cast<double>(n)) : std::max(width_, height_) / 16.0;
     cell = std::max(rule * (1.0 + 1e-9), density_cell);
     cell = std::max(cell, std::sqrt(area / 4.0e7));  // keep the table under ~4e7 cells
     // A periodic arena needs three cells across, so that no pair is seen through two images.
@@ -1023,9 +1025,9 @@ double Engine<Flight, kBallBall, kStep, kTurtles>::rebase() {
     r.t_start -= shift;
     r.t_end -= shift;
   }
-  heap_.shift_keys(shift);
   t_base_ += shift;
   now_ = 0.0;
+  heap_.shift_keys(shift);
   return shift;
 }
 
