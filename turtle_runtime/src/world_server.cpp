@@ -61,12 +61,11 @@ std::vector<SensorArc> equal_sensors(int n) {
 }
 
 bool Touch::fired(const std::string& sensor_name) const {
-  for (std::size_t k = 0; k < sensors.size() && k < sensor_names.size(); ++k)
-    if (sensor_names[k] == sensor_name) return sensors[k];
+  if (!sensor_names) return false;
+  for (std::size_t k = 0; k < sensor_names->size(); ++k)
+    if ((*sensor_names)[k] == sensor_name) return fired(k);
   return false;
 }
-
-bool Touch::any() const { return std::any_of(sensors.begin(), sensors.end(), [](bool b) { return b; }); }
 
 void Registry::add(std::string name, Controller controller, std::string summary) {
   entries_[std::move(name)] = {std::move(controller), std::move(summary)};
@@ -139,6 +138,7 @@ class Agent {
   std::vector<Touch> inbox;                   // touches to deliver when the program resumes
   std::function<void(const Touch&)> handler;
   std::vector<std::pair<sim::Vec2, Touch>> in_contact;  // world-frame normals of contacts in force
+  std::vector<std::string> sensor_names;                  // what Touch::sensor_names points to
 
   bool pen_down = false;
   std::vector<sim::Vec2> trail;
@@ -178,15 +178,18 @@ class WorldServer::Impl {
       default: return world.walls()[other].id;
     }
   }
-  std::vector<bool> sensors_for(const Agent& a, double bearing) const {
-    std::vector<bool> fired;
-    for (const SensorArc& s : a.program.sensors) {
-      const double span = s.to - s.from;
-      fired.push_back(wrap_degrees(bearing - s.from) < (span >= 360.0 ? 360.0 : wrap_degrees(span)));
-    }
-    return fired;
-  }
+  std::uint64_t sensors_for(const Agent& a, double bearing) const;
 };
+
+std::uint64_t WorldServer::Impl::sensors_for(const Agent& a, double bearing) const {
+  std::uint64_t fired = 0;
+  for (std::size_t k = 0; k < a.program.sensors.size(); ++k) {
+    const SensorArc& s = a.program.sensors[k];
+    const double span = s.to - s.from;
+    if (wrap_degrees(bearing - s.from) < (span >= 360.0 ? 360.0 : wrap_degrees(span))) fired |= std::uint64_t{1} << k;
+  }
+  return fired;
+}
 
 Touch Agent::make_touch(const sim::TurtleContact& c) const {
   // The contact point lies against the normal (which points from the obstacle to the turtle).
@@ -195,7 +198,7 @@ Touch Agent::make_touch(const sim::TurtleContact& c) const {
   Touch t;
   t.bearing = wrap_degrees(std::atan2(d.x, d.y) / kDeg - heading_deg);
   t.sensors = server->sensors_for(*this, t.bearing);
-  for (const SensorArc& s : program.sensors) t.sensor_names.push_back(s.name);
+  t.sensor_names = &sensor_names;
   t.what = server->other_id(c.kind, c.other);
   t.kind = kind_word(c.kind);
   t.t = c.t;
@@ -284,7 +287,10 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
       throw std::invalid_argument("turtle '" + a->id + "': controller '" + a->program.controller +
                                   "' is not registered; known: " + known);
     }
-    if (a->program.sensors.empty()) throw std::invalid_argument("turtle '" + a->id + "' has no sensors");
+    if (a->program.sensors.empty() || a->program.sensors.size() > 64)
+      throw std::invalid_argument("turtle '" + a->id + "' needs 1 to 64 sensors (has " +
+                                  std::to_string(a->program.sensors.size()) + ")");
+    for (const SensorArc& arc : a->program.sensors) a->sensor_names.push_back(arc.name);
     a->controller = *c;
     a->params = Params(a->program.params);
     a->pen_down = a->program.pen_down;
@@ -362,8 +368,8 @@ void WorldServer::Impl::control_step() {
     Agent& a = *agents[c.turtle];
     Touch t = a.make_touch(c);
     LogEvent e{now, "touch", a.id, t.what, {}, t.bearing, {}};
-    for (std::size_t k = 0; k < t.sensors.size(); ++k)
-      if (t.sensors[k]) e.sensors.push_back(a.program.sensors[k].name);
+    for (std::size_t k = 0; k < a.program.sensors.size(); ++k)
+      if (t.fired(k)) e.sensors.push_back(a.program.sensors[k].name);
     emit(std::move(e));
     a.in_contact.emplace_back(c.normal, t);
     if (!a.finished) a.inbox.push_back(std::move(t));

@@ -58,8 +58,8 @@ class Params {
 
 /// One touch: which sensors fired, where the contact was and what was touched.
 struct Touch {
-  std::vector<bool> sensors;  ///< one flag per sensor, in the turtle's sensor order
-  std::vector<std::string> sensor_names;
+  std::uint64_t sensors = 0;  ///< bit k set: sensor k fired (the turtle's sensor order, at most 64)
+  const std::vector<std::string>* sensor_names = nullptr;  ///< the turtle's sensor names; owned by the runtime
   double bearing = 0.0;       ///< degrees clockwise from the heading to the contact point, [0, 360)
   std::string what;           ///< id of the wall, ball or turtle touched
   std::string kind;           ///< "wall", "wall-end", "turtle" or "ball"
@@ -69,8 +69,9 @@ struct Touch {
   bool right() const { return fired("right"); }
   bool back() const { return fired("back"); }
   bool left() const { return fired("left"); }
+  bool fired(std::size_t sensor) const { return sensor < 64 && ((sensors >> sensor) & 1u) != 0; }
   bool fired(const std::string& sensor_name) const;
-  bool any() const;
+  bool any() const { return sensors != 0; }
 };
 
 /// What a command did.
