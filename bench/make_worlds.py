@@ -1,0 +1,69 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Writes the benchmark scenes worlds/bench/gas_N<n>_phi<f>.json.
+
+A random gas in a square box with four walls: N discs of radius 0.5, mass 1 and speed 3 in random
+directions, at area fraction phi, so the box side is sqrt(N * pi * r^2 / phi). The files are data
+shared with other engines' benchmarks; rerun this script only to change the scene set.
+
+    python3 bench/make_worlds.py [OUT_DIR]
+"""
+
+import json
+import math
+import pathlib
+import re
+import sys
+
+RADIUS = 0.5
+SPEED = 3.0
+SEED = 272
+DT = 1.0 / 30.0  # the memo's step: moves a ball 0.1 per step, so the memo's rule asks for cells > 1.2
+COUNTS = [("1e3", 1_000), ("1e4", 10_000), ("1e5", 100_000), ("1e6", 1_000_000)]
+FRACTIONS = [("0p05", 0.05), ("0p30", 0.30)]
+
+
+def scene(count: int, phi: float) -> dict:
+    side = math.sqrt(count * math.pi * RADIUS * RADIUS / phi)
+    return {
+        "format": "turtlegas-world/1",
+        "name": f"gas benchmark N={count} phi={phi:g}",
+        "x-about": (
+            f"{count} discs of radius {RADIUS:g} and speed {SPEED:g} in random directions in a square "
+            f"box with walls at area fraction {phi:g} (side sqrt(N pi r^2 / phi)). "
+            "Written by bench/make_worlds.py; run by bench/gas_bench (docs/performance.md)."
+        ),
+        "seed": SEED,
+        "dt": DT,
+        "arena": {"width": side, "height": side, "boundary": "walls"},
+        "gas": [
+            {
+                "count": count,
+                "radius": RADIUS,
+                "mass": 1,
+                "speed": SPEED,
+                "region": [[0, 0], [side, side]],
+                "seed": SEED,
+            }
+        ],
+    }
+
+
+def main() -> None:
+    root = pathlib.Path(__file__).resolve().parent.parent
+    out = pathlib.Path(sys.argv[1]) if len(sys.argv) > 1 else root / "worlds" / "bench"
+    out.mkdir(parents=True, exist_ok=True)
+    for count_name, count in COUNTS:
+        for phi_name, phi in FRACTIONS:
+            path = out / f"gas_N{count_name}_phi{phi_name}.json"
+            # repr-exact doubles: the side must give exactly this phi in every engine that reads it.
+            text = json.dumps(scene(count, phi), indent=2)
+            # Number pairs on one line: [[0, 0], [side, side]] reads better than eight lines.
+            text = re.sub(r"\[\s*([-\d.e+]+),\s*([-\d.e+]+)\s*\]", r"[\1, \2]", text)
+            text = re.sub(r"\[\s*(\[[^\[\]]*\]),\s*(\[[^\[\]]*\])\s*\]", r"[\1, \2]", text)
+            path.write_text(text + "\n")
+            print(path)
+
+
+if __name__ == "__main__":
+    main()

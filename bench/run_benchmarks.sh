@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+#
+# Builds gas_bench (Release, build-bench/), runs every worlds/bench/*.json scene in exact and step
+# mode, each run in its own process, writes the JSON lines to docs/bench/results-DATE-HOST-COMMIT.jsonl and
+# regenerates the tables and the plot in docs/performance.md.
+#
+#   bash bench/run_benchmarks.sh           # the full set, 3-5 minutes on 2 cores
+#   bash bench/run_benchmarks.sh --quick   # small budgets, to check the script; leaves docs/ alone
+#
+# Extra gas_bench options for every run can be given in GAS_BENCH_ARGS (e.g. "--max-wall 120").
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build=${BUILD_DIR:-$root/build-bench}
+quick=0
+if [[ ${1:-} == --quick ]]; then quick=1; fi
+
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DBUILD_TESTING=OFF > /dev/null
+cmake --build "$build" --target gas_bench
+bench=$build/bench/gas_bench
+
+stamp=$(date -u +%Y-%m-%d)
+host=$(hostname -s 2>/dev/null || echo host)
+commit=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
+if (( quick )); then
+  out_dir=$build/quick
+  exact_budget=(--collisions 2e5)
+  step_budget=(--ball-steps 2e6)
+else
+  out_dir=$root/docs/bench
+  exact_budget=()  # gas_bench's defaults: max(5e6, 10 N) collisions
+  step_budget=()   # and max(1e7, 10 N) ball-steps
+fi
+mkdir -p "$out_dir"
+results=$out_dir/results-$stamp-$host-$commit.jsonl
+machine=$out_dir/results-$stamp-$host-$commit.machine.json
+tmp=$(mktemp)
+trap 'rm -f "$tmp"' EXIT
+
+compiler=$(grep '^CMAKE_CXX_COMPILER:' "$build/CMakeCache.txt" | cut -d= -f2)
+flags=$(grep '^CMAKE_CXX_FLAGS_RELEASE:' "$build/CMakeCache.txt" | cut -d= -f2)
+dirty=$( (git -C "$root" status --porcelain -- sim turtle_runtime bench 2>/dev/null || true) | wc -l)
+CPU=$(lscpu | sed -n 's/^Model name: *//p' | head -1) \
+CORES=$(nproc) \
+COMPILER=$("$compiler" --version | head -1) \
+FLAGS="Release ($flags -ffp-contract=off)" \
+KERNEL=$(uname -sr) \
+COMMIT="$commit$( (( dirty )) && echo " + uncommitted changes in $dirty files of sim/, turtle_runtime/, bench/")" \
+DATE=$(date -u '+%Y-%m-%d %H:%M') \
+LOADAVG=$(cut -d' ' -f1-3 /proc/loadavg) \
+python3 -c 'import json, os; print(json.dumps({k.lower(): os.environ[k] for k in
+  ["CPU", "CORES", "COMPILER", "FLAGS", "KERNEL", "COMMIT", "DATE", "LOADAVG"]}, indent=2))' > "$machine"
+
+# One line per run on stderr while the set runs.
+progress='import json, sys
+r = json.loads(sys.stdin.read())
+print("%7.2f s  %6.3f M coll/s  %7.3f M ball-steps/s  %6.0f B/ball" % (r["wall_seconds"],
+      r["collisions_per_second"] / 1e6, r["ball_steps_per_second"] / 1e6, r["bytes_per_ball"]))'
+
+start=$SECONDS
+for world in "$root"/worlds/bench/gas_*.json; do
+  for mode in exact step; do
+    if [[ $mode == exact ]]; then budget=("${exact_budget[@]}"); else budget=("${step_budget[@]}"); fi
+    printf '%-28s %-5s ' "$(basename "$world" .json)" "$mode" >&2
+    # shellcheck disable=SC2086  # GAS_BENCH_ARGS is a list of options
+    "$bench" "$world" --mode "$mode" "${budget[@]}" ${GAS_BENCH_ARGS:-} >> "$tmp"
+    tail -n 1 "$tmp" | python3 -c "$progress" >&2
+  done
+done
+mv "$tmp" "$results"
+trap - EXIT
+echo "$(( SECONDS - start )) s; results in $results" >&2
+
+if (( quick )); then
+  python3 "$root/bench/make_tables.py" "$results" --machine "$machine"
+else
+  python3 "$root/bench/make_tables.py" "$results" --machine "$machine" --doc "$root/docs/performance.md" \
+    --svg "$root/docs/bench/ns_per_collision.svg"
+  echo "tables updated in docs/performance.md" >&2
+fi
