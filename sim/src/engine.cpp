@@ -125,6 +125,24 @@ struct TurtleRun {
 
 double path_length(Vec2 v, double dt) { return norm(v) * dt; }
 
+/// The unit vector of a Logo heading (radians; 0 is +y, clockwise). Headings within 1e-9 degrees
+/// of a multiple of 90 give the exact axis: cos(pi/2) is 6e-17, not 0, and a turtle that has
+/// turned to drive along the wall it touches would otherwise "approach" it at 1e-15 units/s and
+/// stop at once.
+Vec2 heading_vector(double heading) {
+  const double deg = heading * (180.0 / 3.141592653589793);
+  const double quarter = std::round(deg / 90.0);
+  if (std::abs(deg - 90.0 * quarter) < 1e-9) {
+    switch (((static_cast<long long>(quarter) % 4) + 4) % 4) {
+      case 0: return {0.0, 1.0};
+      case 1: return {1.0, 0.0};
+      case 2: return {0.0, -1.0};
+      default: return {-1.0, 0.0};
+    }
+  }
+  return {std::sin(heading), std::cos(heading)};
+}
+
 template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
 class Engine final : public EngineBase {
  public:
@@ -807,11 +825,14 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::collide_with_turtle(std::uint32
   note_contact(bt.r + bo.r - dist, std::min(bt.r, bo.r));
   const Vec2 n = F / dist;
   if (!is_turtle(o)) {
-    // A ball bounces off the turtle as off a moving wall of infinite mass.
-    bo.v = bt.v + bounce(o, bo.v - bt.v, n);
+    // The turtle stops dead (or bounces) at the contact first; the ball then bounces off it as
+    // off a wall of infinite mass moving at the turtle's new velocity. (Against the old velocity,
+    // a ball that caught up with a turtle from behind would keep closing on it once it stopped.)
+    touch(t, EventKind::turtle_ball, o, -n);
+    const Vec2 w = bo.v - bt.v;
+    if (dot(w, n) < 0.0) bo.v = bt.v + bounce(o, w, n);
     ++stats_.turtle_ball;
     log(EventKind::turtle_ball, t - nb_, o);
-    touch(t, EventKind::turtle_ball, o, -n);
   } else {
     ++stats_.turtle_turtle;
     log(EventKind::turtle_turtle, t - nb_, o - nb_);
@@ -874,7 +895,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::end_command(std::uint32_t i) {
   // A turtle's command (or its coasting after a bounce) has run its course.
   sync(i);
   TurtleRun& r = run_[i - nb_];
-  if (r.kind == TurtleCommand::Kind::turn && r.busy) r.heading0 = heading_at(i - nb_, now_);
+  // A completed turn ends exactly where it was told to, not where omega * time rounds to.
+  if (r.kind == TurtleCommand::Kind::turn && r.busy) r.heading0 += r.amount;
   if (r.busy) r.amount = std::abs(r.amount);
   r.busy = false;
   r.coasting = false;
@@ -911,7 +933,7 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::command_turtle(std::size_t k, c
       const double sign = c.amount >= 0.0 ? 1.0 : -1.0;
       r.busy = c.amount != 0.0 && r.speed > 0.0;
       r.t_end = r.busy ? now_ + std::abs(c.amount) / r.speed : kNever;
-      if (r.busy) b.v = (sign * r.speed) * Vec2{std::sin(r.heading0), std::cos(r.heading0)};
+      if (r.busy) b.v = (sign * r.speed) * heading_vector(r.heading0);
       r.amount = c.amount;
       break;
     }

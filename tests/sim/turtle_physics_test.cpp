@@ -152,7 +152,7 @@ TEST_CASE("two turtles meeting head on both stop at contact", "[turtle]") {
   }
 }
 
-TEST_CASE("a ball bounces off a turtle as off a moving wall", "[turtle]") {
+TEST_CASE("a ball bounces off a turtle, which stops dead at the touch", "[turtle]") {
   for (Mode mode : kModes) {
     INFO(name(mode));
     WorldDef d = box(400, 400);
@@ -161,16 +161,27 @@ TEST_CASE("a ball bounces off a turtle as off a moving wall", "[turtle]") {
     World w(d, mode);
     w.command_turtle(0, move(100));
     w.advance_to(3.0);
-    // Closing speed 30 over a gap of 48: contact at 1.6 s. The ball leaves at 20 + (20 + 10) = 50
-    // (reflected in the turtle's frame); the turtle stops dead.
+    // Closing speed 30 over a gap of 48: contact at 1.6 s. The turtle stops dead there; the ball
+    // then bounces off it as off a wall of infinite mass at rest, leaving at +10.
     CHECK(w.stats().turtle_ball == 1);
-    CHECK(w.ball(0).vel.x == Approx(50));
+    CHECK(w.ball(0).vel.x == Approx(10));
     CHECK(w.turtle(0).touched);
     CHECK(w.turtle(0).pos.x == Approx(232));
     const auto c = w.take_turtle_contacts();
     REQUIRE(c.size() == 1);
     CHECK(c[0].kind == EventKind::turtle_ball);
     CHECK(c[0].t == Approx(1.6));
+  }
+  SECTION("a still turtle hit by a ball reflects it elastically") {
+    WorldDef d = box(400, 400);
+    d.turtles.push_back(turtle("t", {200, 200}, 0));
+    d.balls.push_back(ball("b", {260, 230}, {-30, -10}, 2));
+    World w(d, Mode::exact);
+    const double e0 = w.energy();
+    w.advance_to(3.0);
+    CHECK(w.stats().turtle_ball == 1);
+    CHECK(w.energy() == Approx(e0).epsilon(1e-14));
+    CHECK(w.turtle(0).pos.x == 200.0);
   }
 }
 
@@ -238,5 +249,46 @@ TEST_CASE("a hundred turtles driven at random stay apart and inside", "[turtle][
       REQUIRE(s.pos.y >= 6 - 1e-9);
       REQUIRE(s.pos.y <= 994 + 1e-9);
     }
+  }
+}
+
+TEST_CASE("a ball that catches a moving turtle from behind bounces off the stopped turtle", "[turtle][regression]") {
+  // Bounced against the turtle's velocity before it stopped, the ball kept closing on it and, with
+  // the pair marked as just collided, sank into it (0.16 units here, 0.67 in step mode).
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(200, 400);
+    d.balls.push_back(ball("b", {100, 50}, {10, 60}, 3));
+    d.turtles.push_back(turtle("t", {100, 100}, 0, 14, 30));
+    World w(d, mode);
+    w.command_turtle(0, move(150));
+    for (int k = 1; k <= 120; ++k) {
+      w.advance_to(k * d.dt);
+      if (!w.turtle(0).busy) w.command_turtle(0, {TurtleCommand::Kind::wait, 2.0});
+      REQUIRE(w.measure_overlap().relative <= 1e-9);
+    }
+    CHECK(w.stats().turtle_ball >= 1);
+    CHECK(std::abs(w.energy() - 0.5 * (100 + 3600)) <= 1e-9 * 1850);  // the stopped turtle gives no energy
+  }
+}
+
+TEST_CASE("after touching a wall and turning 90 degrees, a turtle drives along it", "[turtle][regression]") {
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(400, 400);
+    d.walls.push_back({"w", {50, 0}, {50, 400}});
+    d.turtles.push_back(turtle("t", {100, 100}, 270));  // facing the wall (-x)
+    World w(d, mode);
+    w.command_turtle(0, move(100));
+    w.advance_to(3.0);
+    REQUIRE(w.turtle(0).touched);
+    w.command_turtle(0, turn(90));  // now facing +y, the wall on the left, exactly parallel
+    w.advance_to(5.0);
+    w.command_turtle(0, move(60));
+    w.advance_to(9.0);
+    CHECK_FALSE(w.turtle(0).touched);
+    CHECK(w.turtle(0).done == Approx(60));
+    CHECK(w.turtle(0).pos.y == Approx(160));
+    CHECK(w.turtle(0).pos.x == 60.0);
   }
 }
