@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -249,4 +250,208 @@ TEST_CASE("cli: exits are logged without b, and exited balls leave the state") {
   const json s = json::parse(read(state));
   REQUIRE(s.at("balls").size() == 1);
   CHECK(s.at("balls")[0].at("id") == "stayer");
+}
+
+namespace {
+
+/// A walled room with a wall in front of a scripted turtle, and a wanderer.
+const std::string turtle_world = R"({
+  "format": "turtlegas-world/1", "name": "turtles", "seed": 9,
+  "arena": {"width": 300, "height": 200, "boundary": "walls"},
+  "walls": [{"id": "target", "from": [200, 20], "to": [200, 180]}],
+  "turtles": [
+    {"id": "s", "pos": [50, 100], "heading": 90, "speed": 45, "controller": "script", "pen": "down",
+     "params": {"commands": [["forward", 500], ["back", 10], ["left", 90], ["forward", 20]]}},
+    {"id": "w", "pos": [250, 100], "heading": 10, "speed": 60, "controller": "wander", "sensors": 8}
+  ]
+})";
+
+std::vector<json> lines_of(const fs::path& p) {
+  std::vector<json> out;
+  std::ifstream in(p);
+  std::string line;
+  while (std::getline(in, line)) out.push_back(json::parse(line));
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("cli: a turtle world logs contacts and touches, and writes turtles to the state and stats") {
+  TempDir dir;
+  const fs::path w = dir.write("turtles.json", turtle_world);
+  for (const char* mode : {"exact", "step"}) {
+    INFO(mode);
+    const fs::path events = dir.path / "e.jsonl", state = dir.path / "s.json", stats = dir.path / "st.json",
+                   svg = dir.path / "t.svg";
+    const Result r = run(dir, {"run", w.string(), "--until", "20", "--mode", mode, "--events", events.string(),
+                               "--state-out", state.string(), "--stats-json", stats.string(), "--svg", svg.string(),
+                               "--stats"});
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    CHECK(contains(r.out, "2 turtles"));
+    CHECK(contains(r.out, "touches"));
+
+    const std::vector<json> log = lines_of(events);
+    double last = 0.0;
+    std::size_t contacts = 0, touches = 0;
+    bool s_hit_target = false, s_felt_it_in_front = false;
+    for (const json& e : log) {
+      const double t = e.at("t").get<double>();
+      CHECK(t >= last);
+      last = t;
+      const std::string kind = e.at("kind");
+      if (kind.starts_with("turtle-")) ++contacts;
+      if (kind == "turtle-wall" && e.at("a") == "s" && e.at("b") == "target") s_hit_target = true;
+      if (kind == "touch") {
+        ++touches;
+        REQUIRE(e.contains("sensors"));
+        REQUIRE(e.contains("bearing"));
+        CHECK(e.at("sensors").is_array());
+        const double bearing = e.at("bearing").get<double>();
+        CHECK(bearing >= 0.0);
+        CHECK(bearing < 360.0);
+        if (e.at("a") == "s" && e.at("b") == "target") {
+          s_felt_it_in_front = e.at("sensors") == json::array({"front"}) && std::abs(bearing) < 1e-9;
+          // Contact at x = 190 after 140 units at 45/s, t = 3.11 s; felt at the next boundary, 94 dt.
+          CHECK(t == Approx(94.0 / 30.0));
+        }
+      }
+    }
+    CHECK(s_hit_target);
+    CHECK(s_felt_it_in_front);
+    CHECK(contacts > 3);
+    CHECK(touches == contacts);  // each contact becomes exactly one touch at the next boundary
+
+    const json s = json::parse(read(state));
+    CHECK(s.at("balls").empty());
+    REQUIRE(s.at("turtles").size() == 2);
+    const json& st0 = s.at("turtles")[0];
+    CHECK(st0.at("id") == "s");
+    // 140 to the wall, 10 back, a left turn, 20 north.
+    CHECK(st0.at("pos")[0].get<double>() == Approx(180.0));
+    CHECK(st0.at("pos")[1].get<double>() == Approx(120.0));
+    CHECK(std::remainder(st0.at("heading").get<double>(), 360.0) == Approx(0.0).margin(1e-9));  // north
+    CHECK(st0.at("heading").get<double>() < 360.0);
+    CHECK(s.at("turtles")[1].at("id") == "w");
+
+    const json stj = json::parse(read(stats));
+    for (const char* key : {"turtles", "turtle_wall", "turtle_wall_end", "turtle_turtle", "turtle_ball", "touches",
+                            "faults", "turtles_finished", "collisions", "max_overlap"})
+      CHECK(stj.contains(key));
+    CHECK(stj.at("turtles") == 2);
+    CHECK(stj.at("touches").get<std::size_t>() == touches);
+    CHECK(stj.at("faults") == 0);
+    CHECK(stj.at("turtles_finished") == 1);
+    CHECK(stj.at("turtle_wall").get<std::size_t>() + stj.at("turtle_wall_end").get<std::size_t>() +
+              stj.at("turtle_turtle").get<std::size_t>() + stj.at("turtle_ball").get<std::size_t>() ==
+          contacts);
+
+    const std::string picture = read(svg);
+    CHECK(contains(picture, "class=\"turtle\""));
+    CHECK(contains(picture, "class=\"trail\""));
+    CHECK(contains(picture, ">w</text>"));
+  }
+}
+
+TEST_CASE("cli: turtle worlds give the same event log, byte for byte") {
+  TempDir dir;
+  for (const char* world : {"worlds/mixed.json", "worlds/wander.json"}) {
+    INFO(world);
+    const std::string file = std::string(TURTLEGAS_SOURCE_DIR) + "/" + world;
+    const fs::path a = dir.path / "a.jsonl", b = dir.path / "b.jsonl";
+    REQUIRE(run(dir, {"run", file, "--until", "20", "--events", a.string()}).code == 0);
+    REQUIRE(run(dir, {"run", file, "--until", "20", "--events", b.string()}).code == 0);
+    const std::string log = read(a);
+    CHECK(log == read(b));
+    CHECK(contains(log, "\"kind\": \"touch\""));
+  }
+}
+
+TEST_CASE("cli: turtle input errors exit with 2 and say why") {
+  TempDir dir;
+  SECTION("an unknown controller") {
+    std::string text = turtle_world;
+    text.replace(text.find("\"wander\""), 8, "\"wandr\"");
+    const fs::path w = dir.write("wandr.json", text);
+    for (const char* command : {"run", "check"}) {
+      const Result r = command == std::string("run") ? run(dir, {"run", w.string(), "--until", "1"})
+                                                     : run(dir, {"check", w.string()});
+      CHECK(r.code == 2);
+      CHECK(contains(r.err, w.string() + ": /turtles/1/controller: controller 'wandr' is not registered; known: script, "
+                                         "spiral, square, wall_follower, wander"));
+    }
+  }
+  SECTION("a typo in a script") {
+    std::string text = turtle_world;
+    text.replace(text.find("\"back\""), 6, "\"bakc\"");
+    const fs::path w = dir.write("typo.json", text);
+    const Result r = run(dir, {"run", w.string(), "--until", "1"});
+    CHECK(r.code == 2);
+    CHECK(contains(r.err, "/turtles/0/params/commands/1/0: unknown command 'bakc'"));
+  }
+  SECTION("bad runtime options") {
+    const fs::path w = dir.write("t.json", turtle_world);
+    const Result stack = run(dir, {"run", w.string(), "--until", "1", "--stack-kib", "1"});
+    CHECK(stack.code == 2);
+    CHECK(contains(stack.err, "--stack-kib must be"));
+    const Result budget = run(dir, {"run", w.string(), "--until", "1", "--program-budget", "0"});
+    CHECK(budget.code == 2);
+    CHECK(contains(budget.err, "--program-budget must be"));
+  }
+}
+
+TEST_CASE("cli: a faulty program stops its turtle, is logged, and the run goes on") {
+  TempDir dir;
+  std::string text = turtle_world;
+  // wander reads params.step as a number: a string makes its program throw on its first line.
+  text.replace(text.find("\"sensors\": 8"), 12, R"("params": {"step": "far"})");
+  const fs::path w = dir.write("fault.json", text);
+  const fs::path events = dir.path / "e.jsonl", stats = dir.path / "st.json";
+  const Result r = run(dir, {"run", w.string(), "--until", "10", "--events", events.string(), "--stats-json", stats.string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(contains(r.err, "turtle 'w'"));
+  bool fault = false, touch = false;
+  for (const json& e : lines_of(events)) {
+    if (e.at("kind") == "fault") {
+      fault = true;
+      CHECK(e.at("a") == "w");
+      CHECK(contains(e.at("message").get<std::string>(), "params.step"));
+    }
+    touch = touch || (e.at("kind") == "touch" && e.at("a") == "s");
+  }
+  CHECK(fault);
+  CHECK(touch);  // the other turtle ran on
+  CHECK(json::parse(read(stats)).at("faults") == 1);
+}
+
+TEST_CASE("cli: check reports turtles and controllers; controllers lists the registry") {
+  TempDir dir;
+  const fs::path w = dir.write("t.json", turtle_world);
+  const Result r = run(dir, {"check", w.string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(contains(r.out, "2 turtles"));
+  CHECK(contains(r.out, "turtles: s, w; controllers: script, wander"));
+
+  const Result list = run(dir, {"controllers"});
+  REQUIRE(list.code == 0);
+  for (const char* name : {"script", "spiral", "square", "wall_follower", "wander"}) CHECK(contains(list.out, name));
+  CHECK(contains(list.out, "runs params.commands"));
+}
+
+TEST_CASE("cli: every shipped turtle world runs for a minute") {
+  TempDir dir;
+  for (const char* world : {"wander", "wall_follower", "spiral", "square", "script", "mixed"}) {
+    INFO(world);
+    const fs::path state = dir.path / "s.json";
+    const fs::path stats = dir.path / "stats.json";
+    const Result r = run(dir, {"run", std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/" + world + ".json", "--until", "60",
+                               "--state-out", state.string(), "--stats-json", stats.string()});
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    CHECK_FALSE(json::parse(read(state)).at("turtles").empty());
+    // Nothing sinks into anything: in mixed.json balls hit moving turtles from every side.
+    CHECK(json::parse(read(stats)).at("max_overlap_relative").get<double>() <= 1e-9);
+  }
 }

@@ -53,3 +53,31 @@ TEST_CASE("an SVG snapshot draws the arena, walls and balls with +y up") {
   CHECK(svg.find("fill=\"#440154\"") != std::string::npos);
   CHECK(svg.find("fill=\"#fde725\"") != std::string::npos);
 }
+
+TEST_CASE("an SVG snapshot draws turtles with a heading tick and their id, and pen trails") {
+  sim::WorldDef def;
+  def.name = "turtles";
+  def.arena.width = 100;
+  def.arena.height = 100;
+  sim::TurtleDef t;
+  t.id = "east<1>";
+  t.pos = {50, 50};
+  t.heading = 1.5707963267948966;  // Logo: 90 degrees, towards +x
+  t.radius = 10;
+  def.turtles.push_back(t);
+  tw::Snapshot snap = tw::snapshot_of(def);
+  REQUIRE(snap.turtles.size() == 1);
+  snap.turtles[0].trail = {{10, 10}, {10, 50}, {50, 50}};
+
+  std::ostringstream out;
+  tw::write_svg(out, snap, 100.0);
+  const std::string svg = out.str();
+  CHECK(count(svg, "class=\"turtle\"") == 1);
+  CHECK(count(svg, "class=\"trail\"") == 1);
+  CHECK(svg.find("points=\"10,10 10,50 50,50\"") != std::string::npos);
+  // The tick runs from the centre to the rim along the heading: (50, 50) to (60, 50).
+  CHECK(svg.find("class=\"heading\" x1=\"50\" y1=\"50\" x2=\"60\" y2=\"50\"") != std::string::npos);
+  CHECK(svg.find(">east&lt;1&gt;</text>") != std::string::npos);
+  CHECK(svg.find("0 balls, 1 turtle<") != std::string::npos);
+  CHECK(svg.find("linearGradient") == std::string::npos);  // no balls, no speed legend
+}

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
-// The turtlegas command-line program: `turtlegas run` and `turtlegas check` (see docs/design.md,
-// "Command line", for the contract this file keeps).
+// The turtlegas command-line program: `turtlegas run`, `turtlegas check` and `turtlegas controllers`
+// (see docs/design.md, "Command line", for the contract this file keeps). A scene with turtles runs
+// through the world server (their programs between control steps); one without runs the bare engine.
+#include <dlfcn.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -11,10 +13,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -22,7 +26,9 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/sim/world.hpp"
+#include "turtlegas/turtle/world_server.hpp"
 #include "turtlegas/world/svg_snapshot.hpp"
 #include "turtlegas/world/world_file.hpp"
 
@@ -31,6 +37,7 @@ namespace {
 namespace fs = std::filesystem;
 namespace sim = turtlegas::sim;
 namespace tw = turtlegas::world;
+namespace tt = turtlegas::turtle;
 using Clock = std::chrono::steady_clock;
 
 constexpr int exit_ok = 0;
@@ -118,6 +125,8 @@ struct RunOptions {
   std::optional<double> dt;
   std::string events, state_out, stats_json, svg;
   bool stats = false;
+  std::size_t stack_kib = 32;   ///< each turtle program's stack
+  double program_budget = 2.0;  ///< wall-clock seconds a program may run without a command
 };
 
 /// The event log as JSON lines, written in chunks while the world runs.
@@ -163,6 +172,48 @@ class EventWriter {
   std::string buf_;
 };
 
+/// The world server's event log (balls' and turtles' events, touches, faults) as JSON lines.
+class LogEventWriter {
+ public:
+  explicit LogEventWriter(AtomicFile& file) : file_(file) {}
+
+  void write(const std::vector<tt::LogEvent>& events) {
+    buf_.clear();
+    for (const tt::LogEvent& e : events) {
+      buf_ += "{\"t\": ";
+      append_number(buf_, e.t);
+      buf_ += ", \"kind\": ";
+      append_json_string(buf_, e.kind);
+      buf_ += ", \"a\": ";
+      append_json_string(buf_, e.a);
+      if (!e.b.empty()) {  // an exit or a fault names no second body
+        buf_ += ", \"b\": ";
+        append_json_string(buf_, e.b);
+      }
+      if (e.kind == "touch") {
+        buf_ += ", \"sensors\": [";
+        for (std::size_t k = 0; k < e.sensors.size(); ++k) {
+          if (k > 0) buf_ += ", ";
+          append_json_string(buf_, e.sensors[k]);
+        }
+        // Degrees clockwise from the heading to the contact point, [0, 360).
+        buf_ += "], \"bearing\": ";
+        append_number(buf_, e.bearing);
+      }
+      if (!e.message.empty()) {
+        buf_ += ", \"message\": ";
+        append_json_string(buf_, e.message);
+      }
+      buf_ += "}\n";
+    }
+    file_.stream().write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+  }
+
+ private:
+  AtomicFile& file_;
+  std::string buf_;
+};
+
 /// Simulated time / until on stderr, refreshed in place, only on a terminal and only once a run
 /// has taken long enough for it to help.
 class Progress {
@@ -195,11 +246,21 @@ class Progress {
   bool shown_ = false;
 };
 
-sim::WorldDef load(const std::string& file) {
+tw::Scene load(const std::string& file, const tt::Registry& registry) {
   try {
-    return tw::load_world_file(file);
+    return tw::load_scene(file, registry);
   } catch (const tw::WorldFileError& e) {
     throw BadInput(e.what());
+  }
+}
+
+/// As make_world, for a scene with turtles: the server also checks controllers and sensors.
+std::unique_ptr<tt::WorldServer> make_server(const tw::Scene& scene, const tt::Registry& registry,
+                                             const tt::ServerOptions& options, const std::string& file) {
+  try {
+    return std::make_unique<tt::WorldServer>(scene.def, scene.programs, registry, options);
+  } catch (const std::invalid_argument& e) {
+    throw BadInput(file + ": " + (options.mode == sim::Mode::exact ? "exact" : "step") + " mode: " + e.what());
   }
 }
 
@@ -217,6 +278,7 @@ std::string count_summary(const sim::WorldDef& def) {
   auto plural = [](std::size_t n, const char* noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); };
   std::string s = plural(def.balls.size(), "ball") + ", " + plural(def.walls.size(), "wall");
   if (def.arena.boundary == sim::Boundary::walls) s += " (+4 arena walls)";
+  if (!def.turtles.empty()) s += ", " + plural(def.turtles.size(), "turtle");
   return s;
 }
 
@@ -235,22 +297,177 @@ std::string fmt(double v) {
   return buf.data();
 }
 
-int check_command(const std::string& file) {
-  const sim::WorldDef def = load(file);
+/// "wander x3, script": each controller the scene uses and how many turtles run it, in file order.
+std::string controller_summary(const tw::Scene& scene) {
+  std::vector<std::pair<std::string, std::size_t>> uses;
+  for (const tt::TurtleProgram& p : scene.programs) {
+    auto it = std::find_if(uses.begin(), uses.end(), [&](const auto& u) { return u.first == p.controller; });
+    if (it == uses.end()) uses.emplace_back(p.controller, 1);
+    else ++it->second;
+  }
+  std::string s;
+  for (const auto& [name, n] : uses) s += (s.empty() ? "" : ", ") + name + (n > 1 ? " x" + std::to_string(n) : "");
+  return s;
+}
+
+int check_command(const std::string& file, const tt::Registry& registry) {
+  const tw::Scene scene = load(file, registry);
+  const sim::WorldDef& def = scene.def;
   const sim::World exact = make_world(def, sim::Mode::exact, file);
   const sim::World step = make_world(def, sim::Mode::step, file);
   std::printf("%s: ok: \"%s\", %s, arena %s x %s (boundary %s), cell %s (%d x %d), dt %s s\n", file.c_str(),
               def.name.c_str(), count_summary(def).c_str(), fmt(def.arena.width).c_str(), fmt(def.arena.height).c_str(),
               boundary_name(def.arena.boundary), fmt(step.cell_size()).c_str(), step.cells_x(), step.cells_y(),
               fmt(def.dt).c_str());
+  if (!def.turtles.empty()) {
+    // Building the servers checks what only the runtime knows (controllers, sensors); no program
+    // runs until the first control step, so this costs nothing.
+    for (sim::Mode mode : {sim::Mode::exact, sim::Mode::step}) {
+      tt::ServerOptions options;
+      options.mode = mode;
+      make_server(scene, registry, options, file);
+    }
+    std::printf("  turtles: %s; controllers: %s\n",
+                [&] {
+                  std::string ids;
+                  constexpr std::size_t shown = 8;
+                  for (std::size_t i = 0; i < def.turtles.size() && i < shown; ++i)
+                    ids += (i ? ", " : "") + def.turtles[i].id;
+                  if (def.turtles.size() > shown) ids += ", ... (" + std::to_string(def.turtles.size()) + " in all)";
+                  return ids;
+                }()
+                    .c_str(),
+                controller_summary(scene).c_str());
+  }
   return exit_ok;
 }
 
-int run_command(const RunOptions& opt) {
+/// Loads controller plugins: shared modules exporting `extern "C" void turtlegas_register(Registry&)`,
+/// built against the same turtlegas headers and compiler (see docs/controllers.md). They stay loaded
+/// for the life of the program, since the registry holds their code.
+void load_plugins(const std::vector<std::string>& paths, tt::Registry& registry) {
+  using Register = void (*)(tt::Registry&);
+  for (const std::string& path : paths) {
+    // A bare name would be searched for on the library path; a plugin is a file the user names.
+    const std::string file = path.find('/') == std::string::npos ? "./" + path : path;
+    void* handle = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) {
+      const char* why = ::dlerror();
+      throw BadInput("--plugin " + path + ": cannot load it: " + (why ? why : "unknown error") +
+                     " (is it a plugin built with turtlegas_add_plugin, for this turtlegas?)");
+    }
+    auto* entry = reinterpret_cast<Register>(::dlsym(handle, "turtlegas_register"));
+    if (!entry)
+      throw BadInput("--plugin " + path +
+                     ": it does not export turtlegas_register; define extern \"C\" void "
+                     "turtlegas_register(turtlegas::turtle::Registry&) in it");
+    entry(registry);
+  }
+}
+
+int controllers_command(const tt::Registry& registry) {
+  std::size_t width = 0;
+  for (const std::string& name : registry.names()) width = std::max(width, name.size());
+  for (const std::string& name : registry.names())
+    std::printf("%-*s  %s\n", static_cast<int>(width), name.c_str(), registry.summary(name).c_str());
+  return exit_ok;
+}
+
+/// What a run adds up besides the engine's own Stats.
+struct RunTotals {
+  double wall_seconds = 0.0;
+  double energy_start = 0.0;
+  std::uint64_t touches = 0;
+  std::uint64_t faults = 0;
+  std::size_t turtles_finished = 0;
+};
+
+/// Advances in chunks so the event buffer stays bounded and progress can be shown; the physics
+/// does not depend on where a run is cut. `advance(t)` runs to t and returns the events since the
+/// last call, which `flush` gets. Chunks start at `first_chunk` and adapt to about 0.1 s of wall
+/// time, but never drop below `min_chunk`.
+template <class Advance, class Flush>
+double run_in_chunks(double from, double until, double first_chunk, double min_chunk, Progress& progress,
+                     Advance&& advance, Flush&& flush) {
+  const auto start = Clock::now();
+  double t = from;
+  double chunk = first_chunk;
+  while (t < until) {
+    double next = std::min(until, t + chunk);
+    if (!(next > t)) next = until;
+    const auto chunk_start = Clock::now();
+    const auto [events, total_events] = advance(next);
+    const double took = std::chrono::duration<double>(Clock::now() - chunk_start).count();
+    flush();
+    if ((took > 0.25 || events > (1u << 20)) && chunk / 2.0 >= min_chunk) chunk /= 2.0;
+    else if (took < 0.05 && events < (1u << 18)) chunk *= 2.0;
+    t = next;
+    progress.update(t, total_events);
+  }
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void write_state(AtomicFile& file, const sim::World& world, const sim::WorldDef& def) {
+  std::string buf = "{\"t\": ";
+  append_number(buf, world.time());
+  buf += ", \"balls\": [";
+  bool first = true;
+  for (std::size_t i = 0; i < world.ball_count(); ++i) {
+    const sim::BallState b = world.ball(i);
+    if (!b.alive) continue;
+    buf += first ? "\n  " : ",\n  ";
+    first = false;
+    buf += "{\"id\": ";
+    append_json_string(buf, def.balls[i].id);
+    buf += ", \"pos\": [";
+    append_number(buf, b.pos.x);
+    buf += ", ";
+    append_number(buf, b.pos.y);
+    buf += "], \"vel\": [";
+    append_number(buf, b.vel.x);
+    buf += ", ";
+    append_number(buf, b.vel.y);
+    buf += "]}";
+    if (buf.size() > (1u << 20)) {
+      file.stream() << buf;
+      buf.clear();
+    }
+  }
+  buf += first ? "], \"turtles\": [" : "\n], \"turtles\": [";
+  for (std::size_t i = 0; i < world.turtle_count(); ++i) {
+    const sim::TurtleState tu = world.turtle(i);
+    buf += i == 0 ? "\n  " : ",\n  ";
+    buf += "{\"id\": ";
+    append_json_string(buf, def.turtles[i].id);
+    buf += ", \"pos\": [";
+    append_number(buf, tu.pos.x);
+    buf += ", ";
+    append_number(buf, tu.pos.y);
+    // Radians inside, degrees in files (Logo convention: 0 is +y, clockwise), in [0, 360).
+    double heading = std::fmod(tu.heading * (180.0 / std::numbers::pi), 360.0);
+    if (heading < 0.0) heading += 360.0;
+    if (heading >= 360.0) heading = 0.0;  // -1e-17 + 360 rounds to 360
+    buf += "], \"heading\": ";
+    append_number(buf, heading);
+    buf += "}";
+  }
+  buf += world.turtle_count() == 0 ? "]}\n" : "\n]}\n";
+  file.stream() << buf;
+  file.commit();
+}
+
+int run_command(const RunOptions& opt, const tt::Registry& registry) {
   if (!std::isfinite(opt.until) || opt.until < 0.0)
     throw BadInput("--until must be a finite time >= 0 in seconds (got " + fmt(opt.until) + ")");
   if (opt.dt && (!std::isfinite(*opt.dt) || *opt.dt <= 0.0))
     throw BadInput("--dt must be a finite time > 0 in seconds (got " + fmt(*opt.dt) + ")");
+  constexpr std::size_t min_stack_kib = 16, max_stack_kib = 1024 * 1024;
+  if (opt.stack_kib < min_stack_kib || opt.stack_kib > max_stack_kib)
+    throw BadInput("--stack-kib must be from " + std::to_string(min_stack_kib) + " to " + std::to_string(max_stack_kib) +
+                   " (got " + std::to_string(opt.stack_kib) + ")");
+  if (!std::isfinite(opt.program_budget) || opt.program_budget <= 0.0)
+    throw BadInput("--program-budget must be a finite time > 0 in seconds of wall clock (got " +
+                   fmt(opt.program_budget) + ")");
   const sim::Mode mode = opt.mode == "step" ? sim::Mode::step : sim::Mode::exact;
 
   // Outputs are opened before the run, so a bad path costs nothing.
@@ -260,97 +477,82 @@ int run_command(const RunOptions& opt) {
   if (!opt.stats_json.empty()) stats_file.emplace(opt.stats_json, "--stats-json");
   if (!opt.svg.empty()) svg_file.emplace(opt.svg, "--svg");
 
-  sim::WorldDef def = load(opt.world);
+  tw::Scene scene = load(opt.world, registry);
+  sim::WorldDef& def = scene.def;
   if (opt.dt) def.dt = *opt.dt;
-  sim::World world = make_world(def, mode, opt.world);
-  const double energy_start = world.energy();
 
-  std::vector<sim::Event> events;
-  std::optional<EventWriter> writer;
-  if (events_file) {
-    writer.emplace(*events_file, def, world);
-    world.set_event_log(&events);
-  }
-
-  // Advance in chunks so the event buffer stays bounded and progress can be shown; the engine's
-  // physics does not depend on where a run is cut. Chunks start at a quarter step, short enough
-  // for a million balls, and adapt to about 0.1 s of wall time.
   Progress progress(opt.until);
-  const auto start = Clock::now();
-  double t = world.time();
-  double chunk = std::min((opt.until - t) / 64.0, def.dt / 4.0);
-  while (t < opt.until) {
-    double next = std::min(opt.until, t + chunk);
-    if (!(next > t)) next = opt.until;
-    const auto chunk_start = Clock::now();
-    world.advance_to(next);
-    const double took = std::chrono::duration<double>(Clock::now() - chunk_start).count();
-    if (writer) writer->write(events);
-    if (took > 0.25 || events.size() > (1u << 20)) chunk /= 2.0;
-    else if (took < 0.05 && events.size() < (1u << 18)) chunk *= 2.0;
-    events.clear();
-    t = next;
-    progress.update(t, world.stats().events);
+  RunTotals totals;
+  // Exactly one of these runs the scene: the bare engine, or the world server when there are
+  // turtles (which then owns the engine).
+  std::optional<sim::World> bare;
+  std::unique_ptr<tt::WorldServer> server;
+  if (def.turtles.empty()) {
+    bare.emplace(make_world(def, mode, opt.world));
+    sim::World& world = *bare;
+    totals.energy_start = world.energy();
+    std::vector<sim::Event> events;
+    std::optional<EventWriter> writer;
+    if (events_file) {
+      writer.emplace(*events_file, def, world);
+      world.set_event_log(&events);
+    }
+    // A quarter step first: short enough for a million balls.
+    totals.wall_seconds = run_in_chunks(
+        world.time(), opt.until, std::min((opt.until - world.time()) / 64.0, def.dt / 4.0), 0.0, progress,
+        [&](double t) {
+          world.advance_to(t);
+          return std::pair{events.size(), world.stats().events};
+        },
+        [&] {
+          if (writer) writer->write(events);
+          events.clear();
+        });
+    world.set_event_log(nullptr);
+  } else {
+    tt::ServerOptions options;
+    options.mode = mode;
+    options.stack_bytes = opt.stack_kib * 1024;
+    options.program_budget = opt.program_budget;
+    server = make_server(scene, registry, options, opt.world);
+    totals.energy_start = server->world().energy();
+    // The log is always kept: touches and faults are counted from it.
+    std::vector<tt::LogEvent> events;
+    std::optional<LogEventWriter> writer;
+    if (events_file) writer.emplace(*events_file);
+    server->set_event_log(&events);
+    // Whole control steps at first; programs run only at step boundaries anyway.
+    totals.wall_seconds = run_in_chunks(
+        server->time(), opt.until, def.dt, def.dt, progress,
+        [&](double t) {
+          server->run_until(t);  // a BusyLoopError ends the run (exit 1)
+          return std::pair{events.size(), server->world().stats().events};
+        },
+        [&] {
+          for (const tt::LogEvent& e : events) {
+            totals.touches += e.kind == "touch" ? 1 : 0;
+            totals.faults += e.kind == "fault" ? 1 : 0;
+          }
+          if (writer) writer->write(events);
+          events.clear();
+        });
+    server->set_event_log(nullptr);
+    for (std::size_t i = 0; i < server->turtle_count(); ++i) totals.turtles_finished += server->turtle(i).finished ? 1 : 0;
   }
-  const double wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   progress.clear();
-  world.set_event_log(nullptr);
+  const sim::World& world = server ? server->world() : *bare;
 
   const sim::Stats& st = world.stats();
   const sim::Overlap now = world.measure_overlap(), seen = world.max_contact_overlap();
   const double max_overlap = std::max(now.depth, seen.depth);
   const double max_overlap_relative = std::max(now.relative, seen.relative);
-  const double energy_end = world.energy();
+  const double energy_start = totals.energy_start, energy_end = world.energy();
+  const double wall_seconds = totals.wall_seconds;
   std::size_t live = 0;
   for (std::size_t i = 0; i < world.ball_count(); ++i) live += world.ball(i).alive ? 1 : 0;
 
   if (events_file) events_file->commit();
-
-  if (state_file) {
-    std::string buf = "{\"t\": ";
-    append_number(buf, world.time());
-    buf += ", \"balls\": [";
-    bool first = true;
-    for (std::size_t i = 0; i < world.ball_count(); ++i) {
-      const sim::BallState b = world.ball(i);
-      if (!b.alive) continue;
-      buf += first ? "\n  " : ",\n  ";
-      first = false;
-      buf += "{\"id\": ";
-      append_json_string(buf, def.balls[i].id);
-      buf += ", \"pos\": [";
-      append_number(buf, b.pos.x);
-      buf += ", ";
-      append_number(buf, b.pos.y);
-      buf += "], \"vel\": [";
-      append_number(buf, b.vel.x);
-      buf += ", ";
-      append_number(buf, b.vel.y);
-      buf += "]}";
-      if (buf.size() > (1u << 20)) {
-        state_file->stream() << buf;
-        buf.clear();
-      }
-    }
-    buf += first ? "], \"turtles\": [" : "\n], \"turtles\": [";
-    for (std::size_t i = 0; i < world.turtle_count(); ++i) {
-      const sim::TurtleState tu = world.turtle(i);
-      buf += i == 0 ? "\n  " : ",\n  ";
-      buf += "{\"id\": ";
-      append_json_string(buf, def.turtles[i].id);
-      buf += ", \"pos\": [";
-      append_number(buf, tu.pos.x);
-      buf += ", ";
-      append_number(buf, tu.pos.y);
-      // Radians inside, degrees in files (Logo convention: 0 is +y, clockwise).
-      buf += "], \"heading\": ";
-      append_number(buf, tu.heading * (180.0 / std::numbers::pi));
-      buf += "}";
-    }
-    buf += world.turtle_count() == 0 ? "]}\n" : "\n]}\n";
-    state_file->stream() << buf;
-    state_file->commit();
-  }
+  if (state_file) write_state(*state_file, world, def);
 
   const char* mode_name = mode == sim::Mode::exact ? "exact" : "step";
   const double per_second = wall_seconds > 0.0 ? static_cast<double>(st.collisions()) / wall_seconds : 0.0;
@@ -365,6 +567,8 @@ int run_command(const RunOptions& opt) {
         {"balls", def.balls.size()},
         {"balls_alive", live},
         {"walls", world.walls().size()},
+        {"turtles", def.turtles.size()},
+        {"turtles_finished", totals.turtles_finished},
         {"cell_size", world.cell_size()},
         {"collisions", st.collisions()},
         {"ball_ball", st.ball_ball},
@@ -375,6 +579,8 @@ int run_command(const RunOptions& opt) {
         {"turtle_wall_end", st.turtle_wall_end},
         {"turtle_turtle", st.turtle_turtle},
         {"turtle_ball", st.turtle_ball},
+        {"touches", totals.touches},
+        {"faults", totals.faults},
         {"cell_crossings", st.cell_crossings},
         {"stale", st.stale},
         {"steps", st.steps},
@@ -391,21 +597,27 @@ int run_command(const RunOptions& opt) {
   }
 
   if (svg_file) {
-    tw::write_svg(svg_file->stream(), tw::snapshot_of(world, def));
+    tw::write_svg(svg_file->stream(), server ? tw::snapshot_of(*server, def) : tw::snapshot_of(world, def));
     svg_file->commit();
   }
 
   if (opt.stats) {
+    using ull = unsigned long long;
     const double de = energy_start != 0.0 ? (energy_end - energy_start) / std::abs(energy_start) : energy_end - energy_start;
     std::printf("%s (%s): %s, %s mode, t = 0 -> %s s\n", def.name.c_str(), opt.world.c_str(), count_summary(def).c_str(),
                 mode_name, fmt(world.time()).c_str());
-    std::printf("  collisions   %llu  (ball-ball %llu, ball-wall %llu, ball-wall-end %llu)\n",
-                static_cast<unsigned long long>(st.collisions()), static_cast<unsigned long long>(st.ball_ball),
-                static_cast<unsigned long long>(st.ball_wall), static_cast<unsigned long long>(st.ball_wall_end));
-    std::printf("  exits        %llu  (%zu balls left)\n", static_cast<unsigned long long>(st.exits), live);
-    std::printf("  events       %llu  (cell crossings %llu, stale %llu, steps %llu)\n",
-                static_cast<unsigned long long>(st.events), static_cast<unsigned long long>(st.cell_crossings),
-                static_cast<unsigned long long>(st.stale), static_cast<unsigned long long>(st.steps));
+    std::printf("  collisions   %llu  (ball-ball %llu, ball-wall %llu, ball-wall-end %llu)\n", ull(st.collisions()),
+                ull(st.ball_ball), ull(st.ball_wall), ull(st.ball_wall_end));
+    if (!def.turtles.empty()) {
+      std::printf("  turtles      %zu  (turtle-wall %llu, turtle-wall-end %llu, turtle-turtle %llu, turtle-ball %llu)\n",
+                  def.turtles.size(), ull(st.turtle_wall), ull(st.turtle_wall_end), ull(st.turtle_turtle),
+                  ull(st.turtle_ball));
+      std::printf("  programs     %s  (touches %llu, faults %llu, finished %zu)\n", controller_summary(scene).c_str(),
+                  ull(totals.touches), ull(totals.faults), totals.turtles_finished);
+    }
+    std::printf("  exits        %llu  (%zu balls left)\n", ull(st.exits), live);
+    std::printf("  events       %llu  (cell crossings %llu, stale %llu, steps %llu)\n", ull(st.events),
+                ull(st.cell_crossings), ull(st.stale), ull(st.steps));
     std::printf("  wall time    %.3f s  (%s collisions/s)\n", wall_seconds, fmt(per_second).c_str());
     std::printf("  energy       %s -> %s  (relative change %.3g)\n", fmt(energy_start).c_str(), fmt(energy_end).c_str(), de);
     std::printf("  max overlap  %s  (%.3g of a radius)\n", fmt(max_overlap).c_str(), max_overlap_relative);
@@ -420,7 +632,7 @@ int main(int argc, char** argv) {
   log->set_pattern("%^%l%$: %v");
   spdlog::set_default_logger(log);
 
-  CLI::App app{"turtlegas: a 2-D gas of discs and walls (after MIT AI Memo 272, the GAS program)"};
+  CLI::App app{"turtlegas: a 2-D gas of discs and walls, and turtles with touch sensors (after MIT AI Memo 272)"};
   app.require_subcommand(1);
 
   RunOptions opt;
@@ -437,10 +649,22 @@ int main(int argc, char** argv) {
   run->add_flag("--stats", opt.stats, "Print a summary of the run");
   run->add_option("--stats-json", opt.stats_json, "Write the run's statistics here (JSON)");
   run->add_option("--svg", opt.svg, "Write an SVG picture of the final state here");
+  std::vector<std::string> plugins;
+  const char* plugin_help = "Load controllers from this shared-library plugin (repeatable)";
+  run->add_option("--plugin", plugins, plugin_help);
+  run->add_option("--stack-kib", opt.stack_kib, "Each turtle program's stack, KiB (a guard page is added)")
+      ->capture_default_str();
+  run->add_option("--program-budget", opt.program_budget,
+                  "Wall-clock seconds a turtle program may run without issuing a command before the run stops")
+      ->capture_default_str();
 
   std::string check_world;
   CLI::App* check = app.add_subcommand("check", "Load and validate a world file, and build it in both modes");
   check->add_option("world", check_world, "World file (format turtlegas-world/1)")->required();
+  check->add_option("--plugin", plugins, plugin_help);
+
+  CLI::App* list = app.add_subcommand("controllers", "List the controllers world files can name, with their params");
+  list->add_option("--plugin", plugins, plugin_help);
 
   try {
     app.parse(argc, argv);
@@ -450,8 +674,11 @@ int main(int argc, char** argv) {
   if (*dt_option) opt.dt = dt;
 
   try {
-    if (*check) return check_command(check_world);
-    return run_command(opt);
+    tt::Registry registry = turtlegas::controllers::builtin_registry();
+    load_plugins(plugins, registry);
+    if (*list) return controllers_command(registry);
+    if (*check) return check_command(check_world, registry);
+    return run_command(opt, registry);
   } catch (const BadInput& e) {
     spdlog::error("{}", e.what());
     return exit_bad_input;

@@ -70,7 +70,8 @@ bool clip(Vec2& p, Vec2& q, Vec2 lo, Vec2 hi) {
 }
 
 /// Everything a new disc must not overlap, in a uniform grid of linked cell lists. Items are
-/// `ball * 2` or `wall * 2 + 1`; discs are entered in every cell their bounding box covers, walls in
+/// `ball * 2` or `wall * 2 + 1`, where a "wall" index past the walls is a turtle (walls and turtles
+/// do not change while a gas is placed, balls do); discs are entered in every cell their bounding box covers, walls in
 /// every cell their (clipped) segment crosses, so an overlapping pair always shares a cell.
 class ObstacleGrid {
  public:
@@ -136,9 +137,13 @@ class ObstacleGrid {
             const sim::BallDef& b = def.balls[item / 2];
             const double s = r + b.radius;
             if (sim::norm2(c - b.pos) < s * s) return true;
-          } else {
+          } else if (item / 2 < def.walls.size()) {
             const sim::WallDef& w = def.walls[item / 2];
             if (segment_distance2(c, w.from, w.to) < r * r) return true;
+          } else {
+            const sim::TurtleDef& t = def.turtles[item / 2 - def.walls.size()];
+            const double s = r + t.radius;
+            if (sim::norm2(c - t.pos) < s * s) return true;
           }
         }
     return false;
@@ -288,7 +293,7 @@ std::size_t place_gas(sim::WorldDef& def, const GasSpec& gas) {
 
   const double r = gas.radius;
   const Vec2 glo = lo - Vec2{r, r}, ghi = hi + Vec2{r, r};
-  const std::size_t others = def.balls.size() + def.walls.size();
+  const std::size_t others = def.balls.size() + def.walls.size() + def.turtles.size();
   ObstacleGrid grid(glo, ghi, 2.0 * r, 4 * (gas.count + others) + 4096);
   for (std::size_t i = 0; i < def.balls.size(); ++i) {
     const sim::BallDef& b = def.balls[i];
@@ -296,6 +301,11 @@ std::size_t place_gas(sim::WorldDef& def, const GasSpec& gas) {
   }
   for (std::size_t w = 0; w < def.walls.size(); ++w)
     grid.add_segment(def.walls[w].from, def.walls[w].to, static_cast<std::uint32_t>(w * 2 + 1));
+  for (std::size_t k = 0; k < def.turtles.size(); ++k) {
+    const sim::TurtleDef& t = def.turtles[k];
+    if (grid.touches(t.pos, t.radius))
+      grid.add_disc(t.pos, t.radius, static_cast<std::uint32_t>((def.walls.size() + k) * 2 + 1));
+  }
 
   Random rng(gas.seed);
   def.balls.reserve(def.balls.size() + gas.count);

@@ -31,7 +31,7 @@ void centre_range(const GasSpec& gas, const sim::ArenaDef& arena, sim::Vec2& lo,
 
 /// Appends up to gas.count balls to def.balls, ids id_prefix + 0..count-1 numbered row by row from
 /// the bottom: uniformly at random in the region, whole disc inside the region and the arena, not
-/// overlapping def's walls, its earlier balls or each other; each with speed gas.speed in a
+/// overlapping def's walls, its earlier balls, its turtles or each other; each with speed gas.speed in a
 /// uniformly random direction. Deterministic: the same def and spec give bit-identical balls on
 /// every platform. Returns the number placed (less than count when the region is too full).
 /// O(count) expected time.

@@ -35,6 +35,10 @@ std::string xml_escape(std::string_view s) {
 constexpr std::array<std::array<int, 3>, 5> palette = {{
     {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
 
+/// Turtles and their trails: Tableau 10, distinct hues that stand out from the viridis balls.
+constexpr std::array<const char*, 10> turtle_colours = {"#4e79a7", "#f28e2b", "#e15759", "#76b7b2", "#59a14f",
+                                                         "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac"};
+
 std::string colour(double u) {
   u = std::clamp(u, 0.0, 1.0) * (palette.size() - 1);
   const auto k = std::min(static_cast<std::size_t>(u), palette.size() - 2);
@@ -57,6 +61,17 @@ Snapshot snapshot_of(const sim::WorldDef& def) {
     for (auto& w : sim::arena_walls(def.arena)) s.walls.push_back(std::move(w));
   s.balls.reserve(def.balls.size());
   for (const auto& b : def.balls) s.balls.push_back({b.pos, b.vel, b.radius});
+  for (const auto& t : def.turtles) s.turtles.push_back({t.id, t.pos, t.heading, t.radius, {}, false});
+  return s;
+}
+
+Snapshot snapshot_of(const turtle::WorldServer& server, const sim::WorldDef& def) {
+  Snapshot s = snapshot_of(server.world(), def);
+  for (std::size_t i = 0; i < s.turtles.size() && i < server.turtle_count(); ++i) {
+    turtle::WorldServer::TurtleInfo info = server.turtle(i);
+    s.turtles[i].trail = std::move(info.trail);
+    s.turtles[i].fault = !info.fault.empty();
+  }
   return s;
 }
 
@@ -88,7 +103,9 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
       << "<title>" << title << " at t = " << fmt(snap.time) << " s</title>\n"
       << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
       << "<text x=\"" << fmt(margin) << "\" y=\"" << fmt(margin + 14) << "\" font-size=\"16\">" << title
-      << " — t = " << fmt(snap.time) << " s, " << snap.balls.size() << " balls</text>\n";
+      << " — t = " << fmt(snap.time) << " s, " << snap.balls.size() << " balls";
+  if (!snap.turtles.empty()) out << ", " << snap.turtles.size() << " turtle" << (snap.turtles.size() == 1 ? "" : "s");
+  out << "</text>\n";
 
   // World coordinates inside the group: +y up, one world unit = scale pixels.
   out << "<g transform=\"translate(" << fmt(margin) << ' ' << fmt(top + ah * scale) << ") scale(" << fmt(scale)
@@ -104,9 +121,49 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
     out << "<circle cx=\"" << fmt(b.pos.x) << "\" cy=\"" << fmt(b.pos.y) << "\" r=\"" << fmt(b.radius)
         << "\" fill=\"" << colour(speeds[i] / v_scale) << "\"/>\n";
   }
+  // Trails under the turtles, so a turtle is never hidden by its own path.
+  for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
+    const auto& t = snap.turtles[i];
+    if (t.trail.size() < 2) continue;
+    out << "<polyline class=\"trail\" fill=\"none\" stroke=\"" << turtle_colours[i % turtle_colours.size()]
+        << "\" stroke-width=\"1.5\" stroke-linejoin=\"round\" vector-effect=\"non-scaling-stroke\" points=\"";
+    for (std::size_t k = 0; k < t.trail.size(); ++k)
+      out << (k == 0 ? "" : " ") << fmt(t.trail[k].x) << ',' << fmt(t.trail[k].y);
+    out << "\"/>\n";
+  }
+  for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
+    const auto& t = snap.turtles[i];
+    // Logo convention: heading 0 points to +y and angles grow clockwise, so the direction is
+    // (sin h, cos h).
+    const sim::Vec2 tip = t.pos + t.radius * sim::Vec2{std::sin(t.heading), std::cos(t.heading)};
+    out << "<circle class=\"turtle\" cx=\"" << fmt(t.pos.x) << "\" cy=\"" << fmt(t.pos.y) << "\" r=\"" << fmt(t.radius)
+        << "\" fill=\"" << turtle_colours[i % turtle_colours.size()]
+        << "\" fill-opacity=\"0.8\" stroke=\"#222\" stroke-width=\"1\" vector-effect=\"non-scaling-stroke\"/>\n"
+        << "<line class=\"heading\" x1=\"" << fmt(t.pos.x) << "\" y1=\"" << fmt(t.pos.y) << "\" x2=\"" << fmt(tip.x)
+        << "\" y2=\"" << fmt(tip.y)
+        << "\" stroke=\"#222\" stroke-width=\"2\" stroke-linecap=\"round\" vector-effect=\"non-scaling-stroke\"/>\n";
+    if (t.fault) {
+      const double d = t.radius * 0.7;
+      out << "<path class=\"fault\" d=\"M" << fmt(t.pos.x - d) << ',' << fmt(t.pos.y - d) << " L" << fmt(t.pos.x + d)
+          << ',' << fmt(t.pos.y + d) << " M" << fmt(t.pos.x - d) << ',' << fmt(t.pos.y + d) << " L" << fmt(t.pos.x + d)
+          << ',' << fmt(t.pos.y - d)
+          << "\" stroke=\"#c00\" stroke-width=\"2\" vector-effect=\"non-scaling-stroke\"/>\n";
+    }
+  }
   out << "</g>\n";
+  // Labels in pixel coordinates (outside the flipped group, so the text is upright), beside each
+  // turtle's upper right.
+  for (const auto& t : snap.turtles) {
+    const double px = margin + (t.pos.x + t.radius) * scale + 2.0, py = top + (ah - t.pos.y - t.radius) * scale;
+    out << "<text class=\"turtle-id\" x=\"" << fmt(px) << "\" y=\"" << fmt(py) << "\" font-size=\"11\">"
+        << xml_escape(t.id) << "</text>\n";
+  }
 
-  // Legend: a vertical colour bar from 0 (bottom) to v_max (top).
+  // Legend: a vertical colour bar from 0 (bottom) to v_max (top); only when there are balls.
+  if (snap.balls.empty()) {
+    out << "</svg>\n";
+    return;
+  }
   const double lx = margin + aw * scale + 24.0, ly = top + 16.0, lh = 120.0;
   out << "<defs><linearGradient id=\"speed\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">";
   for (std::size_t k = 0; k < palette.size(); ++k) {

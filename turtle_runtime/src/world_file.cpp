@@ -8,8 +8,10 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <optional>
 #include <initializer_list>
+#include <numbers>
+#include <optional>
+#include <set>
 #include <sstream>
 #include <unordered_map>
 #include <utility>
@@ -88,21 +90,28 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 
 /// Features that later versions add to the format: named so that a file written for them fails
 /// with a clear message rather than as an unknown key.
-constexpr std::array<std::string_view, 5> reserved_keys = {"turtles", "views", "expect", "game", "draw"};
+constexpr std::array<std::string_view, 4> reserved_keys = {"views", "expect", "game", "draw"};
+
+/// The commands of the built-in `script` controller; pendown and penup take no amount.
+constexpr std::array<std::string_view, 7> script_commands = {"forward", "back", "left", "right", "wait", "pendown", "penup"};
+
+/// Degrees (world files, the controller API) to radians (everything inside).
+constexpr double radians_per_degree = std::numbers::pi / 180.0;
 
 constexpr std::array<std::string_view, 4> arena_wall_ids = {"arena-bottom", "arena-right", "arena-top", "arena-left"};
 
-/// Reads one parsed document into a WorldDef, remembering where each ball came from so that a
-/// problem found later (by sim::validate) can be reported at its JSON path.
+/// Reads one parsed document into a Scene, remembering where each ball came from so that a
+/// problem found later (by sim::validate) can be reported at its JSON path. Controller names are
+/// checked against `registry` when one is given.
 class Reader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
+  Reader(std::string file, const turtle::Registry* registry) : file_(std::move(file)), registry_(registry) {}
 
   [[noreturn]] void fail(const std::string& path, const std::string& reason) const {
     throw WorldFileError(file_, path, reason);
   }
 
-  sim::WorldDef read(const json& doc, std::string_view default_name);
+  Scene read(const json& doc, std::string_view default_name);
 
  private:
   void expect_object(const json& v, const std::string& path, std::string_view what) const {
@@ -183,7 +192,8 @@ class Reader {
     if (!fresh) {
       if (it->second.empty())
         fail(p, "id \"" + s + "\" is taken by an arena wall of boundary \"walls\"; choose another id");
-      fail(p, "duplicate id \"" + s + "\" (already used at " + it->second + "); every wall and ball needs its own id");
+      fail(p, "duplicate id \"" + s + "\" (already used at " + it->second +
+                  "); every wall, ball and turtle needs its own id");
     }
     return s;
   }
@@ -192,11 +202,15 @@ class Reader {
   void read_effects(const json& v, sim::EffectsDef& effects);
   void read_walls(const json& v, std::vector<sim::WallDef>& walls);
   void read_balls(const json& v, std::vector<sim::BallDef>& balls);
+  void read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles, std::vector<turtle::TurtleProgram>& programs);
+  std::vector<turtle::SensorArc> read_sensors(const json& v, const std::string& path) const;
+  void check_script(const json& params, const std::string& path) const;
   std::vector<detail::GasSpec> read_gases(const json& v, const sim::WorldDef& def);
   std::string path_of(const sim::DefProblem& p) const;
   void check_gas_ids(const std::vector<detail::GasSpec>& gases) const;
 
   std::string file_;
+  const turtle::Registry* registry_;
   std::unordered_map<std::string, std::string> ids_;  // id -> JSON path of its "id" ("" for arena walls)
   std::size_t explicit_balls_ = 0;
   std::vector<std::size_t> gas_first_;  // index in WorldDef::balls of each gas entry's first ball
@@ -277,6 +291,149 @@ void Reader::read_balls(const json& v, std::vector<sim::BallDef>& balls) {
     if (const json* x = find(b, "mass")) def.mass = positive(*x, at(p, "mass"), "mass");
     if (const json* x = find(b, "charge")) def.charge = number(*x, at(p, "charge"));
     balls.push_back(std::move(def));
+  }
+}
+
+void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
+                          std::vector<turtle::TurtleProgram>& programs) {
+  const std::string path = "/turtles";
+  expect_array(v, path, "turtles");
+  turtles.reserve(v.size());
+  programs.reserve(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::string p = at(path, i);
+    const json& t = v[i];
+    expect_object(t, p, "a turtle");
+    check_keys(t, p, "a turtle",
+               {"id", "pos", "heading", "radius", "speed", "turn_rate", "controller", "params", "sensors", "pen", "gps",
+                "bounce"});
+    sim::TurtleDef body;
+    turtle::TurtleProgram program;
+    body.id = id(t, p, "a turtle");
+    body.pos = vec2(require(t, p, "pos", "a turtle"), at(p, "pos"));
+    // Angles are degrees in the file and radians inside: converted here, once. The heading is
+    // wrapped into [0, 360) first so that a state written back reads like the file.
+    double heading = 0.0;
+    if (const json* x = find(t, "heading")) heading = std::fmod(number(*x, at(p, "heading")), 360.0);
+    if (heading < 0.0) heading += 360.0;
+    if (heading >= 360.0) heading = 0.0;  // -1e-17 + 360 rounds to 360
+    body.heading = heading * radians_per_degree;
+    body.radius = 10.0;
+    if (const json* x = find(t, "radius")) body.radius = positive(*x, at(p, "radius"), "radius");
+    body.speed = 30.0;
+    if (const json* x = find(t, "speed")) body.speed = positive(*x, at(p, "speed"), "speed (units/s)");
+    double turn_rate = 90.0;
+    if (const json* x = find(t, "turn_rate")) turn_rate = positive(*x, at(p, "turn_rate"), "turn_rate (degrees/s)");
+    body.turn_rate = turn_rate * radians_per_degree;
+    if (const json* x = find(t, "bounce")) {
+      body.bounce = number(*x, at(p, "bounce"));
+      if (!(body.bounce >= 0.0 && body.bounce <= 1.0))
+        fail(at(p, "bounce"), "bounce must be in [0, 1] (got " + num(body.bounce) +
+                                  "); leave it out for the memo's dead stop at a contact");
+    }
+
+    if (const json* x = find(t, "controller")) {
+      program.controller = string(*x, at(p, "controller"));
+      if (registry_ && !registry_->find(program.controller)) {
+        std::string known;
+        for (const std::string& name : registry_->names()) known += (known.empty() ? "" : ", ") + name;
+        fail(at(p, "controller"), "controller '" + program.controller + "' is not registered; known: " + known);
+      }
+    }
+    if (const json* x = find(t, "params")) {
+      expect_object(*x, at(p, "params"), "params");
+      program.params = *x;
+    }
+    if (program.controller == "script") check_script(program.params, at(p, "params"));
+    if (const json* x = find(t, "sensors")) program.sensors = read_sensors(*x, at(p, "sensors"));
+    if (const json* x = find(t, "pen")) {
+      const std::string pp = at(p, "pen");
+      if (x->is_boolean()) {
+        program.pen_down = x->get<bool>();
+      } else if (x->is_string() && (*x == "up" || *x == "down")) {
+        program.pen_down = *x == "down";
+      } else {
+        fail(pp, "pen must be \"up\", \"down\", true (down) or false (up), got " +
+                     (x->is_string() ? "\"" + x->get<std::string>() + "\"" : kind_of(*x)));
+      }
+    }
+    if (const json* x = find(t, "gps")) program.gps = boolean(*x, at(p, "gps"));
+    turtles.push_back(std::move(body));
+    programs.push_back(std::move(program));
+  }
+}
+
+std::vector<turtle::SensorArc> Reader::read_sensors(const json& v, const std::string& path) const {
+  constexpr std::uint64_t max_sensors = 360;
+  if (v.is_number()) {
+    const std::uint64_t n = natural(v, path);
+    if (n < 1 || n > max_sensors)
+      fail(path, "a sensor count must be from 1 to " + std::to_string(max_sensors) + " (got " + std::to_string(n) + ")");
+    return turtle::equal_sensors(static_cast<int>(n));
+  }
+  const std::string shape =
+      "sensors must be a count (4: four equal arcs) or a list of arcs "
+      "[{\"name\": \"front\", \"from\": -45, \"to\": 45}, ...], got ";
+  if (!v.is_array()) fail(path, shape + kind_of(v));
+  if (v.empty()) fail(path, "a turtle needs at least one sensor; leave \"sensors\" out for the default four");
+  if (v.size() > max_sensors) fail(path, "at most " + std::to_string(max_sensors) + " sensors (got " + std::to_string(v.size()) + ")");
+  std::vector<turtle::SensorArc> arcs;
+  std::set<std::string> names;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const std::string p = at(path, k);
+    const json& a = v[k];
+    expect_object(a, p, "a sensor arc");
+    check_keys(a, p, "a sensor arc", {"name", "from", "to"});
+    turtle::SensorArc arc;
+    arc.name = string(require(a, p, "name", "a sensor arc"), at(p, "name"));
+    if (arc.name.empty()) fail(at(p, "name"), "a sensor's name must not be empty");
+    if (!names.insert(arc.name).second) fail(at(p, "name"), "duplicate sensor name \"" + arc.name + "\"");
+    arc.from = number(require(a, p, "from", "a sensor arc"), at(p, "from"));
+    arc.to = number(require(a, p, "to", "a sensor arc"), at(p, "to"));
+    // Degrees clockwise from the heading, [from, to): an arc through the heading has a negative from.
+    if (!(arc.from < arc.to) || arc.to - arc.from > 360.0)
+      fail(p, "sensor \"" + arc.name + "\" covers [" + num(arc.from) + ", " + num(arc.to) +
+                  ") degrees; need from < to <= from + 360 (clockwise from the heading; an arc through the "
+                  "heading is written with a negative from, e.g. -45 to 45)");
+    arcs.push_back(std::move(arc));
+  }
+  return arcs;
+}
+
+void Reader::check_script(const json& params, const std::string& path) const {
+  // The script controller would only find these at run time, as a fault that stops the turtle; a
+  // typo in a scripted test world should stop the load instead.
+  check_keys(params, path, "the script controller's params", {"commands"});
+  const json* commands = find(params, "commands");
+  if (!commands) return;  // a script turtle without commands stands still: an obstacle
+  const std::string cp = at(path, "commands");
+  if (!commands->is_array())
+    fail(cp, "commands must be a list of [command, amount], e.g. [[\"forward\", 100], [\"right\", 90]], got " +
+                 kind_of(*commands));
+  std::string known;
+  for (std::string_view c : script_commands) known += (known.empty() ? "" : ", ") + std::string(c);
+  for (std::size_t k = 0; k < commands->size(); ++k) {
+    const std::string p = at(cp, k);
+    const json& c = (*commands)[k];
+    if (!c.is_array() || c.empty() || !c[0].is_string())
+      fail(p, "a command must be [command, amount], e.g. [\"forward\", 100], got " + c.dump());
+    const std::string name = c[0].get<std::string>();
+    if (std::find(script_commands.begin(), script_commands.end(), name) == script_commands.end())
+      fail(at(p, 0), "unknown command '" + name + "'; known: " + known);
+    if (name == "pendown" || name == "penup") {
+      if (c.size() != 1) fail(p, "'" + name + "' takes no amount: [\"" + name + "\"]");
+      continue;
+    }
+    if (c.size() != 2) fail(p, "'" + name + "' needs one number, e.g. [\"" + name + "\", 100], got " + c.dump());
+    const double amount = number(c[1], at(p, 1));
+    const char* unit = name == "wait" ? "seconds" : (name == "left" || name == "right") ? "degrees" : "units";
+    if (amount < 0.0)
+      fail(at(p, 1), "'" + name + "' needs an amount >= 0 in " + unit + " (got " + num(amount) + ")" +
+                         (name == "forward" ? "; use [\"back\", ...] to go backwards"
+                          : name == "back"  ? "; use [\"forward\", ...] to go forwards"
+                          : name == "left"  ? "; use [\"right\", ...] to turn the other way"
+                          : name == "right" ? "; use [\"left\", ...] to turn the other way"
+                                            : ""));
   }
 }
 
@@ -393,7 +550,7 @@ std::string Reader::path_of(const sim::DefProblem& p) const {
   return "";
 }
 
-sim::WorldDef Reader::read(const json& doc, std::string_view default_name) {
+Scene Reader::read(const json& doc, std::string_view default_name) {
   if (!doc.is_object()) fail("", "a world file must be a JSON object ({\"format\": \"turtlegas-world/1\", ...}), got " + kind_of(doc));
   const json* format = find(doc, "format");
   if (!format) fail("", "missing \"format\"; add \"format\": \"" + std::string(world_format) + "\" to the top-level object");
@@ -403,9 +560,11 @@ sim::WorldDef Reader::read(const json& doc, std::string_view default_name) {
     if (doc.contains(key))
       fail(at("", key), "\"" + std::string(key) + "\" is not supported yet by this version of turtlegas; remove it (or rename it \"x-" +
                             std::string(key) + "\" to keep it in the file)");
-  check_keys(doc, "", "the world", {"format", "name", "seed", "dt", "arena", "effects", "walls", "balls", "gas"});
+  check_keys(doc, "", "the world",
+             {"format", "name", "seed", "dt", "arena", "effects", "walls", "balls", "turtles", "gas"});
 
-  sim::WorldDef def;
+  Scene scene;
+  sim::WorldDef& def = scene.def;
   def.name = std::string(default_name);
   if (const json* v = find(doc, "name")) def.name = string(*v, "/name");
   if (const json* v = find(doc, "seed")) def.seed = natural(*v, "/seed");
@@ -417,9 +576,10 @@ sim::WorldDef Reader::read(const json& doc, std::string_view default_name) {
   if (const json* v = find(doc, "walls")) read_walls(*v, def.walls);
   if (const json* v = find(doc, "balls")) read_balls(*v, def.balls);
   explicit_balls_ = def.balls.size();
+  if (const json* v = find(doc, "turtles")) read_turtles(*v, def.turtles, scene.programs);
 
-  // The scene without its gases first: gases are placed around the walls and balls, which must
-  // therefore be sound.
+  // The scene without its gases first: gases are placed around the walls, balls and turtles,
+  // which must therefore be sound.
   if (auto problem = sim::validate(def)) fail(path_of(*problem), problem->message);
 
   if (const json* v = find(doc, "gas")) {
@@ -440,7 +600,7 @@ sim::WorldDef Reader::read(const json& doc, std::string_view default_name) {
     // their generated ids remain to be checked; that needs only their prefixes, not a million strings.
     check_gas_ids(gases);
   }
-  return def;
+  return scene;
 }
 
 /// Line and column (1-based, column in bytes) of the byte that nlohmann's parser stopped at.
@@ -464,7 +624,9 @@ WorldFileError::WorldFileError(std::string file_, std::string json_path_, std::s
       line(line_),
       column(column_) {}
 
-sim::WorldDef parse_world(std::string_view text, std::string_view file_name) {
+namespace {
+
+Scene parse(std::string_view text, std::string_view file_name, const turtle::Registry* registry) {
   const std::string file(file_name);
   json doc;
   try {
@@ -485,10 +647,10 @@ sim::WorldDef parse_world(std::string_view text, std::string_view file_name) {
     throw WorldFileError(file, "", "invalid JSON: " + what);
   }
   std::string stem = std::filesystem::path(file).stem().string();
-  return Reader(file).read(doc, stem);
+  return Reader(file, registry).read(doc, stem);
 }
 
-sim::WorldDef load_world_file(const std::filesystem::path& path) {
+Scene load(const std::filesystem::path& path, const turtle::Registry* registry) {
   const std::string file = path.string();
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
@@ -499,7 +661,21 @@ sim::WorldDef load_world_file(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw WorldFileError(file, "", std::string("cannot read: ") + std::strerror(errno));
-  return parse_world(text.str(), file);
+  return parse(text.str(), file, registry);
 }
+
+}  // namespace
+
+Scene parse_scene(std::string_view text, std::string_view file_name, const turtle::Registry& registry) {
+  return parse(text, file_name, &registry);
+}
+
+Scene load_scene(const std::filesystem::path& file, const turtle::Registry& registry) { return load(file, &registry); }
+
+sim::WorldDef parse_world(std::string_view text, std::string_view file_name) {
+  return parse(text, file_name, nullptr).def;
+}
+
+sim::WorldDef load_world_file(const std::filesystem::path& file) { return load(file, nullptr).def; }
 
 }  // namespace turtlegas::world

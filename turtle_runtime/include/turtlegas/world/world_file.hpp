@@ -6,8 +6,10 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "turtlegas/sim/world_def.hpp"
+#include "turtlegas/turtle/world_server.hpp"
 
 namespace turtlegas::world {
 
@@ -28,12 +30,28 @@ struct WorldFileError : std::runtime_error {
   std::size_t column = 0; ///< 1-based, in bytes, for JSON syntax errors only (0 otherwise)
 };
 
+/// A world file's contents: the bodies, and the program that drives each turtle.
+struct Scene {
+  sim::WorldDef def;  ///< accepted by sim::validate; turtles' angles in radians
+  /// programs[i] drives def.turtles[i]; controllers are registered, sensor arcs in degrees.
+  std::vector<turtle::TurtleProgram> programs;
+};
+
 /// Reads and checks a `turtlegas-world/1` file, generates its gases and returns a scene that
-/// sim::validate accepts. Throws WorldFileError (also for a file that cannot be read).
+/// sim::validate accepts and turtle::WorldServer can run with `registry`: every turtle's controller
+/// is registered there, and the `script` controller's commands are checked. Throws WorldFileError
+/// (also for a file that cannot be read).
+Scene load_scene(const std::filesystem::path& file, const turtle::Registry& registry);
+
+/// As load_scene, from text already in memory; file_name is used in messages and as the default
+/// scene name (its stem).
+Scene parse_scene(std::string_view text, std::string_view file_name, const turtle::Registry& registry);
+
+/// The bodies only: load_scene(file).def, with controller names left unchecked (no registry is
+/// given; `script` commands are still checked).
 sim::WorldDef load_world_file(const std::filesystem::path& file);
 
-/// As load_world_file, from text already in memory; file_name is used in messages and as the
-/// default scene name (its stem).
+/// As load_world_file, from text already in memory.
 sim::WorldDef parse_world(std::string_view text, std::string_view file_name);
 
 }  // namespace turtlegas::world

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: MIT
+// Turtles at scale: N turtles, each running its own coroutine program, in an arena with walls.
+// Prints one JSON line: turtle-steps per second, the cost of a coroutine switch, memory per turtle.
+//
+//   turtle_bench [--turtles N] [--steps S] [--controller NAME] [--mode exact|step] [--stack-kib K]
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "fiber.hpp"
+#include "turtlegas/controllers/registry.hpp"
+#include "turtlegas/turtle/world_server.hpp"
+
+using namespace turtlegas;
+
+namespace {
+
+// Resident and peak resident set size, bytes (from /proc/self/status).
+long status_kib(const std::string& key) {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind(key + ":", 0) == 0) return std::strtol(line.c_str() + key.size() + 1, nullptr, 10);
+  return -1;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Coroutine switch cost: one fiber that suspends forever; each resume() is two switches.
+double switch_ns(std::size_t stack_bytes) {
+  using turtle::detail::Fiber;
+  Fiber* self = nullptr;
+  Fiber f(
+      [&] {
+        for (;;) self->suspend();
+      },
+      stack_bytes);
+  self = &f;
+  const int n = 2'000'000;
+  f.resume(0);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < n; ++k) f.resume(0);
+  return seconds_since(t0) * 1e9 / (2.0 * n);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int turtles = 10000;
+  int steps = 300;
+  std::string controller = "wander";
+  sim::Mode mode = sim::Mode::exact;
+  std::size_t stack_kib = 32;
+  for (int k = 1; k + 1 < argc; k += 2) {
+    const std::string a = argv[k], v = argv[k + 1];
+    if (a == "--turtles") turtles = std::stoi(v);
+    else if (a == "--steps") steps = std::stoi(v);
+    else if (a == "--controller") controller = v;
+    else if (a == "--mode") mode = v == "step" ? sim::Mode::step : sim::Mode::exact;
+    else if (a == "--stack-kib") stack_kib = std::stoul(v);
+    else {
+      std::cerr << "turtle_bench: unknown option " << a << "\n";
+      return 2;
+    }
+  }
+  const long rss0 = status_kib("VmRSS");
+
+  // A square arena with walls and a few interior walls; turtles on a lattice, 30 units apart,
+  // radius 5, headings spread round the compass.
+  const int side = static_cast<int>(std::ceil(std::sqrt(turtles)));
+  const double pitch = 30.0, size = side * pitch + 40.0;
+  sim::WorldDef def;
+  def.name = "turtle bench";
+  def.seed = 1;
+  def.dt = 0.1;
+  def.arena.width = def.arena.height = size;
+  def.arena.boundary = sim::Boundary::walls;
+  for (int k = 1; k < 4; ++k) {
+    const double y = 20.0 + pitch * (k * side / 4);  // midway between two lattice rows
+    def.walls.push_back({"bar" + std::to_string(k), {size * 0.2, y}, {size * 0.8, y}});
+  }
+  std::vector<turtle::TurtleProgram> programs;
+  for (int k = 0; k < turtles; ++k) {
+    sim::TurtleDef t;
+    t.id = "t" + std::to_string(k);
+    t.pos = {20.0 + pitch * (k % side) + pitch / 2, 20.0 + pitch * (k / side) + pitch / 2};
+    t.heading = std::fmod(k * 2.399963, 2 * M_PI);  // golden-angle spread
+    t.radius = 5;
+    t.speed = 20;
+    t.turn_rate = M_PI;
+    def.turtles.push_back(t);
+    turtle::TurtleProgram p;
+    p.controller = controller;
+    p.params = {{"step", 60.0}, {"back_off", 2.0}};
+    programs.push_back(p);
+  }
+  turtle::ServerOptions options;
+  options.mode = mode;
+  options.stack_bytes = stack_kib * 1024;
+  options.program_budget = 10.0;
+  turtle::WorldServer server(def, programs, controllers::builtin_registry(), options);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  server.run_until(steps * def.dt);
+  const double wall = seconds_since(t0);
+  const long rss1 = status_kib("VmRSS");
+  const long hwm = status_kib("VmHWM");
+
+  const auto& st = server.world().stats();
+  const double turtle_steps = static_cast<double>(turtles) * steps;
+  nlohmann::json out = {
+      {"bench", "turtles"},
+      {"turtles", turtles},
+      {"steps", steps},
+      {"controller", controller},
+      {"mode", mode == sim::Mode::exact ? "exact" : "step"},
+      {"wall_seconds", wall},
+      {"turtle_steps_per_second", turtle_steps / wall},
+      {"ns_per_turtle_step", wall * 1e9 / turtle_steps},
+      {"contacts", st.turtle_wall + st.turtle_wall_end + st.turtle_turtle + st.turtle_ball},
+      {"events", st.events},
+      {"stack_reserved_bytes", server.stack_reservation()},
+      {"rss_bytes_per_turtle", (rss1 - rss0) * 1024.0 / turtles},
+      {"peak_rss_bytes_per_turtle", (hwm - rss0) * 1024.0 / turtles},
+      {"switch_ns", switch_ns(options.stack_bytes)},
+      {"max_overlap_relative", server.world().measure_overlap().relative},
+  };
+  std::cout << out.dump() << "\n";
+}
