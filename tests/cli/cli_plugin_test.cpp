@@ -107,6 +107,12 @@ TEST_CASE("plugins: a plugin's controllers are listed and run") {
 }
 
 TEST_CASE("plugins: a busy loop ends the run with exit 1 and leaves no outputs") {
+#if defined(__SANITIZE_ADDRESS__)
+  // Busy-loop recovery jumps out of a signal handler across stacks, which AddressSanitizer cannot
+  // follow (see tests/runtime/world_server_test.cpp); this runs in the normal builds only.
+  WARN("skipped under AddressSanitizer");
+  return;
+#endif
   TempDir dir;
   const fs::path world = dir.path / "spin.json";
   std::ofstream(world) << R"({"format": "turtlegas-world/1", "arena": {"width": 100, "height": 100, "boundary": "walls"},

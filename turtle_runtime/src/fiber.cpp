@@ -265,7 +265,13 @@ Fiber::Outcome Fiber::resume(double budget_seconds) {
 
 void Fiber::suspend() {
   TURTLEGAS_ASAN_SWITCH(&impl_->inner_fake, impl_->outer_bottom, impl_->outer_size);
-  impl_->caller = std::move(impl_->caller).resume();
+  try {
+    impl_->caller = std::move(impl_->caller).resume();
+  } catch (const ctx::detail::forced_unwind&) {
+    // Destroyed while suspended: we are back on this stack to unwind it.
+    TURTLEGAS_ASAN_ARRIVE(impl_->inner_fake, &impl_->outer_bottom, &impl_->outer_size);
+    throw;
+  }
   TURTLEGAS_ASAN_ARRIVE(impl_->inner_fake, &impl_->outer_bottom, &impl_->outer_size);
 }
 
