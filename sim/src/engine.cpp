@@ -164,6 +164,7 @@ class Engine final : public EngineBase {
   TurtleState turtle(std::size_t k) const override;
   double turtle_radius(std::size_t k) const override { return body_[nb_ + k].r; }
   void command_turtle(std::size_t k, const TurtleCommand& command) override;
+  std::size_t add_wall(const WallDef& wall) override;
   std::vector<TurtleContact> take_turtle_contacts() override {
     std::vector<TurtleContact> out;
     out.swap(contacts_);
@@ -279,6 +280,7 @@ class Engine final : public EngineBase {
   std::vector<Segment> walls_;
   std::vector<WallEnd> ends_;
   CellGrid grid_;
+  double cell_ = 0.0;  ///< the cell side the grid was built for (rebuilt with it when walls are added)
 
   double now_ = 0.0;     ///< internal time, relative to t_base_
   double t_base_ = 0.0;  ///< external time of internal time zero
@@ -369,6 +371,7 @@ Engine<Flight, kBallBall, kStep, kTurtles>::Engine(const WorldDef& def, Mode) {
     if (boundary_ == Boundary::periodic) cell = std::max(rule * (1.0 + 1e-9), std::min(cell, std::min(width_, height_) / 3.0));
   }
   const bool periodic = boundary_ == Boundary::periodic;
+  cell_ = cell;
   grid_ = CellGrid(width_, height_, cell, periodic, walls_, ends_);
   if (periodic && (grid_.nx() < 3 || grid_.ny() < 3))
     throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell) +
@@ -956,6 +959,45 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::command_turtle(std::size_t k, c
   last_[id] = kNone;
   if constexpr (kStep) dmax_ = std::max(dmax_, travel_[id] + path_length(b.v, dt_ - now_));
   repredict(id);
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+std::size_t Engine<Flight, kBallBall, kStep, kTurtles>::add_wall(const WallDef& wall) {
+  const Vec2 d = wall.to - wall.from;
+  if (!(norm2(d) > 0.0) || !is_finite(wall.from) || !is_finite(wall.to))
+    throw std::invalid_argument("wall '" + wall.id + "' has zero length or a non-finite end; give it two distinct ends");
+  if (boundary_ == Boundary::periodic)
+    for (Vec2 p : {wall.from, wall.to})
+      if (p.x < 0.0 || p.x > width_ || p.y < 0.0 || p.y > height_)
+        throw std::invalid_argument("wall '" + wall.id + "' reaches outside a periodic arena; keep walls inside it");
+  const Segment seg = make_segment(wall.from, wall.to);
+  for (std::uint32_t i = 0; i < body_.size(); ++i) {
+    const Body& b = body_[i];
+    if (b.cell == kNone) continue;
+    const Vec2 rel = min_image(pos_at(b, i, now_ - b.t) - seg.p1);
+    const double foot = std::clamp(dot(rel, seg.u), 0.0, seg.len);
+    const double gap = norm(rel - foot * seg.u) - b.r;
+    if (gap < 0.0)
+      throw std::invalid_argument("wall '" + wall.id + "' would overlap " + (is_turtle(i) ? "a turtle" : "a ball") +
+                                  " (by " + std::to_string(-gap) + "); lay it clear of bodies");
+  }
+  // Append, so that the indices of walls and ends already named by predictions stay valid.
+  const auto w = static_cast<std::uint32_t>(walls_.size());
+  wall_defs_.push_back(wall);
+  walls_.push_back(seg);
+  for (Vec2 p : {wall.from, wall.to}) {
+    const bool known = std::any_of(ends_.begin(), ends_.end(), [&](const WallEnd& e) { return e.p == p; });
+    if (!known) ends_.push_back({p, w});
+  }
+  grid_ = CellGrid(width_, height_, cell_, grid_.periodic(), walls_, ends_);  // same cells, new lists
+  if constexpr (kStep) stamp_.assign(walls_.size() * 9 + ends_.size() * 9, 0);
+  // Every prediction may now meet the new wall first.
+  for (std::uint32_t i = 0; i < body_.size(); ++i) {
+    if (body_[i].cell == kNone) continue;
+    sync(i);
+    repredict(i);
+  }
+  return w;
 }
 
 template <class Flight, bool kBallBall, bool kStep, bool kTurtles>

@@ -29,6 +29,7 @@ class EngineBase {
   virtual double turtle_radius(std::size_t i) const = 0;
   virtual void command_turtle(std::size_t i, const TurtleCommand& command) = 0;
   virtual std::vector<TurtleContact> take_turtle_contacts() = 0;
+  virtual std::size_t add_wall(const WallDef& wall) = 0;
   virtual double cell_size() const = 0;
   virtual int cells_x() const = 0;
   virtual int cells_y() const = 0;

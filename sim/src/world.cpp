@@ -30,6 +30,7 @@ BallState World::ball(std::size_t i) const { return impl_->engine->ball(i); }
 double World::radius(std::size_t i) const { return impl_->engine->radius(i); }
 double World::mass(std::size_t i) const { return impl_->engine->mass(i); }
 const std::vector<WallDef>& World::walls() const { return impl_->engine->walls(); }
+std::size_t World::add_wall(const WallDef& wall) { return impl_->engine->add_wall(wall); }
 std::size_t World::turtle_count() const { return impl_->engine->turtle_count(); }
 TurtleState World::turtle(std::size_t i) const { return impl_->engine->turtle(i); }
 double World::turtle_radius(std::size_t i) const { return impl_->engine->turtle_radius(i); }

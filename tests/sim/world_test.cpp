@@ -272,3 +272,28 @@ TEST_CASE("step mode widens its search when a collision speeds a ball up", "[wor
     CHECK(w.ball(i).pos.x <= 199.0);
   }
 }
+
+TEST_CASE("a wall added while the world runs enters the predictions at once", "[world][walls]") {
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    INFO((mode == Mode::exact ? "exact" : "step"));
+    WorldDef d = box(200, 100);
+    d.balls.push_back(ball("b", {20, 50}, {10, 0}, 1));
+    World w(d, mode);
+    std::vector<Event> log;
+    w.set_event_log(&log);
+    w.advance_to(1.0);  // the ball is at x = 30
+    // Overlapping the ball: refused, nothing changes.
+    CHECK_THROWS_WITH(w.add_wall({"bad", {30, 0}, {30, 100}}), Catch::Contains("would overlap a ball"));
+    CHECK(w.walls().size() == 4);
+    const std::size_t k = w.add_wall({"new", {61, 20}, {61, 80}});
+    CHECK(w.walls()[k].id == "new");
+    w.advance_to(5.0);
+    // Contact when the centre reaches x = 60: t = 4.
+    REQUIRE(log.size() == 1);
+    CHECK(log[0].kind == EventKind::ball_wall);
+    CHECK(log[0].b == k);
+    CHECK(log[0].t == Approx(4.0).epsilon(1e-12));
+    CHECK(w.ball(0).vel.x == Approx(-10));
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}

@@ -110,8 +110,12 @@ class World {
   BallState ball(std::size_t i) const;
   double radius(std::size_t i) const;
   double mass(std::size_t i) const;
-  /// All walls, the scene's followed by the arena's (boundary `walls`).
+  /// All walls: the scene's, the arena's (boundary `walls`), then those added since.
   const std::vector<WallDef>& walls() const;
+  /// Adds a wall at the current time (a world built while it runs). It enters the grid and every
+  /// prediction at once. Returns its index. Throws std::invalid_argument, changing nothing, if it
+  /// has zero length, reaches outside a periodic arena, or overlaps a ball or a turtle.
+  std::size_t add_wall(const WallDef& wall);
 
   std::size_t turtle_count() const;
   TurtleState turtle(std::size_t i) const;
