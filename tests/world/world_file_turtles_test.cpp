@@ -176,8 +176,8 @@ TEST_CASE("bad turtle entries name their JSON path") {
 }
 
 TEST_CASE("bad sensor arcs name their JSON path") {
-  CHECK_ERROR(one(R"(, "sensors": 0)"), "/turtles/0/sensors", "a sensor count must be from 1 to 360 (got 0)");
-  CHECK_ERROR(one(R"(, "sensors": 1000)"), "/turtles/0/sensors", "a sensor count must be from 1 to 360");
+  CHECK_ERROR(one(R"(, "sensors": 0)"), "/turtles/0/sensors", "a sensor count must be from 1 to 64 (got 0)");
+  CHECK_ERROR(one(R"(, "sensors": 1000)"), "/turtles/0/sensors", "a sensor count must be from 1 to 64");
   CHECK_ERROR(one(R"(, "sensors": 2.5)"), "/turtles/0/sensors", "expected an integer >= 0, got 2.5");
   CHECK_ERROR(one(R"(, "sensors": "four")"), "/turtles/0/sensors", "sensors must be a count");
   CHECK_ERROR(one(R"(, "sensors": [])"), "/turtles/0/sensors", "a turtle needs at least one sensor");

@@ -364,7 +364,7 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
 }
 
 std::vector<turtle::SensorArc> Reader::read_sensors(const json& v, const std::string& path) const {
-  constexpr std::uint64_t max_sensors = 360;
+  constexpr std::uint64_t max_sensors = 64;  // the runtime reports fired sensors as a 64-bit mask
   if (v.is_number()) {
     const std::uint64_t n = natural(v, path);
     if (n < 1 || n > max_sensors)
