@@ -26,9 +26,13 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "tag_command.hpp"
+#include "test_command.hpp"
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/sim/world.hpp"
+#include "turtlegas/turtle/game.hpp"
 #include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/world/game_file.hpp"
 #include "turtlegas/world/svg_snapshot.hpp"
 #include "turtlegas/world/world_file.hpp"
 
@@ -258,7 +262,7 @@ tw::Scene load(const std::string& file, const tt::Registry& registry) {
 std::unique_ptr<tt::WorldServer> make_server(const tw::Scene& scene, const tt::Registry& registry,
                                              const tt::ServerOptions& options, const std::string& file) {
   try {
-    return std::make_unique<tt::WorldServer>(scene.def, scene.programs, registry, options);
+    return tw::make_server(scene, registry, options);  // with the scene's game (game_file.hpp)
   } catch (const std::invalid_argument& e) {
     throw BadInput(file + ": " + (options.mode == sim::Mode::exact ? "exact" : "step") + " mode: " + e.what());
   }
@@ -615,6 +619,15 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
       std::printf("  programs     %s  (touches %llu, faults %llu, finished %zu)\n", controller_summary(scene).c_str(),
                   ull(totals.touches), ull(totals.faults), totals.turtles_finished);
     }
+    if (server && server->game()) {  // the tag referee's score (game.hpp)
+      const nlohmann::json g = server->game()->score(world.time());
+      std::string line;
+      for (const auto& t : g.at("turtles"))
+        line += (line.empty() ? "" : ", ") + t.at("id").get<std::string>() + " " + fmt(t.at("time_it").get<double>()) +
+                " s/" + std::to_string(t.at("tags").get<std::size_t>());
+      std::printf("  tag          it now %s; time as it/tags made: %s\n", g.at("it").get<std::string>().c_str(),
+                  line.c_str());
+    }
     std::printf("  exits        %llu  (%zu balls left)\n", ull(st.exits), live);
     std::printf("  events       %llu  (cell crossings %llu, stale %llu, steps %llu)\n", ull(st.events),
                 ull(st.cell_crossings), ull(st.stale), ull(st.steps));
@@ -666,6 +679,14 @@ int main(int argc, char** argv) {
   CLI::App* list = app.add_subcommand("controllers", "List the controllers world files can name, with their params");
   list->add_option("--plugin", plugins, plugin_help);
 
+  turtlegas::apps::TestOptions test_opt;  // `turtlegas test` (test_command.hpp)
+  CLI::App* test = turtlegas::apps::add_test_command(app, test_opt);
+  test->add_option("--plugin", plugins, plugin_help);
+
+  turtlegas::apps::TagCommandOptions tag_opt;  // `turtlegas tag` (tag_command.hpp)
+  CLI::App* tag = turtlegas::apps::add_tag_command(app, tag_opt);
+  tag->add_option("--plugin", plugins, plugin_help);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -678,6 +699,14 @@ int main(int argc, char** argv) {
     load_plugins(plugins, registry);
     if (*list) return controllers_command(registry);
     if (*check) return check_command(check_world, registry);
+    if (*test) return turtlegas::apps::test_command(test_opt, registry);
+    if (*tag) {
+      try {
+        return turtlegas::apps::run_tag_command(tag_opt, registry);
+      } catch (const turtlegas::apps::TagBadInput& e) {
+        throw BadInput(e.what());
+      }
+    }
     return run_command(opt, registry);
   } catch (const BadInput& e) {
     spdlog::error("{}", e.what());

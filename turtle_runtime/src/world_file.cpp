@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gas.hpp"
+#include "turtlegas/world/game_file.hpp"
 
 namespace turtlegas::world {
 namespace {
@@ -90,7 +91,7 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 
 /// Features that later versions add to the format: named so that a file written for them fails
 /// with a clear message rather than as an unknown key.
-constexpr std::array<std::string_view, 4> reserved_keys = {"views", "expect", "game", "draw"};
+constexpr std::array<std::string_view, 2> reserved_keys = {"views", "draw"};
 
 /// The commands of the built-in `script` controller; pendown and penup take no amount.
 constexpr std::array<std::string_view, 7> script_commands = {"forward", "back", "left", "right", "wait", "pendown", "penup"};
@@ -561,7 +562,7 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
       fail(at("", key), "\"" + std::string(key) + "\" is not supported yet by this version of turtlegas; remove it (or rename it \"x-" +
                             std::string(key) + "\" to keep it in the file)");
   check_keys(doc, "", "the world",
-             {"format", "name", "seed", "dt", "arena", "effects", "walls", "balls", "turtles", "gas"});
+             {"format", "name", "seed", "dt", "arena", "effects", "walls", "balls", "turtles", "gas", "expect", "game"});
 
   Scene scene;
   sim::WorldDef& def = scene.def;
@@ -577,6 +578,8 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
   if (const json* v = find(doc, "balls")) read_balls(*v, def.balls);
   explicit_balls_ = def.balls.size();
   if (const json* v = find(doc, "turtles")) read_turtles(*v, def.turtles, scene.programs);
+  if (const json* v = find(doc, "game"))  // game_file.hpp
+    scene.game = read_game(*v, def, [this](const std::string& path, const std::string& reason) { fail(path, reason); });
 
   // The scene without its gases first: gases are placed around the walls, balls and turtles,
   // which must therefore be sound.
@@ -600,6 +603,8 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
     // their generated ids remain to be checked; that needs only their prefixes, not a million strings.
     check_gas_ids(gases);
   }
+  // Scripted test worlds (expect.hpp): read last, so that their ids can name any body.
+  if (const json* v = find(doc, "expect")) scene.expect = parse_expect(*v, file_, def);
   return scene;
 }
 

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "fiber.hpp"
+#include "turtlegas/turtle/game.hpp"
 
 namespace turtlegas::turtle {
 namespace {
@@ -137,6 +138,9 @@ class Agent {
   std::optional<sim::TurtleCommand> command;  // issued by the program, taken by the scheduler
   std::vector<Touch> inbox;                   // touches to deliver when the program resumes
   std::function<void(const Touch&)> handler;
+  std::vector<Message> messages;              // messages to deliver when the program resumes
+  std::function<void(const Message&)> message_handler;
+  bool it = false;                            // the game's role, as Turtle::it() reports it
   std::vector<std::pair<sim::Vec2, Touch>> in_contact;  // world-frame normals of contacts in force
   std::vector<std::string> sensor_names;                  // what Touch::sensor_names points to
 
@@ -151,7 +155,7 @@ class Agent {
   Touch make_touch(const sim::TurtleContact& c) const;
 };
 
-class WorldServer::Impl {
+class WorldServer::Impl : public GameHost {
  public:
   sim::WorldDef def;
   sim::World world;
@@ -159,6 +163,7 @@ class WorldServer::Impl {
   std::vector<std::unique_ptr<Agent>> agents;
   std::vector<sim::Event> sim_log;
   std::vector<LogEvent>* log = nullptr;
+  std::unique_ptr<Game> game;
   std::uint64_t step = 0;        // index of the next control boundary
   bool boundary_done = false;    // whether the programs have run at boundary `step`
 
@@ -179,6 +184,16 @@ class WorldServer::Impl {
     }
   }
   std::uint64_t sensors_for(const Agent& a, double bearing) const;
+
+  // GameHost: what a game may do.
+  std::size_t turtle_count() const override { return agents.size(); }
+  const std::string& turtle_id(std::size_t i) const override { return agents.at(i)->id; }
+  void send(std::size_t i, Message m) override {
+    Agent& a = *agents.at(i);
+    if (!a.finished) a.messages.push_back(std::move(m));
+  }
+  void set_it(std::size_t i, bool it) override { agents.at(i)->it = it; }
+  void log_event(LogEvent e) override { emit(std::move(e)); }
 };
 
 std::uint64_t WorldServer::Impl::sensors_for(const Agent& a, double bearing) const {
@@ -220,6 +235,10 @@ Result Agent::issue(sim::TurtleCommand c) {
   if (pen_down) trail.push_back(s.pos);
   if (handler)
     for (const Touch& t : delivered) handler(t);
+  std::vector<Message> letters;
+  letters.swap(messages);
+  if (message_handler)
+    for (const Message& m : letters) message_handler(m);
   const double done = c.kind == sim::TurtleCommand::Kind::turn ? s.done / kDeg : s.done;
   return Result(done, std::move(cut));
 }
@@ -240,6 +259,8 @@ void Turtle::pen_down() {
 }
 bool Turtle::pen_is_down() const { return agent_->pen_down; }
 void Turtle::on_touch(std::function<void(const Touch&)> handler) { agent_->handler = std::move(handler); }
+void Turtle::on_message(std::function<void(const Message&)> handler) { agent_->message_handler = std::move(handler); }
+bool Turtle::it() const { return agent_->it; }
 double Turtle::odometer() const { return agent_->odometer; }
 double Turtle::heading() const { return wrap_degrees(agent_->server->world.turtle(agent_->index).heading / kDeg); }
 std::optional<sim::Vec2> Turtle::position() const {
@@ -364,7 +385,8 @@ void WorldServer::Impl::run_program(Agent& a) {
 void WorldServer::Impl::control_step() {
   // 1. Contacts of the previous step become interrupts.
   const double now = world.time();
-  for (const sim::TurtleContact& c : world.take_turtle_contacts()) {
+  const std::vector<sim::TurtleContact> contacts = world.take_turtle_contacts();
+  for (const sim::TurtleContact& c : contacts) {
     Agent& a = *agents[c.turtle];
     Touch t = a.make_touch(c);
     LogEvent e{now, "touch", a.id, t.what, {}, t.bearing, {}};
@@ -374,6 +396,8 @@ void WorldServer::Impl::control_step() {
     a.in_contact.emplace_back(c.normal, t);
     if (!a.finished) a.inbox.push_back(std::move(t));
   }
+  // 1a. The game's referee, on the same contacts.
+  if (game) game->referee(now, contacts, *this);
   // 2. Programs, in world-file order, each until its next command.
   for (auto& ap : agents) {
     Agent& a = *ap;
@@ -431,6 +455,12 @@ void WorldServer::run_until(double t) {
 double WorldServer::time() const { return impl_->world.time(); }
 const sim::World& WorldServer::world() const { return impl_->world; }
 void WorldServer::set_event_log(std::vector<LogEvent>* log) { impl_->log = log; }
+void WorldServer::set_game(std::unique_ptr<Game> game) {
+  impl_->game = std::move(game);
+  for (auto& a : impl_->agents) a->it = false;
+  if (impl_->game) impl_->game->start(impl_->world.time(), *impl_);
+}
+const Game* WorldServer::game() const { return impl_->game.get(); }
 std::size_t WorldServer::turtle_count() const { return impl_->agents.size(); }
 
 WorldServer::TurtleInfo WorldServer::turtle(std::size_t i) const {

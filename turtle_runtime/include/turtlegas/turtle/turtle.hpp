@@ -91,6 +91,15 @@ class Result {
   std::optional<Touch> touch_;
 };
 
+/// A message to a program from the world (a game's referee, say): delivered when the program
+/// next resumes, after its touches. `data` is a JSON object with at least "kind"; the tag game
+/// sends {"kind": "tag", "it": true|false, "by": "<the other turtle's id>"}.
+struct Message {
+  nlohmann::json data = nlohmann::json::object();
+  double t = 0.0;  ///< seconds, when it was sent
+  std::string kind() const { return data.is_object() ? data.value("kind", std::string()) : std::string(); }
+};
+
 class Agent;  // the runtime's side of a turtle
 
 /// The handle a controller program drives its turtle with. Valid for the program's lifetime.
@@ -114,6 +123,13 @@ class Turtle {
   /// Installs an interrupt handler: called for each touch, in the turtle's program, before the
   /// program resumes from the command the touch cut short. Replaces any previous handler.
   void on_touch(std::function<void(const Touch&)> handler);
+  /// Installs a message handler: called for each message, in the turtle's program, when it next
+  /// resumes (after the on_touch handlers, before the command that was running returns). Replaces
+  /// any previous handler; messages that arrive with no handler installed are dropped.
+  void on_message(std::function<void(const Message&)> handler);
+  /// Whether this turtle is "it" in the world's tag game (false when the world has no game). It
+  /// changes at control-step boundaries, together with the message that announces it.
+  bool it() const;
 
   /// Odometry: distance driven in all (units) and heading (degrees, Logo convention).
   double odometer() const;

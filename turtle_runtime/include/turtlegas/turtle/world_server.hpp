@@ -4,10 +4,14 @@
 //
 // Order of one control step, at t = k dt (AI Memo 272, "On simulating turtles"):
 //   1. Contacts that involved turtles during the previous step become touch interrupts.
+//   1a. If the world has a game (set_game), its referee sees those contacts and may change roles
+//      (Turtle::it()), queue messages for programs and log events (a `tag`), all at t.
 //   2. Turtles are taken in world-file order. A turtle whose command is still running is left
 //      alone. Any other turtle first receives its interrupts (its on_touch handler runs for each,
-//      and each is logged as a `touch` event), then its program runs until it issues its next
-//      command (or yields, or returns); the command starts at once, at t.
+//      and each is logged as a `touch` event), then its messages (its on_message handler runs for
+//      each), then its program runs until it issues its next command (or yields, or returns); the
+//      command starts at once, at t. (A turtle-turtle contact ends both turtles' commands, so
+//      both hear about a tag at the boundary right after it.)
 //   3. The physics advances every body to (k+1) dt, earliest collision first. A turtle that
 //      touches something stops at the contact point at the exact contact time; its command ends
 //      there and the interrupt waits for the next step.
@@ -93,6 +97,8 @@ struct BusyLoopError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+class Game;  // game.hpp
+
 class WorldServer {
  public:
   /// programs[i] belongs to def.turtles[i]. Throws std::invalid_argument for a controller that is
@@ -110,6 +116,13 @@ class WorldServer {
 
   /// When set, events are appended to *log (nullptr stops).
   void set_event_log(std::vector<LogEvent>* log);
+
+  /// Makes the world's game referee (step 1a above); replaces any previous game. The game starts
+  /// at once (Game::start, at time()); its exceptions (std::invalid_argument for rules that do
+  /// not fit the world) propagate. nullptr removes the game.
+  void set_game(std::unique_ptr<Game> game);
+  /// The game, or nullptr.
+  const Game* game() const;
 
   struct TurtleInfo {
     std::string id;

@@ -3,13 +3,16 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "turtlegas/sim/world_def.hpp"
+#include "turtlegas/turtle/tag_game.hpp"
 #include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/world/expect.hpp"
 
 namespace turtlegas::world {
 
@@ -35,6 +38,10 @@ struct Scene {
   sim::WorldDef def;  ///< accepted by sim::validate; turtles' angles in radians
   /// programs[i] drives def.turtles[i]; controllers are registered, sensor arcs in degrees.
   std::vector<turtle::TurtleProgram> programs;
+  /// The world's game (the `game` key): the tag rules, when the world plays tag.
+  std::optional<turtle::TagRules> game;
+  /// The `expect` list of a scripted test world (empty when the file has none).
+  Expectations expect;
 };
 
 /// Reads and checks a `turtlegas-world/1` file, generates its gases and returns a scene that

@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: MIT
+// The world file's `game` key, worlds/tag.json and tag tournaments.
+#include <catch2/catch.hpp>
+
+#include <string>
+
+#include "turtlegas/controllers/registry.hpp"
+#include "turtlegas/turtle/tag_game.hpp"
+#include "turtlegas/world/game_file.hpp"
+#include "turtlegas/world/tag_tournament.hpp"
+#include "turtlegas/world/world_file.hpp"
+
+namespace tw = turtlegas::world;
+namespace tt = turtlegas::turtle;
+
+namespace {
+
+std::string world_with(const std::string& game, int turtles = 2) {
+  std::string text = R"({"format": "turtlegas-world/1", "arena": {"width": 200, "height": 200, "boundary": "walls"},
+                         "turtles": [)";
+  for (int i = 0; i < turtles; ++i)
+    text += std::string(i ? ", " : "") + R"({"id": "t)" + std::to_string(i + 1) + R"(", "pos": [)" +
+            std::to_string(40 + 50 * i) + ", 100]}";
+  return text + "]" + (game.empty() ? "" : ", \"game\": " + game) + "}";
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    tw::parse_scene(text, "w.json", tt::base_registry());
+  } catch (const tw::WorldFileError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+}  // namespace
+
+TEST_CASE("the game key", "[world][tag]") {
+  const tw::Scene s = tw::parse_scene(world_with(R"({"kind": "tag", "it": "t2", "no_tag_back": 1.5})"), "w.json",
+                                      tt::base_registry());
+  REQUIRE(s.game);
+  CHECK(s.game->it == "t2");
+  CHECK(s.game->no_tag_back == 1.5);
+  const tw::Scene d = tw::parse_scene(world_with(R"({"kind": "tag"})"), "w.json", tt::base_registry());
+  REQUIRE(d.game);
+  CHECK(d.game->it == "t1");  // the first turtle by default
+  CHECK(d.game->no_tag_back == 2.0);
+  CHECK(!tw::parse_scene(world_with(""), "w.json", tt::base_registry()).game);
+
+  CHECK(error_of(world_with(R"({"kind": "tig"})")) ==
+        "w.json: /game/kind: unknown game kind \"tig\"; the only kind so far is \"tag\"");
+  CHECK(error_of(world_with(R"({"kind": "tag", "it": "t7"})")) ==
+        "w.json: /game/it: no turtle has id 't7'; the turtles are: t1, t2");
+  CHECK_THAT(error_of(world_with(R"({"kind": "tag", "no_tag_back": -1})")), Catch::StartsWith("w.json: /game/no_tag_back:"));
+  CHECK_THAT(error_of(world_with(R"({"kind": "tag", "no_tag_bak": 1})")),
+             Catch::StartsWith("w.json: /game/no_tag_bak: unknown key"));
+  CHECK_THAT(error_of(world_with(R"({"kind": "tag"})", 1)), Catch::Contains("tag needs at least two turtles"));
+  CHECK_THAT(error_of(world_with(R"([])")), Catch::StartsWith("w.json: /game: game must be a JSON object"));
+}
+
+TEST_CASE("worlds/tag.json plays tag for a minute", "[world][tag]") {
+  const tt::Registry registry = turtlegas::controllers::builtin_registry();
+  const tw::Scene scene = tw::load_scene("worlds/tag.json", registry);
+  REQUIRE(scene.game);
+  CHECK(scene.def.turtles.size() >= 4);
+  CHECK(scene.def.turtles.size() <= 6);
+  auto server = tw::make_server(scene, registry, {});
+  std::vector<tt::LogEvent> log;
+  server->set_event_log(&log);
+  server->run_until(60.0);
+  const auto& tag = dynamic_cast<const tt::TagGame&>(*server->game());
+  const tt::TagScore score = tag.tally(server->time());
+  double total = 0;
+  std::size_t tags = 0;
+  for (std::size_t i = 0; i < score.ids.size(); ++i) total += score.time_it[i], tags += score.tags[i];
+  CHECK(total == Approx(60.0).epsilon(1e-12));
+  std::size_t logged = 0, faults = 0;
+  for (const auto& e : log) logged += e.kind == "tag", faults += e.kind == "fault";
+  CHECK(tags == logged);
+  CHECK(tags > 0);
+  CHECK(faults == 0);
+}
+
+TEST_CASE("a tag tournament is deterministic and reports every field", "[world][tag]") {
+  const tt::Registry registry = turtlegas::controllers::builtin_registry();
+  const tw::Scene scene = tw::load_scene("worlds/tag.json", registry);
+  tw::TournamentOptions options;
+  options.controllers = {"tag_chaser", "tag_evader", "tag_random"};
+  options.rounds = 6;
+  options.until = 20.0;
+  const tw::TournamentResult a = tw::run_tag_tournament(scene, "worlds/tag.json", options, registry);
+  const tw::TournamentResult b = tw::run_tag_tournament(scene, "worlds/tag.json", options, registry);
+  CHECK(tw::to_json(a) == tw::to_json(b));
+  CHECK(tw::ranking_table(a) == tw::ranking_table(b));
+
+  const nlohmann::json j = tw::to_json(a);
+  for (const char* key : {"format", "world", "rounds", "until", "controllers", "ranking", "round_results"})
+    CHECK(j.contains(key));
+  REQUIRE(j.at("ranking").size() == 3);
+  std::size_t turtle_rounds = 0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto& row = j.at("ranking")[k];
+    for (const char* key : {"rank", "controller", "rounds", "mean_time_it", "tags", "tags_per_round", "starts_it", "faults"})
+      CHECK(row.contains(key));
+    CHECK(row.at("rank") == k + 1);
+    if (k > 0) CHECK(row.at("mean_time_it").get<double>() >= j.at("ranking")[k - 1].at("mean_time_it").get<double>());
+    turtle_rounds += row.at("rounds").get<std::size_t>();
+  }
+  CHECK(turtle_rounds == 6 * scene.def.turtles.size());
+  REQUIRE(j.at("round_results").size() == 6);
+  for (std::size_t r = 0; r < 6; ++r) {
+    const auto& round = j.at("round_results")[r];
+    CHECK(round.at("seed") == scene.def.seed + r);
+    double total = 0;
+    for (const auto& t : round.at("turtles")) total += t.at("time_it").get<double>();
+    CHECK(total == Approx(20.0).epsilon(1e-12));
+  }
+  // Every controller starts as "it" in turn: rounds 0..2 start with t1 and rotate the controllers.
+  CHECK(a.rounds[0].first_it == "t1");
+  CHECK(a.rounds[3].first_it == "t2");
+  for (const auto& row : a.ranking) CHECK(row.starts_it == 2);
+
+  options.controllers = {"tag_chaser", "nobody"};
+  CHECK_THROWS_WITH(tw::run_tag_tournament(scene, "worlds/tag.json", options, registry),
+                    Catch::Contains("controller 'nobody' is not registered; known: "));
+}

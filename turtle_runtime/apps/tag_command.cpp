@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: MIT
+#include "tag_command.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "turtlegas/world/tag_tournament.hpp"
+#include "turtlegas/world/world_file.hpp"
+
+namespace turtlegas::apps {
+
+CLI::App* add_tag_command(CLI::App& app, TagCommandOptions& options) {
+  CLI::App* tag = app.add_subcommand("tag", "Play a blindfold-tag tournament between controllers on a world");
+  tag->add_option("world", options.world, "World file with two or more turtles (its \"game\" sets the rules)")
+      ->required();
+  tag->add_option("--controllers", options.controllers, "Comma-separated controller names, e.g. tag_chaser,tag_evader")
+      ->required();
+  tag->add_option("--rounds", options.rounds, "Rounds to play, each with its own seed")->capture_default_str();
+  tag->add_option("--until", options.until, "Simulated seconds per round")->capture_default_str();
+  tag->add_option("--json", options.json_out, "Write the ranking and every round's score here (JSON)");
+  tag->add_option("--mode", options.mode, "exact (event-driven) or step (the memo's fixed steps)")
+      ->check(CLI::IsMember({"exact", "step"}))
+      ->capture_default_str();
+  return tag;
+}
+
+int run_tag_command(const TagCommandOptions& options, const turtle::Registry& registry) {
+  world::TournamentOptions t;
+  std::string name;
+  for (char ch : options.controllers + ",") {
+    if (ch != ',') {
+      name += ch;
+    } else if (!name.empty()) {
+      t.controllers.push_back(name);
+      name.clear();
+    }
+  }
+  t.rounds = options.rounds;
+  t.until = options.until;
+  t.server.mode = options.mode == "step" ? sim::Mode::step : sim::Mode::exact;
+
+  world::Scene scene;
+  try {
+    scene = world::load_scene(options.world, registry);
+  } catch (const world::WorldFileError& e) {
+    throw TagBadInput(e.what());
+  }
+  world::TournamentResult result;
+  try {
+    result = world::run_tag_tournament(scene, options.world, t, registry);
+  } catch (const std::invalid_argument& e) {
+    throw TagBadInput(e.what());
+  }
+  std::printf("%s: %zu rounds of %g s, %zu turtles\n", options.world.c_str(), t.rounds, t.until,
+              scene.def.turtles.size());
+  std::fputs(world::ranking_table(result).c_str(), stdout);
+  if (!options.json_out.empty()) {
+    // Written beside the target and renamed into place, so a failed run leaves no half file.
+    const std::filesystem::path out(options.json_out), tmp(options.json_out + ".tmp");
+    {
+      std::ofstream f(tmp);
+      if (!f) throw TagBadInput("--json: cannot write " + tmp.string());
+      f << world::to_json(result).dump(2) << '\n';
+      if (!f) throw std::runtime_error("--json: writing " + tmp.string() + " failed");
+    }
+    std::filesystem::rename(tmp, out);
+  }
+  return 0;
+}
+
+}  // namespace turtlegas::apps

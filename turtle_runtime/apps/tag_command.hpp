@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: MIT
+// `turtlegas tag`: a blindfold-tag tournament between controllers (docs/controllers.md).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "turtlegas/turtle/world_server.hpp"
+
+namespace turtlegas::apps {
+
+struct TagCommandOptions {
+  std::string world;
+  std::string controllers;  ///< comma-separated
+  std::size_t rounds = 20;
+  double until = 60.0;
+  std::string json_out;
+  std::string mode = "exact";
+};
+
+/// Bad arguments or a bad world file: exit code 2.
+struct TagBadInput : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Adds the `tag` subcommand, its options bound to `options`.
+CLI::App* add_tag_command(CLI::App& app, TagCommandOptions& options);
+
+/// Plays the tournament, prints the ranking and writes the JSON. Throws TagBadInput for bad input.
+int run_tag_command(const TagCommandOptions& options, const turtle::Registry& registry);
+
+}  // namespace turtlegas::apps

@@ -1,0 +1,736 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/world/expect.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <set>
+#include <stdexcept>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "turtlegas/world/world_file.hpp"
+
+namespace turtlegas::world {
+namespace {
+
+using json = nlohmann::json;
+using sim::Vec2;
+
+/// Shortest decimal that reads back as the same double.
+std::string num(double v) {
+  std::array<char, 32> buf{};
+  auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  return std::string(buf.data(), r.ptr);
+}
+
+std::string vec(Vec2 v) {
+  std::string s = "[";
+  s += num(v.x);
+  s += ", ";
+  s += num(v.y);
+  s += ']';
+  return s;
+}
+
+std::string at(const std::string& path, std::string_view key) { return path + "/" + std::string(key); }
+
+/// The event kinds a run's log carries (sim's kinds, plus the runtime's touch and fault).
+constexpr std::array<std::string_view, 10> event_kinds = {
+    "ball-ball",     "ball-wall",      "ball-wall-end", "exit",  "turtle-wall",
+    "turtle-wall-end", "turtle-turtle", "turtle-ball",   "touch", "fault"};
+
+std::string join(const auto& items) {
+  std::string s;
+  for (const auto& k : items) s += (s.empty() ? "" : ", ") + std::string(k);
+  return s;
+}
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+/// `; did you mean "count"?` for a close misspelling of one of `known`, else empty.
+std::string suggestion(std::string_view key, const auto& known) {
+  std::string best;
+  std::size_t best_distance = 3;  // only close misspellings
+  for (std::string_view k : known) {
+    const std::size_t d = edit_distance(key, k);
+    if (d < best_distance) best_distance = d, best = k;
+  }
+  return best.empty() ? std::string() : "; did you mean \"" + best + "\"?";
+}
+
+// ---- event filters: {"event"|"no_event"|"count": KIND, "a": id, "b": id, "after": t, "before": t}
+
+struct EventFilter {
+  std::string kind;
+  std::string a, b;  // empty: any
+  double after = -std::numeric_limits<double>::infinity();
+  double before = std::numeric_limits<double>::infinity();
+
+  bool matches_bodies(const turtle::LogEvent& e) const {
+    return e.kind == kind && (a.empty() || e.a == a) && (b.empty() || e.b == b);
+  }
+  bool in_window(double t) const { return t >= after && t < before; }
+
+  static EventFilter parse(const json& entry, const std::string& path, std::string_view key, const ExpectParser& p) {
+    EventFilter f;
+    f.kind = p.event_kind(entry.at(std::string(key)), at(path, key));
+    if (auto it = entry.find("a"); it != entry.end()) f.a = p.body_id(*it, at(path, "a"));
+    if (auto it = entry.find("b"); it != entry.end()) f.b = p.body_id(*it, at(path, "b"));
+    if (auto it = entry.find("after"); it != entry.end()) f.after = p.non_negative(*it, at(path, "after"));
+    if (auto it = entry.find("before"); it != entry.end()) f.before = p.non_negative(*it, at(path, "before"));
+    if (!(f.after < f.before)) p.fail(path, "\"after\" (" + num(f.after) + ") must be less than \"before\" (" + num(f.before) + ")");
+    return f;
+  }
+
+  /// "touch (a t1, b w3) before t = 5"
+  std::string describe() const {
+    std::string s = kind;
+    if (!a.empty() || !b.empty()) {
+      s += " (";
+      if (!a.empty()) s += "a " + a;
+      if (!b.empty()) s += (a.empty() ? "b " : ", b ") + b;
+      s += ")";
+    }
+    if (std::isfinite(after)) s += " after t = " + num(after);
+    if (std::isfinite(before)) s += (std::isfinite(after) ? " and" : "") + std::string(" before t = ") + num(before);
+    return s;
+  }
+};
+
+std::string describe_event(const turtle::LogEvent& e) {
+  std::string s = "t = " + num(e.t) + " (" + e.a;
+  if (!e.b.empty()) s += " with " + e.b;
+  return s + ")";
+}
+
+/// {"event": KIND, ...}: at least one matching event in the window.
+class EventAssertion final : public Assertion {
+ public:
+  explicit EventAssertion(EventFilter f) : f_(std::move(f)) {}
+  std::unique_ptr<Check> start(const RunView&) const override {
+    struct C final : Check {
+      const EventFilter& f;
+      bool seen = false;
+      std::optional<turtle::LogEvent> outside;  // first match of the bodies outside the window
+      explicit C(const EventFilter& f_) : f(f_) {}
+      void on_event(const turtle::LogEvent& e, const RunView&) override {
+        if (seen || !f.matches_bodies(e)) return;
+        if (f.in_window(e.t)) seen = true;
+        else if (!outside) outside = e;
+      }
+      std::optional<std::string> finish(const RunView& v) override {
+        if (seen) return std::nullopt;
+        std::string m = "event " + f.describe() + ": none happened";
+        if (outside) m += " (the first such event is at " + describe_event(*outside) + ")";
+        else m += " by t = " + num(v.time());
+        return m;
+      }
+    };
+    return std::make_unique<C>(f_);
+  }
+
+ private:
+  EventFilter f_;
+};
+
+/// {"no_event": KIND, ...}: no matching event in the window.
+class NoEventAssertion final : public Assertion {
+ public:
+  explicit NoEventAssertion(EventFilter f) : f_(std::move(f)) {}
+  std::unique_ptr<Check> start(const RunView&) const override {
+    struct C final : Check {
+      const EventFilter& f;
+      std::optional<turtle::LogEvent> first;
+      std::size_t n = 0;
+      explicit C(const EventFilter& f_) : f(f_) {}
+      void on_event(const turtle::LogEvent& e, const RunView&) override {
+        if (!f.matches_bodies(e) || !f.in_window(e.t)) return;
+        if (!first) first = e;
+        ++n;
+      }
+      std::optional<std::string> finish(const RunView&) override {
+        if (!first) return std::nullopt;
+        std::string m = "no_event " + f.describe() + ": " + std::to_string(n) + " happened, the first at " +
+                        describe_event(*first);
+        if (!first->message.empty()) m += ": " + first->message;
+        return m;
+      }
+    };
+    return std::make_unique<C>(f_);
+  }
+
+ private:
+  EventFilter f_;
+};
+
+/// {"count": KIND, "min": n, "max": n, ...}: the number of matching events is within bounds.
+class CountAssertion final : public Assertion {
+ public:
+  CountAssertion(EventFilter f, std::optional<double> min, std::optional<double> max)
+      : f_(std::move(f)), min_(min), max_(max) {}
+  std::unique_ptr<Check> start(const RunView&) const override {
+    struct C final : Check {
+      const CountAssertion& self;
+      std::uint64_t n = 0;
+      explicit C(const CountAssertion& s) : self(s) {}
+      void on_event(const turtle::LogEvent& e, const RunView&) override {
+        n += self.f_.matches_bodies(e) && self.f_.in_window(e.t) ? 1 : 0;
+      }
+      std::optional<std::string> finish(const RunView&) override {
+        const double x = static_cast<double>(n);
+        const std::string head = "count " + self.f_.describe() + " = " + std::to_string(n) + ", wanted ";
+        if (self.min_ && x < *self.min_) return head + ">= " + num(*self.min_);
+        if (self.max_ && x > *self.max_) return head + "<= " + num(*self.max_);
+        return std::nullopt;
+      }
+    };
+    return std::make_unique<C>(*this);
+  }
+
+ private:
+  EventFilter f_;
+  std::optional<double> min_, max_;
+};
+
+std::shared_ptr<const Assertion> parse_event(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "event", {"a", "b", "after", "before"});
+  return std::make_shared<EventAssertion>(EventFilter::parse(e, path, "event", p));
+}
+
+std::shared_ptr<const Assertion> parse_no_event(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "no_event", {"a", "b", "after", "before"});
+  return std::make_shared<NoEventAssertion>(EventFilter::parse(e, path, "no_event", p));
+}
+
+std::shared_ptr<const Assertion> parse_count(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "count", {"a", "b", "after", "before", "min", "max"});
+  std::optional<double> min, max;
+  if (auto it = e.find("min"); it != e.end()) min = p.non_negative(*it, at(path, "min"));
+  if (auto it = e.find("max"); it != e.end()) max = p.non_negative(*it, at(path, "max"));
+  if (!min && !max) p.fail(path, "count needs \"min\", \"max\" or both, e.g. {\"count\": \"ball-wall\", \"min\": 10}");
+  if (min && max && *min > *max) p.fail(at(path, "min"), "min (" + num(*min) + ") is more than max (" + num(*max) + ")");
+  return std::make_shared<CountAssertion>(EventFilter::parse(e, path, "count", p), min, max);
+}
+
+// ---- {"inside": [[x0, y0], [x1, y1]], "who": ids or "*"}: centres stay in the region at every step
+
+class InsideAssertion final : public Assertion {
+ public:
+  InsideAssertion(Vec2 lo, Vec2 hi, std::vector<std::string> who) : lo_(lo), hi_(hi), who_(std::move(who)) {}
+  std::unique_ptr<Check> start(const RunView&) const override {
+    struct C final : Check {
+      const InsideAssertion& self;
+      std::optional<std::string> failure;
+      explicit C(const InsideAssertion& s) : self(s) {}
+      void test(const std::string& id, Vec2 pos, double t) {
+        if (failure) return;
+        if (pos.x >= self.lo_.x && pos.x <= self.hi_.x && pos.y >= self.lo_.y && pos.y <= self.hi_.y) return;
+        failure = "inside [" + vec(self.lo_) + ", " + vec(self.hi_) + "]: " + id + " is at " + vec(pos) +
+                  " at t = " + num(t);
+      }
+      void on_step(const RunView& v) override {
+        if (failure) return;
+        if (self.who_.empty()) {
+          v.for_each_body([&](const std::string& id, Vec2 pos) { test(id, pos, v.time()); });
+          return;
+        }
+        for (const std::string& id : self.who_) {
+          const RunView::Body b = v.body(id);
+          if (b.alive) test(id, b.pos, v.time());
+          else if (!failure) failure = "inside: " + id + " has left the arena by t = " + num(v.time());
+        }
+      }
+      std::optional<std::string> finish(const RunView&) override { return failure; }
+    };
+    return std::make_unique<C>(*this);
+  }
+
+ private:
+  Vec2 lo_, hi_;
+  std::vector<std::string> who_;
+};
+
+std::shared_ptr<const Assertion> parse_inside(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "inside", {"who"});
+  const json& r = e.at("inside");
+  const std::string rp = at(path, "inside");
+  if (!r.is_array() || r.size() != 2) p.fail(rp, "expected [[x0, y0], [x1, y1]] (two corners), got " + r.dump());
+  const Vec2 lo = p.vec2(r[0], rp + "/0"), hi = p.vec2(r[1], rp + "/1");
+  if (!(lo.x <= hi.x && lo.y <= hi.y)) p.fail(rp, "give the lower-left corner first: x0 <= x1 and y0 <= y1");
+  std::vector<std::string> who;
+  if (auto it = e.find("who"); it != e.end()) who = p.who(*it, at(path, "who"));
+  return std::make_shared<InsideAssertion>(lo, hi, std::move(who));
+}
+
+// ---- checks of one body at one time: near, heading, speed. "at": "end" (default) or a time.
+
+/// A check of one body sampled at the end or at a given time.
+class SampledAssertion : public Assertion {
+ public:
+  SampledAssertion(std::string who, std::optional<double> when) : who_(std::move(who)), at_(when) {}
+  std::vector<double> sample_times() const override {
+    return at_ ? std::vector<double>{*at_} : std::vector<double>{};
+  }
+  std::unique_ptr<Check> start(const RunView&) const override {
+    struct C final : Check {
+      const SampledAssertion& self;
+      std::optional<std::string> result;
+      bool sampled = false;
+      explicit C(const SampledAssertion& s) : self(s) {}
+      void on_step(const RunView& v) override {
+        if (sampled || !self.at_ || v.time() != *self.at_) return;
+        sampled = true;
+        result = self.test(v.body(self.who_), v.time());
+      }
+      std::optional<std::string> finish(const RunView& v) override {
+        if (!self.at_) return self.test(v.body(self.who_), v.time());
+        if (!sampled) return self.name() + " " + self.who_ + ": the run ended at t = " + num(v.time()) +
+                             " before t = " + num(*self.at_);
+        return result;
+      }
+    };
+    return std::make_unique<C>(*this);
+  }
+
+ protected:
+  virtual std::string name() const = 0;
+  /// The failure, or nullopt.
+  virtual std::optional<std::string> test(const RunView::Body& b, double t) const = 0;
+  std::string who_;
+  std::optional<double> at_;
+};
+
+class NearAssertion final : public SampledAssertion {
+ public:
+  NearAssertion(std::string who, std::optional<double> when, Vec2 point, double within)
+      : SampledAssertion(std::move(who), when), point_(point), within_(within) {}
+
+ private:
+  std::string name() const override { return "near " + vec(point_); }
+  std::optional<std::string> test(const RunView::Body& b, double t) const override {
+    const double d = std::hypot(b.pos.x - point_.x, b.pos.y - point_.y);
+    if (b.alive && d <= within_) return std::nullopt;
+    if (!b.alive) return name() + ": " + who_ + " has left the arena by t = " + num(t);
+    return name() + ": " + who_ + " is at " + vec(b.pos) + " at t = " + num(t) + ", distance " + num(d) +
+           ", wanted <= " + num(within_);
+  }
+  Vec2 point_;
+  double within_;
+};
+
+class HeadingAssertion final : public SampledAssertion {
+ public:
+  HeadingAssertion(std::string who, std::optional<double> when, double heading, double within)
+      : SampledAssertion(std::move(who), when), heading_(heading), within_(within) {}
+
+ private:
+  std::string name() const override { return "heading " + num(heading_); }
+  std::optional<std::string> test(const RunView::Body& b, double t) const override {
+    double d = std::fmod(std::abs(b.heading - heading_), 360.0);
+    d = std::min(d, 360.0 - d);
+    if (d <= within_) return std::nullopt;
+    return name() + ": " + who_ + " heads " + num(b.heading) + " degrees at t = " + num(t) + ", off by " + num(d) +
+           ", wanted <= " + num(within_);
+  }
+  double heading_;
+  double within_;
+};
+
+class SpeedAssertion final : public SampledAssertion {
+ public:
+  SpeedAssertion(std::string who, std::optional<double> when, std::optional<double> min, std::optional<double> max)
+      : SampledAssertion(std::move(who), when), min_(min), max_(max) {}
+
+ private:
+  std::string name() const override { return "speed"; }
+  std::optional<std::string> test(const RunView::Body& b, double t) const override {
+    const double s = std::hypot(b.vel.x, b.vel.y);
+    const std::string head = "speed " + who_ + " = " + num(s) + " at t = " + num(t) + ", wanted ";
+    if (min_ && !(s >= *min_)) return head + ">= " + num(*min_);
+    if (max_ && !(s <= *max_)) return head + "<= " + num(*max_);
+    return std::nullopt;
+  }
+  std::optional<double> min_, max_;
+};
+
+std::optional<double> parse_at(const json& e, const std::string& path, const ExpectParser& p) {
+  if (auto it = e.find("at"); it != e.end()) return p.at_time(*it, at(path, "at"));
+  return std::nullopt;
+}
+
+const json& required(const json& e, const std::string& path, std::string_view key, std::string_view kind,
+                     const ExpectParser& p) {
+  auto it = e.find(key);
+  if (it == e.end()) p.fail(path, std::string(kind) + " needs \"" + std::string(key) + "\"");
+  return *it;
+}
+
+std::shared_ptr<const Assertion> parse_near(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "near", {"who", "within", "at"});
+  const Vec2 point = p.vec2(e.at("near"), at(path, "near"));
+  std::string who = p.body_id(required(e, path, "who", "near", p), at(path, "who"));
+  const double within = p.non_negative(required(e, path, "within", "near", p), at(path, "within"));
+  return std::make_shared<NearAssertion>(std::move(who), parse_at(e, path, p), point, within);
+}
+
+std::shared_ptr<const Assertion> parse_heading(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "heading", {"who", "within", "at"});
+  const double heading = p.number(e.at("heading"), at(path, "heading"));
+  std::string who = p.turtle_id(required(e, path, "who", "heading", p), at(path, "who"));
+  double within = 1e-9;
+  if (auto it = e.find("within"); it != e.end()) within = p.non_negative(*it, at(path, "within"));
+  return std::make_shared<HeadingAssertion>(std::move(who), parse_at(e, path, p), heading, within);
+}
+
+std::shared_ptr<const Assertion> parse_speed(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "speed", {"min", "max", "at"});
+  std::string who = p.body_id(e.at("speed"), at(path, "speed"));
+  std::optional<double> min, max;
+  if (auto it = e.find("min"); it != e.end()) min = p.non_negative(*it, at(path, "min"));
+  if (auto it = e.find("max"); it != e.end()) max = p.non_negative(*it, at(path, "max"));
+  if (!min && !max) p.fail(path, "speed needs \"min\", \"max\" or both, e.g. {\"speed\": \"b1\", \"max\": 1e-9}");
+  return std::make_shared<SpeedAssertion>(std::move(who), parse_at(e, path, p), min, max);
+}
+
+// ---- {"energy": "conserved", "tolerance": rel}: |E(t) - E(0)| <= tol |E(0)| at every step
+
+class EnergyAssertion final : public Assertion {
+ public:
+  explicit EnergyAssertion(double tolerance) : tolerance_(tolerance) {}
+  std::unique_ptr<Check> start(const RunView& v) const override {
+    struct C final : Check {
+      double tolerance, e0, worst = 0.0, worst_t = 0.0, worst_e = 0.0;
+      C(double tol, double e) : tolerance(tol), e0(e), worst_e(e) {}
+      void on_step(const RunView& v) override {
+        const double e = v.world().energy();
+        const double rel = e0 != 0.0 ? std::abs(e - e0) / std::abs(e0) : std::abs(e - e0);
+        if (rel > worst) worst = rel, worst_t = v.time(), worst_e = e;
+      }
+      std::optional<std::string> finish(const RunView& v) override {
+        on_step(v);
+        if (worst <= tolerance) return std::nullopt;
+        return "energy conserved: " + num(e0) + " at t = 0, " + num(worst_e) + " at t = " + num(worst_t) +
+               " (relative change " + num(worst) + "), wanted <= " + num(tolerance);
+      }
+    };
+    return std::make_unique<C>(tolerance_, v.world().energy());
+  }
+
+ private:
+  double tolerance_;
+};
+
+std::shared_ptr<const Assertion> parse_energy(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "energy", {"tolerance"});
+  const std::string what = p.string(e.at("energy"), at(path, "energy"));
+  if (what != "conserved") p.fail(at(path, "energy"), "energy must be \"conserved\" (got \"" + what + "\")");
+  const double tol = p.non_negative(required(e, path, "tolerance", "energy", p), at(path, "tolerance"));
+  return std::make_shared<EnergyAssertion>(tol);
+}
+
+// ---- {"max_overlap": f}: no two bodies (or a body and a wall) overlap by more than f of a radius
+
+class OverlapAssertion final : public Assertion {
+ public:
+  explicit OverlapAssertion(double limit) : limit_(limit) {}
+  std::unique_ptr<Check> start(const RunView&) const override {
+    struct C final : Check {
+      double limit, worst = 0.0, worst_depth = 0.0, worst_t = 0.0;
+      explicit C(double l) : limit(l) {}
+      void on_step(const RunView& v) override {
+        const sim::Overlap o = v.world().measure_overlap();
+        if (o.relative > worst) worst = o.relative, worst_depth = o.depth, worst_t = v.time();
+      }
+      std::optional<std::string> finish(const RunView& v) override {
+        on_step(v);
+        const sim::Overlap seen = v.world().max_contact_overlap();
+        if (seen.relative > worst) worst = seen.relative, worst_depth = seen.depth, worst_t = -1.0;
+        if (worst <= limit) return std::nullopt;
+        return "max_overlap: " + num(worst) + " of a radius (depth " + num(worst_depth) + ")" +
+               (worst_t >= 0.0 ? " at t = " + num(worst_t) : std::string(" at a contact")) + ", wanted <= " + num(limit);
+      }
+    };
+    return std::make_unique<C>(limit_);
+  }
+
+ private:
+  double limit_;
+};
+
+std::shared_ptr<const Assertion> parse_max_overlap(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "max_overlap", {});
+  return std::make_shared<OverlapAssertion>(p.non_negative(e.at("max_overlap"), at(path, "max_overlap")));
+}
+
+/// The settings an `expect` list may hold besides assertions.
+constexpr std::array<std::string_view, 2> setting_keys = {"until", "mode"};
+
+}  // namespace
+
+// ---- the table of kinds
+
+const std::vector<AssertionKind>& assertion_kinds() {
+  // An explicit table: one line per kind. The tag game adds {"it", ...} here.
+  static const std::vector<AssertionKind> kinds = {
+      {"event", "an event of this kind (and a, b) happens (after/before t)", parse_event},
+      {"no_event", "no event of this kind (and a, b) happens (after/before t)", parse_no_event},
+      {"count", "the number of events of this kind is within min..max", parse_count},
+      {"inside", "the centres of `who` stay in a rectangle at every control step", parse_inside},
+      {"near", "`who` is within a distance of a point at the end (or at t)", parse_near},
+      {"heading", "turtle `who` heads this way (degrees) at the end (or at t)", parse_heading},
+      {"speed", "a ball's or turtle's speed is within min..max at the end (or at t)", parse_speed},
+      {"energy", "\"conserved\": relative change within tolerance at every control step", parse_energy},
+      {"max_overlap", "no overlap deeper than this fraction of a radius", parse_max_overlap},
+  };
+  return kinds;
+}
+
+// ---- RunView
+
+RunView::RunView(const turtle::WorldServer& server, const sim::WorldDef& def) : server_(server), def_(def) {}
+
+RunView::Body RunView::body(const std::string& id) const {
+  Body b;
+  const sim::World& w = world();
+  for (std::size_t i = 0; i < def_.turtles.size(); ++i)
+    if (def_.turtles[i].id == id) {
+      const sim::TurtleState s = w.turtle(i);
+      double h = std::fmod(s.heading * (180.0 / std::numbers::pi), 360.0);
+      if (h < 0.0) h += 360.0;
+      if (h >= 360.0) h = 0.0;
+      return {true, true, true, s.pos, s.vel, h};
+    }
+  for (std::size_t i = 0; i < def_.balls.size(); ++i)
+    if (def_.balls[i].id == id) {
+      const sim::BallState s = w.ball(i);
+      return {true, false, s.alive, s.pos, s.vel, 0.0};
+    }
+  return b;
+}
+
+// ---- ExpectParser
+
+ExpectParser::ExpectParser(std::string file, const sim::WorldDef& def) : file_(std::move(file)), def_(def) {}
+
+void ExpectParser::fail(const std::string& path, const std::string& reason) const {
+  throw WorldFileError(file_, path, reason);
+}
+
+void ExpectParser::check_keys(const json& entry, const std::string& path, std::string_view kind,
+                              std::initializer_list<std::string_view> known) const {
+  for (const auto& [key, value] : entry.items()) {
+    if (key == kind || key.starts_with("x-") || std::find(known.begin(), known.end(), key) != known.end()) continue;
+    std::string list = "\"" + std::string(kind) + "\"";
+    for (std::string_view k : known) list += ", \"" + std::string(k) + "\"";
+    fail(at(path, key), "unknown key \"" + key + "\" in a \"" + std::string(kind) + "\" expectation" +
+                            suggestion(key, known) + " (it takes " + list + "; keys starting with x- are ignored)");
+  }
+}
+
+double ExpectParser::number(const json& v, const std::string& path) const {
+  if (!v.is_number()) fail(path, "expected a number, got " + v.dump());
+  const double d = v.get<double>();
+  if (!std::isfinite(d)) fail(path, "expected a finite number");
+  return d;
+}
+
+double ExpectParser::non_negative(const json& v, const std::string& path) const {
+  const double d = number(v, path);
+  if (d < 0.0) fail(path, "expected a number >= 0, got " + num(d));
+  return d;
+}
+
+Vec2 ExpectParser::vec2(const json& v, const std::string& path) const {
+  if (!v.is_array() || v.size() != 2) fail(path, "expected [x, y] (an array of 2 numbers), got " + v.dump());
+  return {number(v[0], path + "/0"), number(v[1], path + "/1")};
+}
+
+std::string ExpectParser::string(const json& v, const std::string& path) const {
+  if (!v.is_string()) fail(path, "expected a string, got " + v.dump());
+  return v.get<std::string>();
+}
+
+std::string ExpectParser::body_id(const json& v, const std::string& path) const {
+  const std::string id = string(v, path);
+  for (const auto& t : def_.turtles)
+    if (t.id == id) return id;
+  for (const auto& b : def_.balls)
+    if (b.id == id) return id;
+  for (const auto& w : def_.walls)
+    if (w.id == id) return id;
+  if (def_.arena.boundary == sim::Boundary::walls &&
+      (id == "arena-bottom" || id == "arena-right" || id == "arena-top" || id == "arena-left"))
+    return id;
+  fail(path, "no wall, ball or turtle has id \"" + id + "\"");
+}
+
+std::string ExpectParser::turtle_id(const json& v, const std::string& path) const {
+  const std::string id = string(v, path);
+  for (const auto& t : def_.turtles)
+    if (t.id == id) return id;
+  fail(path, "no turtle has id \"" + id + "\"");
+}
+
+std::vector<std::string> ExpectParser::who(const json& v, const std::string& path) const {
+  if (v.is_string() && v.get<std::string>() == "*") return {};
+  auto one = [&](const json& x, const std::string& p) {
+    const std::string id = string(x, p);
+    for (const auto& t : def_.turtles)
+      if (t.id == id) return id;
+    for (const auto& b : def_.balls)
+      if (b.id == id) return id;
+    fail(p, "no ball or turtle has id \"" + id + "\"");
+  };
+  if (v.is_string()) return {one(v, path)};
+  if (!v.is_array() || v.empty()) fail(path, "who must be \"*\", an id or a non-empty list of ids, got " + v.dump());
+  std::vector<std::string> ids;
+  for (std::size_t i = 0; i < v.size(); ++i) ids.push_back(one(v[i], path + "/" + std::to_string(i)));
+  return ids;
+}
+
+std::string ExpectParser::event_kind(const json& v, const std::string& path) const {
+  const std::string k = string(v, path);
+  if (std::find(event_kinds.begin(), event_kinds.end(), k) == event_kinds.end())
+    fail(path, "unknown event kind \"" + k + "\"; known: " + join(event_kinds));
+  return k;
+}
+
+std::optional<double> ExpectParser::at_time(const json& v, const std::string& path) const {
+  if (v.is_string() && v.get<std::string>() == "end") return std::nullopt;
+  if (!v.is_number()) fail(path, "at must be \"end\" or a time >= 0 in seconds, got " + v.dump());
+  return non_negative(v, path);
+}
+
+// ---- parse_expect
+
+Expectations parse_expect(const json& expect, const std::string& file, const sim::WorldDef& def) {
+  const ExpectParser p(file, def);
+  Expectations out;
+  out.present = true;
+  const std::string path = "/expect";
+  if (!expect.is_array())
+    p.fail(path, "expect must be a list of expectations, e.g. [{\"until\": 10}, {\"no_event\": \"exit\"}], got " +
+                     expect.dump());
+  std::vector<std::string_view> all(setting_keys.begin(), setting_keys.end());
+  for (const AssertionKind& k : assertion_kinds()) all.push_back(k.key);
+  for (std::size_t i = 0; i < expect.size(); ++i) {
+    const std::string ep = path + "/" + std::to_string(i);
+    const json& e = expect[i];
+    if (!e.is_object()) p.fail(ep, "an expectation must be a JSON object ({\"count\": \"ball-wall\", ...}), got " + e.dump());
+    std::vector<std::string> kinds;
+    std::string unknown;
+    for (const auto& [key, value] : e.items())
+      if (std::find(all.begin(), all.end(), key) != all.end()) kinds.push_back(key);
+    if (kinds.empty()) {
+      for (const auto& [key, value] : e.items())
+        if (!key.starts_with("x-")) {
+          unknown = key;
+          break;
+        }
+      const std::string where = unknown.empty() ? ep : at(ep, unknown);
+      p.fail(where, (unknown.empty() ? std::string("empty expectation")
+                                     : "unknown assertion key \"" + unknown + "\"" + suggestion(unknown, all)) +
+                        " (an expectation names one of: " + join(all) + "; keys starting with x- are ignored)");
+    }
+    if (kinds.size() > 1)
+      p.fail(ep, "an expectation names one kind, this one names \"" + kinds[0] + "\" and \"" + kinds[1] +
+                     "\"; put each in its own entry");
+    const std::string& kind = kinds[0];
+    if (kind == "until") {
+      p.check_keys(e, ep, "until", {});
+      const double t = p.number(e.at("until"), at(ep, "until"));
+      if (!(t > 0.0)) p.fail(at(ep, "until"), "until must be a time > 0 in seconds (got " + num(t) + ")");
+      if (out.until) p.fail(ep, "a second {\"until\": ...}; a world has one run length");
+      out.until = t;
+      continue;
+    }
+    if (kind == "mode") {
+      p.check_keys(e, ep, "mode", {});
+      const std::string m = p.string(e.at("mode"), at(ep, "mode"));
+      if (m == "exact") out.modes = {sim::Mode::exact};
+      else if (m == "step") out.modes = {sim::Mode::step};
+      else if (m == "both") out.modes = {sim::Mode::exact, sim::Mode::step};
+      else p.fail(at(ep, "mode"), "mode must be \"exact\", \"step\" or \"both\" (got \"" + m + "\")");
+      continue;
+    }
+    const auto& table = assertion_kinds();
+    const auto it = std::find_if(table.begin(), table.end(), [&](const AssertionKind& k) { return k.key == kind; });
+    out.entries.push_back({i, kind, it->parse(e, ep, p)});
+  }
+  return out;
+}
+
+// ---- run_expectations
+
+ExpectResult run_expectations(const Scene& scene, const turtle::Registry& registry, sim::Mode mode,
+                              turtle::ServerOptions options) {
+  const sim::WorldDef& def = scene.def;
+  const Expectations& expect = scene.expect;
+  if (!expect.until) throw std::invalid_argument("the scene's expect list has no {\"until\": T}");
+  const double until = *expect.until;
+  options.mode = mode;
+  turtle::WorldServer server(def, scene.programs, registry, options);
+  std::vector<turtle::LogEvent> log;
+  server.set_event_log(&log);
+  const RunView view(server, def);
+
+  std::vector<std::unique_ptr<Check>> checks;
+  std::vector<double> times;
+  for (const auto& entry : expect.entries) {
+    checks.push_back(entry.assertion->start(view));
+    for (double t : entry.assertion->sample_times())
+      if (t <= until) times.push_back(t);
+  }
+  // Every control step boundary, as the server computes it (k dt), then the end.
+  for (std::uint64_t k = 1;; ++k) {
+    const double t = static_cast<double>(k) * def.dt;
+    if (!(t < until)) break;
+    times.push_back(t);
+  }
+  times.push_back(until);
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+
+  ExpectResult result;
+  result.assertions = checks.size();
+  for (auto& c : checks) c->on_step(view);
+  try {
+    for (double t : times) {
+      if (t <= 0.0) continue;
+      server.run_until(t);
+      for (const turtle::LogEvent& e : log)
+        for (auto& c : checks) c->on_event(e, view);
+      log.clear();
+      for (auto& c : checks) c->on_step(view);
+    }
+  } catch (const turtle::BusyLoopError& e) {
+    server.set_event_log(nullptr);
+    result.failures.push_back("the run stopped at t = " + num(server.time()) + ": " + e.what());
+    return result;
+  }
+  server.set_event_log(nullptr);
+  for (std::size_t i = 0; i < checks.size(); ++i)
+    if (auto failure = checks[i]->finish(view))
+      result.failures.push_back("expect[" + std::to_string(expect.entries[i].index) + "] " + *failure);
+  return result;
+}
+
+}  // namespace turtlegas::world

@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/world/game_file.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "turtlegas/world/world_file.hpp"
+
+namespace turtlegas::world {
+
+turtle::TagRules read_game(const nlohmann::json& game, const sim::WorldDef& def,
+                           const std::function<void(const std::string&, const std::string&)>& fail) {
+  auto die = [&](const std::string& path, const std::string& reason) {
+    fail(path, reason);
+    throw std::logic_error("read_game: fail() returned");  // fail must throw
+  };
+  if (!game.is_object()) die("/game", "game must be a JSON object ({\"kind\": \"tag\", \"it\": \"t1\"})");
+  for (const auto& [key, value] : game.items())
+    if (!key.starts_with("x-") && key != "kind" && key != "it" && key != "no_tag_back")
+      die("/game/" + key, "unknown key \"" + key +
+                              "\" in game (known keys: kind, it, no_tag_back; keys starting with x- are ignored)");
+  if (!game.contains("kind")) die("/game", "game needs \"kind\"; the only kind so far is \"tag\"");
+  if (!game["kind"].is_string() || game["kind"] != "tag")
+    die("/game/kind", "unknown game kind " + game["kind"].dump() + "; the only kind so far is \"tag\"");
+  if (def.turtles.size() < 2) die("/game", "tag needs at least two turtles (the world has " +
+                                                std::to_string(def.turtles.size()) + ")");
+  turtle::TagRules rules;
+  rules.it = def.turtles.front().id;
+  if (game.contains("it")) {
+    const auto& it = game["it"];
+    if (!it.is_string()) die("/game/it", "expected a turtle id (a string), got " + it.dump());
+    rules.it = it.get<std::string>();
+    bool found = false;
+    std::string known;
+    for (const auto& t : def.turtles) {
+      found = found || t.id == rules.it;
+      known += (known.empty() ? "" : ", ") + t.id;
+    }
+    if (!found) die("/game/it", "no turtle has id '" + rules.it + "'; the turtles are: " + known);
+  }
+  if (game.contains("no_tag_back")) {
+    const auto& v = game["no_tag_back"];
+    if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < 0.0)
+      die("/game/no_tag_back", "expected a time >= 0 in seconds, got " + v.dump());
+    rules.no_tag_back = v.get<double>();
+  }
+  return rules;
+}
+
+std::unique_ptr<turtle::Game> make_game(const Scene& scene) {
+  if (!scene.game) return nullptr;
+  return std::make_unique<turtle::TagGame>(*scene.game);
+}
+
+std::unique_ptr<turtle::WorldServer> make_server(const Scene& scene, const turtle::Registry& registry,
+                                                 const turtle::ServerOptions& options) {
+  auto server = std::make_unique<turtle::WorldServer>(scene.def, scene.programs, registry, options);
+  if (auto game = make_game(scene)) server->set_game(std::move(game));
+  return server;
+}
+
+}  // namespace turtlegas::world
