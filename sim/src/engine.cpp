@@ -26,6 +26,7 @@
 //   3. Move every ball to the end of the step and apply the field kick v += a dt. Balls outside an
 //      open arena exit; a periodic arena wraps them.
 //
+// kExtras: the scene has turtles or collision layers (or both); without them neither costs a thing.
 // Turtles are bodies too (ids after the balls', in cell lists of their own): discs of infinite
 // mass that fly straight at the velocity their current command gives, never feel fields, and stop
 // dead at a contact (or bounce, if asked). The end of a command is one more candidate in a
@@ -143,7 +144,7 @@ Vec2 heading_vector(double heading) {
   return {std::sin(heading), std::cos(heading)};
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
 class Engine final : public EngineBase {
  public:
   Engine(const WorldDef& def, Mode mode);
@@ -181,7 +182,21 @@ class Engine final : public EngineBase {
   double dt() const override { return dt_; }
 
  private:
-  bool is_turtle(std::uint32_t id) const { return kTurtles && id >= nb_; }
+  bool is_turtle(std::uint32_t id) const { return kExtras && id >= nb_; }
+  /// Collision layers: whether two bodies, or a body and a wall or wall end, can touch at all.
+  bool meets(std::uint32_t i, std::uint32_t j) const {
+    if constexpr (kExtras) return layers_[i].collides_with(layers_[j]);
+    else return true;
+  }
+  bool meets_wall(std::uint32_t i, std::uint32_t w) const {
+    if constexpr (kExtras) return layers_[i].collides_with(wall_layers_[w]);
+    else return true;
+  }
+  bool meets_end(std::uint32_t i, std::uint32_t e) const {
+    if constexpr (kExtras) return layers_[i].collides_with(end_layers_[e]);
+    else return true;
+  }
+  void add_end_layers(Vec2 p, const Layers& l);
   /// The acceleration a body flies under: the field for balls, none for turtles.
   Vec2 accel(std::uint32_t id) const { return is_turtle(id) ? Vec2{} : flight_.a; }
   bool straight(std::uint32_t id) const { return !Flight::kAccelerates || is_turtle(id); }
@@ -274,6 +289,9 @@ class Engine final : public EngineBase {
   std::vector<std::uint32_t> turtle_head_;  ///< turtles by cell (only when there are turtles)
   std::vector<TurtleRun> run_;
   std::vector<TurtleContact> contacts_;
+  std::vector<Layers> layers_;       ///< per body (kExtras only)
+  std::vector<Layers> wall_layers_;  ///< per wall (kExtras only)
+  std::vector<Layers> end_layers_;   ///< per end: its walls' categories and masks together
   EventQueue heap_;
 
   std::vector<WallDef> wall_defs_;
@@ -300,8 +318,8 @@ class Engine final : public EngineBase {
   std::vector<Event>* log_ = nullptr;
 };
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-Engine<Flight, kBallBall, kStep, kTurtles>::Engine(const WorldDef& def, Mode) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
   if (auto problem = validate(def)) throw std::invalid_argument(problem->message);
   const EffectsDef& fx = def.effects;
   if constexpr (kStep) kick_ = fx.gravity;
@@ -383,11 +401,20 @@ Engine<Flight, kBallBall, kStep, kTurtles>::Engine(const WorldDef& def, Mode) {
   if (inelastic_) last_time_.assign(n, -kNever);
   pending_.assign(n, Pending{});
   head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
-  if constexpr (kTurtles) turtle_head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
+  if constexpr (kExtras) turtle_head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
   heap_.reset(n);
   if constexpr (kStep) {
     travel_.assign(n, 0.0);
     stamp_.assign(walls_.size() * 9 + ends_.size() * 9, 0);
+  }
+  if constexpr (kExtras) {
+    layers_.resize(n);
+    for (std::uint32_t i = 0; i < nb_; ++i) layers_[i] = def.balls[i].layers;
+    for (std::size_t k = 0; k < def.turtles.size(); ++k) layers_[nb_ + k] = def.turtles[k].layers;
+    for (const auto& w : wall_defs_) wall_layers_.push_back(w.layers);
+    end_layers_.assign(ends_.size(), Layers{0u, 0u});
+    for (const auto& w : wall_defs_)
+      for (Vec2 p : {w.from, w.to}) add_end_layers(p, w.layers);
   }
   for (std::uint32_t i = 0; i < nb_; ++i) {
     const BallDef& d = def.balls[i];
@@ -422,8 +449,8 @@ Engine<Flight, kBallBall, kStep, kTurtles>::Engine(const WorldDef& def, Mode) {
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::link(std::uint32_t i, std::uint32_t cell) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::link(std::uint32_t i, std::uint32_t cell) {
   Body& b = body_[i];
   std::uint32_t& head = is_turtle(i) ? turtle_head_[cell] : head_[cell];
   b.cell = cell;
@@ -433,8 +460,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::link(std::uint32_t i, std::uint
   head = i;
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::unlink(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::unlink(std::uint32_t i) {
   Body& b = body_[i];
   if (b.prev != kNone) body_[b.prev].next = b.next;
   else (is_turtle(i) ? turtle_head_[b.cell] : head_[b.cell]) = b.next;
@@ -442,8 +469,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::unlink(std::uint32_t i) {
   b.next = b.prev = kNone;
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::sync(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::sync(std::uint32_t i) {
   Body& b = body_[i];
   const double dt = now_ - b.t;
   if constexpr (kStep) travel_[i] += path_length(b.v, dt);
@@ -455,11 +482,11 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::sync(std::uint32_t i) {
 // ---------------------------------------------------------------------------------------------
 // Predict
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::consider_ball(std::uint32_t i, const Body& bi, std::uint32_t j,
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::consider_ball(std::uint32_t i, const Body& bi, std::uint32_t j,
                                                                Vec2 shift, Pending& p) const {
   // i is a ball here, j a ball.
-  if (j == i) return;
+  if (j == i || !meets(i, j)) return;
   const Body& bj = body_[j];
   const double dtj = now_ - bj.t;
   // Under uniform gravity both balls fall alike, so their relative motion is a straight line.
@@ -476,11 +503,11 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::consider_ball(std::uint32_t i, 
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::consider_turtle(std::uint32_t i, const Body& bi, std::uint32_t j,
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::consider_turtle(std::uint32_t i, const Body& bi, std::uint32_t j,
                                                                  Vec2 shift, Pending& p) const {
   // j is a turtle (straight flight); i a ball or a turtle.
-  if (j == i) return;
+  if (j == i || !meets(i, j)) return;
   const Body& bj = body_[j];
   const Vec2 rel = bi.x - (bj.x + (now_ - bj.t) * bj.v + shift);
   const Vec2 v = bi.v - bj.v;
@@ -497,10 +524,10 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::consider_turtle(std::uint32_t i
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::consider_wall(std::uint32_t i, const Body& bi, std::uint32_t w,
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::consider_wall(std::uint32_t i, const Body& bi, std::uint32_t w,
                                                                Vec2 shift, Pending& p) const {
-  if (straight(i) && last_[i] == last_code(Partner::wall, w)) return;
+  if (!meets_wall(i, w) || (straight(i) && last_[i] == last_code(Partner::wall, w))) return;
   const Segment& s = walls_[w];
   // Relative to the wall's first end, so walls far from the origin lose nothing.
   const double t = now_ + toi_disc_segment(bi.x - (s.p1 + shift), bi.v, accel(i), s, bi.r);
@@ -511,10 +538,10 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::consider_wall(std::uint32_t i, 
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::consider_end(std::uint32_t i, const Body& bi, std::uint32_t e,
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::consider_end(std::uint32_t i, const Body& bi, std::uint32_t e,
                                                               Vec2 shift, Pending& p) const {
-  if (straight(i) && last_[i] == last_code(Partner::end, e)) return;
+  if (!meets_end(i, e) || (straight(i) && last_[i] == last_code(Partner::end, e))) return;
   const Vec2 rel = bi.x - (ends_[e].p + shift);
   double dt;
   if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(rel, bi.v, flight_.a, bi.r, p.t_coll - now_);
@@ -527,11 +554,12 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::consider_end(std::uint32_t i, c
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::consider_ball_from_turtle(std::uint32_t i, const Body& bi,
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::consider_ball_from_turtle(std::uint32_t i, const Body& bi,
                                                                            std::uint32_t j, Vec2 shift,
                                                                            Pending& p) const {
   // i is a turtle (straight flight), j a ball (which may fall).
+  if (!meets(i, j)) return;
   const Body& bj = body_[j];
   const double dtj = now_ - bj.t;
   const Vec2 rel = flight_.pos(bj.x, bj.v, dtj) + shift - bi.x;
@@ -549,8 +577,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::consider_ball_from_turtle(std::
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::scan_cell(std::uint32_t i, const Body& bi, int cell, Vec2 shift,
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::scan_cell(std::uint32_t i, const Body& bi, int cell, Vec2 shift,
                                                            Pending& p) const {
   // The bodies listed in one cell: balls (when the pair can collide) and turtles.
   if (!is_turtle(i)) {
@@ -559,12 +587,12 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::scan_cell(std::uint32_t i, cons
   } else {
     for (std::uint32_t j = head_[cell]; j != kNone; j = body_[j].next) consider_ball_from_turtle(i, bi, j, shift, p);
   }
-  if constexpr (kTurtles)
+  if constexpr (kExtras)
     for (std::uint32_t j = turtle_head_[cell]; j != kNone; j = body_[j].next) consider_turtle(i, bi, j, shift, p);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::predict(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::predict(std::uint32_t i) {
   const Body& bi = body_[i];
   Pending& p = pending_[i];
   p.t_coll = kNever;
@@ -631,8 +659,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::predict(std::uint32_t i) {
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::predict_strip(std::uint32_t i, int dir) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::predict_strip(std::uint32_t i, int dir) {
   // The three cells that have just come within the 3x3 neighbourhood after a crossing in `dir`.
   const Body& bi = body_[i];
   Pending& p = pending_[i];
@@ -649,8 +677,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::predict_strip(std::uint32_t i, 
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::predict_crossing(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::predict_crossing(std::uint32_t i) {
   const Body& b = body_[i];
   Pending& p = pending_[i];
   const int ix = grid_.ix_of(static_cast<int>(b.cell)), iy = grid_.iy_of(static_cast<int>(b.cell));
@@ -676,8 +704,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::predict_crossing(std::uint32_t 
 // ---------------------------------------------------------------------------------------------
 // Apply
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::process(double limit) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::process(double limit) {
   while (!heap_.empty() && heap_.top_key() <= limit) {
     const std::uint32_t i = heap_.top_id();
     now_ = heap_.top_key();
@@ -691,15 +719,15 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::process(double limit) {
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::repredict(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::repredict(std::uint32_t i) {
   predict(i);
   if constexpr (!kStep) predict_crossing(i);  // crossing times depend on the velocity just changed
   schedule(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::collide(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
   const Pending p = pending_[i];
   switch (p.kind) {
     case Partner::body:
@@ -724,15 +752,15 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::collide(std::uint32_t i) {
   schedule(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-double Engine<Flight, kBallBall, kStep, kTurtles>::restitution_for(std::uint32_t i) const {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+double Engine<Flight, kBallBall, kStep, kExtras>::restitution_for(std::uint32_t i) const {
   // The TC rule (Luding & McNamara): a ball that collided less than tc ago collides elastically,
   // so a cluster cannot collapse into infinitely many collisions in finite time.
   return now_ - last_time_[i] < tc_ ? 1.0 : e_;
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-Vec2 Engine<Flight, kBallBall, kStep, kTurtles>::bounce(std::uint32_t i, Vec2 v, Vec2 n) const {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+Vec2 Engine<Flight, kBallBall, kStep, kExtras>::bounce(std::uint32_t i, Vec2 v, Vec2 n) const {
   // n: unit contact normal pointing from the obstacle to the ball; v relative to the obstacle.
   // Walls take the plain restitution: the TC rule is for ball clusters; a ball pressed onto a wall
   // is kept from collapsing by the rest threshold below.
@@ -748,8 +776,8 @@ Vec2 Engine<Flight, kBallBall, kStep, kTurtles>::bounce(std::uint32_t i, Vec2 v,
   return v + (w + w_out) * n;
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::after_change(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::after_change(std::uint32_t i) {
   ++body_[i].count;
   if (inelastic_) last_time_[i] = now_;
   if constexpr (kStep) {
@@ -758,8 +786,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::after_change(std::uint32_t i) {
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::collide_balls(std::uint32_t i, std::uint32_t j) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::collide_balls(std::uint32_t i, std::uint32_t j) {
   sync(i);
   sync(j);
   Body& a = body_[i];
@@ -780,8 +808,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::collide_balls(std::uint32_t i, 
   repredict(j);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::touch(std::uint32_t id, EventKind kind, std::uint32_t other,
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::touch(std::uint32_t id, EventKind kind, std::uint32_t other,
                                                        Vec2 normal) {
   // A turtle touched something: its command ends here (a dead stop, or a bounce that coasts to the
   // next control step), and the contact waits for its touch sensors.
@@ -814,8 +842,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::touch(std::uint32_t id, EventKi
   contacts_.push_back({t_base_ + now_, static_cast<std::uint32_t>(k), kind, other, normal});
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::collide_with_turtle(std::uint32_t i, std::uint32_t j) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::collide_with_turtle(std::uint32_t i, std::uint32_t j) {
   sync(i);
   sync(j);
   // Name the pair (turtle, other) with the turtle first.
@@ -850,8 +878,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::collide_with_turtle(std::uint32
   repredict(o);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::collide_wall(std::uint32_t i, std::uint32_t w) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::collide_wall(std::uint32_t i, std::uint32_t w) {
   sync(i);
   Body& a = body_[i];
   const Segment& s = walls_[w];
@@ -872,8 +900,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::collide_wall(std::uint32_t i, s
   repredict(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::collide_end(std::uint32_t i, std::uint32_t e) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::collide_end(std::uint32_t i, std::uint32_t e) {
   sync(i);
   Body& a = body_[i];
   const Vec2 F = min_image(a.x - ends_[e].p);
@@ -893,8 +921,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::collide_end(std::uint32_t i, st
   repredict(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::end_command(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::end_command(std::uint32_t i) {
   // A turtle's command (or its coasting after a bounce) has run its course.
   sync(i);
   TurtleRun& r = run_[i - nb_];
@@ -911,8 +939,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::end_command(std::uint32_t i) {
   repredict(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::command_turtle(std::size_t k, const TurtleCommand& c) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, const TurtleCommand& c) {
   if (k >= run_.size()) throw std::out_of_range("command_turtle: no turtle " + std::to_string(k));
   const auto id = static_cast<std::uint32_t>(nb_ + k);
   if (body_[id].cell == kNone) return;  // it has left the arena
@@ -961,8 +989,19 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::command_turtle(std::size_t k, c
   repredict(id);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-std::size_t Engine<Flight, kBallBall, kStep, kTurtles>::add_wall(const WallDef& wall) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::add_end_layers(Vec2 p, const Layers& l) {
+  // An end is there for a body if any wall that ends there is.
+  for (std::size_t e = 0; e < ends_.size(); ++e)
+    if (ends_[e].p == p) {
+      end_layers_[e].category |= l.category;
+      end_layers_[e].mask |= l.mask;
+      return;
+    }
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+std::size_t Engine<Flight, kBallBall, kStep, kExtras>::add_wall(const WallDef& wall) {
   const Vec2 d = wall.to - wall.from;
   if (!(norm2(d) > 0.0) || !is_finite(wall.from) || !is_finite(wall.to))
     throw std::invalid_argument("wall '" + wall.id + "' has zero length or a non-finite end; give it two distinct ends");
@@ -974,6 +1013,8 @@ std::size_t Engine<Flight, kBallBall, kStep, kTurtles>::add_wall(const WallDef& 
   for (std::uint32_t i = 0; i < body_.size(); ++i) {
     const Body& b = body_[i];
     if (b.cell == kNone) continue;
+    if constexpr (kExtras)
+      if (!layers_[i].collides_with(wall.layers)) continue;  // it passes through this wall
     const Vec2 rel = min_image(pos_at(b, i, now_ - b.t) - seg.p1);
     const double foot = std::clamp(dot(rel, seg.u), 0.0, seg.len);
     const double gap = norm(rel - foot * seg.u) - b.r;
@@ -987,7 +1028,14 @@ std::size_t Engine<Flight, kBallBall, kStep, kTurtles>::add_wall(const WallDef& 
   walls_.push_back(seg);
   for (Vec2 p : {wall.from, wall.to}) {
     const bool known = std::any_of(ends_.begin(), ends_.end(), [&](const WallEnd& e) { return e.p == p; });
-    if (!known) ends_.push_back({p, w});
+    if (!known) {
+      ends_.push_back({p, w});
+      if constexpr (kExtras) end_layers_.push_back(Layers{0u, 0u});
+    }
+  }
+  if constexpr (kExtras) {
+    wall_layers_.push_back(wall.layers);
+    for (Vec2 p : {wall.from, wall.to}) add_end_layers(p, wall.layers);
   }
   grid_ = CellGrid(width_, height_, cell_, grid_.periodic(), walls_, ends_);  // same cells, new lists
   if constexpr (kStep) stamp_.assign(walls_.size() * 9 + ends_.size() * 9, 0);
@@ -1000,8 +1048,8 @@ std::size_t Engine<Flight, kBallBall, kStep, kTurtles>::add_wall(const WallDef& 
   return w;
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-TurtleState Engine<Flight, kBallBall, kStep, kTurtles>::turtle(std::size_t k) const {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+TurtleState Engine<Flight, kBallBall, kStep, kExtras>::turtle(std::size_t k) const {
   const auto id = static_cast<std::uint32_t>(nb_ + k);
   const Body& b = body_[id];
   const TurtleRun& r = run_[k];
@@ -1022,8 +1070,8 @@ TurtleState Engine<Flight, kBallBall, kStep, kTurtles>::turtle(std::size_t k) co
   return s;
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::cross(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::cross(std::uint32_t i) {
   ++stats_.cell_crossings;
   sync(i);
   Body& b = body_[i];
@@ -1053,8 +1101,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::cross(std::uint32_t i) {
   schedule(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::remove(std::uint32_t i) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::remove(std::uint32_t i) {
   unlink(i);
   body_[i].cell = kNone;
   ++body_[i].count;  // predictions made against it are now stale
@@ -1070,8 +1118,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::remove(std::uint32_t i) {
 // ---------------------------------------------------------------------------------------------
 // Time
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-double Engine<Flight, kBallBall, kStep, kTurtles>::rebase() {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+double Engine<Flight, kBallBall, kStep, kExtras>::rebase() {
   // Keep internal times small: absolute times would lose a bit of position per doubling of t.
   // All bodies are brought to now, which becomes internal zero. Amortised O(1) per event.
   events_since_rebase_ = 0;
@@ -1095,8 +1143,8 @@ double Engine<Flight, kBallBall, kStep, kTurtles>::rebase() {
   return shift;
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::begin_step() {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::begin_step() {
   // Internal time zero is the start of the step; all bodies are there.
   const std::size_t n = body_.size();
   for (std::uint32_t i = 0; i < n; ++i) {
@@ -1135,8 +1183,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::begin_step() {
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::finish_step() {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::finish_step() {
   now_ = dt_;
   for (std::uint32_t i = 0; i < body_.size(); ++i) {
     if (body_[i].cell == kNone) continue;
@@ -1160,8 +1208,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::finish_step() {
   begin_step();
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-void Engine<Flight, kBallBall, kStep, kTurtles>::advance_to(double t) {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::advance_to(double t) {
   if (!(t >= time())) throw std::invalid_argument("advance_to: time " + std::to_string(t) + " is before the world's time");
   if constexpr (kStep) {
     for (;;) {
@@ -1184,8 +1232,8 @@ void Engine<Flight, kBallBall, kStep, kTurtles>::advance_to(double t) {
 // ---------------------------------------------------------------------------------------------
 // Validate
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-double Engine<Flight, kBallBall, kStep, kTurtles>::energy() const {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+double Engine<Flight, kBallBall, kStep, kExtras>::energy() const {
   const Vec2 g = kStep ? kick_ : flight_.a;
   double e = 0.0;
   for (std::size_t i = 0; i < nb_; ++i) {
@@ -1196,8 +1244,8 @@ double Engine<Flight, kBallBall, kStep, kTurtles>::energy() const {
   return e;
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kTurtles>
-Overlap Engine<Flight, kBallBall, kStep, kTurtles>::measure_overlap() const {
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+Overlap Engine<Flight, kBallBall, kStep, kExtras>::measure_overlap() const {
   const std::size_t n = body_.size();
   std::vector<Vec2> pos(n);
   std::vector<double> rad(n);
@@ -1212,11 +1260,12 @@ Overlap Engine<Flight, kBallBall, kStep, kTurtles>::measure_overlap() const {
   if (!kBallBall && nb_ > 0) {
     // Balls pass through each other by request: measure walls for everyone, and pairs among the
     // turtles and between turtles and balls.
-    Overlap worst = reference::overlap(pos, rad, alive, walls_, periodic ? width_ : 0.0, periodic ? height_ : 0.0, false);
+    Overlap worst = reference::overlap(pos, rad, alive, walls_, periodic ? width_ : 0.0, periodic ? height_ : 0.0, false,
+                                       kExtras ? &layers_ : nullptr, kExtras ? &wall_layers_ : nullptr);
     for (std::uint32_t t = nb_; t < n; ++t) {
       if (!alive[t]) continue;
       for (std::uint32_t j = 0; j < n; ++j) {
-        if (j == t || !alive[j] || (j >= nb_ && j < t)) continue;
+        if (j == t || !alive[j] || (j >= nb_ && j < t) || !meets(t, j)) continue;
         const double depth = rad[t] + rad[j] - norm(min_image(pos[j] - pos[t]));
         if (depth > worst.depth) worst.depth = depth;
         if (depth / std::min(rad[t], rad[j]) > worst.relative) worst.relative = depth / std::min(rad[t], rad[j]);
@@ -1224,18 +1273,24 @@ Overlap Engine<Flight, kBallBall, kStep, kTurtles>::measure_overlap() const {
     }
     return worst;
   }
-  return reference::overlap(pos, rad, alive, walls_, periodic ? width_ : 0.0, periodic ? height_ : 0.0, true);
+  return reference::overlap(pos, rad, alive, walls_, periodic ? width_ : 0.0, periodic ? height_ : 0.0, true,
+                            kExtras ? &layers_ : nullptr, kExtras ? &wall_layers_ : nullptr);
 }
 
-template <class Flight, bool kBallBall, bool kTurtles>
+template <class Flight, bool kBallBall, bool kExtras>
 std::unique_ptr<EngineBase> make_for_mode(const WorldDef& def, Mode mode) {
-  if (mode == Mode::step) return std::make_unique<Engine<FreeFlight, kBallBall, true, kTurtles>>(def, mode);
-  return std::make_unique<Engine<Flight, kBallBall, false, kTurtles>>(def, mode);
+  if (mode == Mode::step) return std::make_unique<Engine<FreeFlight, kBallBall, true, kExtras>>(def, mode);
+  return std::make_unique<Engine<Flight, kBallBall, false, kExtras>>(def, mode);
 }
 
 template <class Flight, bool kBallBall>
 std::unique_ptr<EngineBase> make_with_turtles(const WorldDef& def, Mode mode) {
-  if (def.turtles.empty()) return make_for_mode<Flight, kBallBall, false>(def, mode);
+  const Layers plain{};
+  bool layered = false;
+  for (const auto& b : def.balls) layered = layered || !(b.layers == plain);
+  for (const auto& t : def.turtles) layered = layered || !(t.layers == plain);
+  for (const auto& w : def.walls) layered = layered || !(w.layers == plain);
+  if (def.turtles.empty() && !layered) return make_for_mode<Flight, kBallBall, false>(def, mode);
   return make_for_mode<Flight, kBallBall, true>(def, mode);
 }
 

@@ -25,7 +25,12 @@ double distance_to_segment(Vec2 p, const Segment& s) {
 }  // namespace
 
 Overlap overlap(const std::vector<Vec2>& pos, const std::vector<double>& radius, const std::vector<bool>& alive,
-                const std::vector<Segment>& walls, double periodic_width, double periodic_height, bool ball_pairs) {
+                const std::vector<Segment>& walls, double periodic_width, double periodic_height, bool ball_pairs,
+                const std::vector<Layers>* body_layers, const std::vector<Layers>* wall_layers) {
+  auto meet = [&](std::size_t i, std::size_t j) { return !body_layers || (*body_layers)[i].collides_with((*body_layers)[j]); };
+  auto meet_wall = [&](std::size_t i, std::size_t w) {
+    return !body_layers || !wall_layers || (*body_layers)[i].collides_with((*wall_layers)[w]);
+  };
   Overlap worst;
   auto note = [&](double depth, double r) {
     if (depth <= 0.0) return;
@@ -40,7 +45,9 @@ Overlap overlap(const std::vector<Vec2>& pos, const std::vector<double>& radius,
 
   for (std::size_t i = 0; i < n; ++i) {
     if (!alive[i]) continue;
-    for (const Segment& s : walls) {
+    for (std::size_t w = 0; w < walls.size(); ++w) {
+      const Segment& s = walls[w];
+      if (!meet_wall(i, w)) continue;
       Vec2 p = pos[i];
       if (periodic_width > 0.0) p = s.p1 + min_image(p - s.p1, periodic_width, periodic_height);
       note(radius[i] - distance_to_segment(p, s), radius[i]);
@@ -72,6 +79,7 @@ Overlap overlap(const std::vector<Vec2>& pos, const std::vector<double>& radius,
     for (std::size_t a = 0; a < keys.size(); ++a)
       for (std::size_t b = a + 1; b < keys.size(); ++b) {
         const std::size_t i = keys[a].i, j = keys[b].i;
+        if (!meet(i, j)) continue;
         const Vec2 d = min_image(pos[j] - pos[i], periodic_width, periodic_height);
         note(radius[i] + radius[j] - norm(d), std::min(radius[i], radius[j]));
       }
@@ -89,7 +97,7 @@ Overlap overlap(const std::vector<Vec2>& pos, const std::vector<double>& radius,
         auto it = std::lower_bound(keys.begin(), keys.end(), Key{cx, cy, 0}, less);
         for (; it != keys.end() && it->cx == cx && it->cy == cy; ++it) {
           const std::size_t i = k.i, j = it->i;
-          if (j <= i) continue;
+          if (j <= i || !meet(i, j)) continue;
           const Vec2 d = min_image(pos[j] - pos[i], periodic_width, periodic_height);
           note(radius[i] + radius[j] - norm(d), std::min(radius[i], radius[j]));
         }
@@ -116,13 +124,20 @@ std::vector<Event> events(const WorldDef& def, double t_end, std::vector<BallSta
   struct End {
     Vec2 p;
     std::uint32_t wall;
+    Layers layers{0u, 0u};  // an end is there for a ball if any wall ending there is
   };
   std::vector<End> ends;
   for (std::uint32_t w = 0; w < wall_defs.size(); ++w)
     for (Vec2 p : {wall_defs[w].from, wall_defs[w].to}) {
-      bool seen = false;
-      for (const End& x : ends) seen = seen || x.p == p;
-      if (!seen) ends.push_back({p, w});
+      End* seen = nullptr;
+      for (End& x : ends)
+        if (x.p == p) seen = &x;
+      if (!seen) {
+        ends.push_back({p, w});
+        seen = &ends.back();
+      }
+      seen->layers.category |= wall_defs[w].layers.category;
+      seen->layers.mask |= wall_defs[w].layers.mask;
     }
 
   const std::size_t n = def.balls.size();
@@ -158,14 +173,17 @@ std::vector<Event> events(const WorldDef& def, double t_end, std::vector<BallSta
         for (std::size_t j = i + 1; j < n; ++j) {
           if (!alive[j]) continue;
           if (last[i] == code(kBall, j) && last[j] == code(kBall, i)) continue;
+          if (!def.balls[i].layers.collides_with(def.balls[j].layers)) continue;
           offer(toi_disc_disc(x[j] - x[i], v[j] - v[i], r + def.balls[j].radius), kBall, i, j);
         }
       for (std::size_t w = 0; w < walls.size(); ++w) {
         if (!accel && last[i] == code(kWall, w)) continue;
+        if (!def.balls[i].layers.collides_with(wall_defs[w].layers)) continue;
         offer(toi_disc_segment(x[i] - walls[w].p1, v[i], g, walls[w], r), kWall, i, w);
       }
       for (std::size_t k = 0; k < ends.size(); ++k) {
         if (!accel && last[i] == code(kEnd, k)) continue;
+        if (!def.balls[i].layers.collides_with(ends[k].layers)) continue;
         offer(toi_disc_point_accel(x[i] - ends[k].p, v[i], g, r, best - now), kEnd, i, k);
       }
       if (def.arena.boundary == Boundary::none) {

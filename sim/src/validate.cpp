@@ -196,6 +196,9 @@ struct Discs {
     return is_ball(k) ? def.balls[k].id : def.turtles[k - def.balls.size()].id;
   }
   Where where(std::size_t k) const { return is_ball(k) ? Where::ball : Where::turtle; }
+  const Layers& layers(std::size_t k) const {
+    return is_ball(k) ? def.balls[k].layers : def.turtles[k - def.balls.size()].layers;
+  }
   std::size_t index(std::size_t k) const { return is_ball(k) ? k : k - def.balls.size(); }
   std::string name(std::size_t k) const {
     const char* noun = is_ball(k) ? "ball" : "turtle";
@@ -324,7 +327,8 @@ std::optional<DefProblem> check_ids(const WorldDef& def) {
 /// every disc lies inside it). Walls are entered in every cell their segment crosses, discs in
 /// every cell their bounding box covers; a pair that overlaps then shares at least one cell. In a
 /// periodic arena a disc that crosses an edge is also entered (and tested) at its shifted images.
-/// Two balls may overlap when ball-ball collisions are off; turtles always collide.
+/// Two balls may overlap when ball-ball collisions are off, and any two objects whose collision
+/// layers do not meet may overlap (they pass through each other).
 std::optional<DefProblem> check_overlaps(const WorldDef& def) {
   const Discs d{def};
   const std::size_t n = d.size();
@@ -381,6 +385,7 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
         grid.any(box(p, r), [&](std::uint32_t item) {
           const std::size_t j = item / 4;
           if (!balls_collide && d.is_ball(j) && d.is_ball(k)) return false;
+          if (!d.layers(j).collides_with(d.layers(k))) return false;
           Vec2 q = d.pos(j);
           if (item % 4 != 0) {
             images(j, other);
@@ -432,6 +437,7 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
       const Vec2 p = img[m];
       walls_grid.any(walls_grid.cover(p - Vec2{r, r}, p + Vec2{r, r}), [&](std::uint32_t w) {
         const WallDef& wall = def.walls[w];
+        if (!wall.layers.collides_with(d.layers(k))) return false;
         if (segment_distance2(p, wall.from, wall.to) < r * r) hit = w;
         return hit.has_value();
       });

@@ -14,9 +14,11 @@ namespace turtlegas::sim::reference {
 /// Deepest overlap among discs (ball-ball) and between discs and segments, found with a hash
 /// grid built from scratch (independent of the engine's grid). Periodic arenas use the minimum
 /// image when width/height are > 0. ball_pairs false checks discs against walls only.
+/// With layers given, pairs whose collision layers do not meet are skipped (they may overlap).
 Overlap overlap(const std::vector<Vec2>& pos, const std::vector<double>& radius,
                 const std::vector<bool>& alive, const std::vector<Segment>& walls,
-                double periodic_width = 0.0, double periodic_height = 0.0, bool ball_pairs = true);
+                double periodic_width = 0.0, double periodic_height = 0.0, bool ball_pairs = true,
+                const std::vector<Layers>* body_layers = nullptr, const std::vector<Layers>* wall_layers = nullptr);
 
 /// Exact-mode events up to t_end found by brute force: every pair and every wall checked after
 /// every event, O(N^2) per event, no grid, no event queue. Same contact rules as the engine.

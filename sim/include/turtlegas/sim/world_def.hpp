@@ -46,11 +46,24 @@ struct EffectsDef {
   double tc = 1e-4;
 };
 
+/// Collision layers. Every wall, ball and turtle is in some categories and collides with some;
+/// two objects collide when each is in a category the other collides with:
+/// `(a.category & b.mask) != 0 && (b.category & a.mask) != 0`. The defaults make everything
+/// collide with everything. A wall "not really there" for a turtle leaves the turtle's category
+/// out of its mask; an invisible turtle collides only with walls (mask = the walls' category).
+struct Layers {
+  std::uint32_t category = 1;       ///< bit set: the categories this object is in
+  std::uint32_t mask = 0xffffffffu;  ///< bit set: the categories it collides with
+  bool operator==(const Layers&) const = default;
+  bool collides_with(const Layers& o) const { return (category & o.mask) != 0 && (o.category & mask) != 0; }
+};
+
 /// A line-segment wall. Its two ends are collision objects of their own.
 struct WallDef {
   std::string id;
   Vec2 from;
   Vec2 to;
+  Layers layers{};
 };
 
 /// A disc ("ball", a gas molecule).
@@ -61,6 +74,7 @@ struct BallDef {
   double radius = 1.0;
   double mass = 1.0;
   double charge = 0.0;
+  Layers layers{};
 };
 
 /// A turtle's body: a disc that moves only as its program commands (see World::command_turtle).
@@ -75,6 +89,7 @@ struct TurtleDef {
   /// Negative (the default): the turtle stops dead at a contact (the memo's model). In [0, 1]: it
   /// bounces off with this restitution instead and coasts until the next control step.
   double bounce = -1.0;
+  Layers layers{};
 };
 
 /// A whole scene, independent of any file format.
