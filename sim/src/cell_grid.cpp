@@ -30,7 +30,8 @@ bool segment_meets_box(Vec2 p, Vec2 q, double x0, double y0, double x1, double y
 }  // namespace
 
 CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
-                   const std::vector<Segment>& walls, const std::vector<WallEnd>& ends)
+                   const std::vector<Segment>& walls, const std::vector<WallEnd>& ends,
+                   const std::vector<bool>& skip)
     : width_(width), height_(height), periodic_(periodic) {
   nx_ = std::max(1, static_cast<int>(std::floor(width / min_cell)));
   ny_ = std::max(1, static_cast<int>(std::floor(height / min_cell)));
@@ -49,6 +50,7 @@ CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
   auto col = [&](double x) { return std::clamp(static_cast<int>(std::floor(x / cw_)) + 1, 0, nx_ + 1); };
   auto row = [&](double y) { return std::clamp(static_cast<int>(std::floor(y / ch_)) + 1, 0, ny_ + 1); };
   for (std::uint32_t w = 0; w < walls.size(); ++w) {
+    if (w < skip.size() && skip[w]) continue;
     const Vec2 p = walls[w].p1, q = walls[w].p1 + walls[w].len * walls[w].u;
     const int ix0 = col(std::min(p.x, q.x) - sx), ix1 = col(std::max(p.x, q.x) + sx);
     const int iy0 = row(std::min(p.y, q.y) - sy), iy1 = row(std::max(p.y, q.y) + sy);

@@ -24,8 +24,10 @@ struct WallEnd {
 class CellGrid {
  public:
   CellGrid() = default;
+  /// Walls flagged in `skip` (moving walls, checked apart from the table) are not listed.
   CellGrid(double width, double height, double min_cell, bool periodic,
-           const std::vector<Segment>& walls, const std::vector<WallEnd>& ends);
+           const std::vector<Segment>& walls, const std::vector<WallEnd>& ends,
+           const std::vector<bool>& skip = {});
 
   int nx() const { return nx_; }
   int ny() const { return ny_; }

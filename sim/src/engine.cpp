@@ -89,7 +89,17 @@ static_assert(sizeof(Body) == 64);
 
 /// What a prediction is about. `body` partners are balls or turtles (ids are shared); `command`
 /// is the end of a turtle's own command.
-enum class Partner : std::uint8_t { none, body, wall, end, command };
+enum class Partner : std::uint8_t { none, body, wall, end, command, moving_end };
+
+/// A wall moving through keyframes: between two poses it translates at constant velocity u, so
+/// in its own frame every flight is the usual one with v - u.
+struct Mover {
+  std::uint32_t wall = 0;
+  std::size_t next = 0;  ///< the keyframe it is heading for (keys.size(): it has stopped)
+  Vec2 p1_ref;           ///< its first end at internal time t_ref
+  double t_ref = 0.0;
+  Vec2 u{};              ///< velocity, units/s
+};
 
 /// The earliest predicted collision of a ball, and when it leaves its cell (exact mode).
 struct Pending {
@@ -197,6 +207,11 @@ class Engine final : public EngineBase {
     else return true;
   }
   void add_end_layers(Vec2 p, const Layers& l);
+  Vec2 mover_p1(const Mover& m, double t) const { return m.p1_ref + (t - m.t_ref) * m.u; }
+  void aim_mover(Mover& m);
+  void keyframe();
+  void consider_mover(std::uint32_t i, const Body& bi, std::uint32_t mi, Pending& p) const;
+  void collide_moving_end(std::uint32_t i, std::uint32_t code);
   /// The acceleration a body flies under: the field for balls, none for turtles.
   Vec2 accel(std::uint32_t id) const { return is_turtle(id) ? Vec2{} : flight_.a; }
   bool straight(std::uint32_t id) const { return !Flight::kAccelerates || is_turtle(id); }
@@ -292,6 +307,11 @@ class Engine final : public EngineBase {
   std::vector<Layers> layers_;       ///< per body (kExtras only)
   std::vector<Layers> wall_layers_;  ///< per wall (kExtras only)
   std::vector<Layers> end_layers_;   ///< per end: its walls' categories and masks together
+  std::vector<Mover> movers_;                 ///< moving walls (kExtras only), outside the grid
+  std::vector<std::vector<WallKey>> keys_;    ///< their keyframes, by mover
+  std::vector<std::uint32_t> mover_of_;       ///< per wall: its mover, or kNone
+  std::vector<std::uint32_t> pushed_by_;      ///< per turtle: the mover pushing it, or kNone
+  double next_key_ = kNever;                  ///< internal time of the next keyframe of any mover
   EventQueue heap_;
 
   std::vector<WallDef> wall_defs_;
@@ -343,9 +363,29 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
           throw std::invalid_argument("wall '" + w.id + "' reaches outside a periodic arena; keep walls inside it");
     }
   }
+  // Moving walls are checked by every prediction rather than listed in the table.
+  mover_of_.assign(wall_defs_.size(), kNone);
+  for (std::uint32_t w = 0; w < wall_defs_.size(); ++w) {
+    const WallDef& wd = wall_defs_[w];
+    if (wd.keys.empty()) continue;
+    if constexpr (kStep) throw std::invalid_argument("wall '" + wd.id + "' moves: moving walls need --mode exact for now");
+    if (boundary_ == Boundary::periodic) throw std::invalid_argument("wall '" + wd.id + "' moves: moving walls are not supported in a periodic arena yet");
+    const Vec2 span = wd.to - wd.from;
+    double prev = 0.0;
+    for (const WallKey& k : wd.keys) {
+      if (!(k.t > prev)) throw std::invalid_argument("wall '" + wd.id + "': keyframe times must increase and be > 0");
+      if (norm(k.to - k.from - span) > 1e-12 * norm(span))
+        throw std::invalid_argument("wall '" + wd.id + "' rotates or stretches between keyframes; only translation is supported yet (keep to - from)");
+      prev = k.t;
+    }
+    mover_of_[w] = static_cast<std::uint32_t>(movers_.size());
+    movers_.push_back(Mover{w, 0, wd.from, 0.0, {}});
+    keys_.push_back(wd.keys);
+  }
   // Wall ends, one per distinct point: a corner shared by two walls is one collision object.
   for (std::uint32_t w = 0; w < wall_defs_.size(); ++w)
-    for (Vec2 p : {wall_defs_[w].from, wall_defs_[w].to}) ends_.push_back({p, w});
+    if (mover_of_[w] == kNone)
+      for (Vec2 p : {wall_defs_[w].from, wall_defs_[w].to}) ends_.push_back({p, w});
   std::stable_sort(ends_.begin(), ends_.end(), [](const WallEnd& a, const WallEnd& b) {
     return a.p.x != b.p.x ? a.p.x < b.p.x : a.p.y < b.p.y;
   });
@@ -390,7 +430,9 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
   }
   const bool periodic = boundary_ == Boundary::periodic;
   cell_ = cell;
-  grid_ = CellGrid(width_, height_, cell, periodic, walls_, ends_);
+  std::vector<bool> moving(wall_defs_.size());
+  for (std::uint32_t w = 0; w < wall_defs_.size(); ++w) moving[w] = mover_of_[w] != kNone;
+  grid_ = CellGrid(width_, height_, cell, periodic, walls_, ends_, moving);
   if (periodic && (grid_.nx() < 3 || grid_.ny() < 3))
     throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell) +
                                 "); enlarge the arena or use smaller balls");
@@ -436,6 +478,10 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
     r.turn_rate = d.turn_rate;
     r.bounce = d.bounce;
     link(id, static_cast<std::uint32_t>(grid_.arena_cell_of(d.pos)));
+  }
+  if constexpr (kExtras) {
+    pushed_by_.assign(def.turtles.size(), kNone);
+    for (Mover& m : movers_) aim_mover(m);
   }
   rebase_every_ = std::max<std::uint64_t>(4 * n, 4096);
   if constexpr (kStep) {
@@ -616,6 +662,8 @@ void Engine<Flight, kBallBall, kStep, kExtras>::predict(std::uint32_t i) {
       consider_wall(i, bi, it->item, grid_.shift(it->shift), p);
     for (auto it = grid_.near_ends_begin(bi.cell); it != grid_.near_ends_end(bi.cell); ++it)
       consider_end(i, bi, it->item, grid_.shift(it->shift), p);
+    if constexpr (kExtras)
+      for (std::uint32_t m = 0; m < movers_.size(); ++m) consider_mover(i, bi, m, p);
   } else {
     // The memo's rule normally makes this the 3x3 neighbourhood; a body sped up by a collision
     // inside the step widens the search instead of missing a partner.
@@ -706,7 +754,16 @@ void Engine<Flight, kBallBall, kStep, kExtras>::predict_crossing(std::uint32_t i
 
 template <class Flight, bool kBallBall, bool kStep, bool kExtras>
 void Engine<Flight, kBallBall, kStep, kExtras>::process(double limit) {
-  while (!heap_.empty() && heap_.top_key() <= limit) {
+  for (;;) {
+    const double next_event = heap_.empty() ? kNever : heap_.top_key();
+    if constexpr (kExtras) {
+      // A moving wall reaching a keyframe changes course: everything predicts again.
+      if (next_key_ <= limit && next_key_ <= next_event) {
+        keyframe();
+        continue;
+      }
+    }
+    if (next_event > limit) break;
     const std::uint32_t i = heap_.top_id();
     now_ = heap_.top_key();
     ++stats_.events;
@@ -743,6 +800,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
       return;
     case Partner::wall: collide_wall(i, p.partner); return;
     case Partner::end: collide_end(i, p.partner); return;
+    case Partner::moving_end: collide_moving_end(i, p.partner); return;
     case Partner::command: end_command(i); return;
     case Partner::none: break;
   }
@@ -883,15 +941,24 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_wall(std::uint32_t i, st
   sync(i);
   Body& a = body_[i];
   const Segment& s = walls_[w];
-  const double d = dot(min_image(a.x - s.p1), s.n);
+  const std::uint32_t mi = mover_of_[w];
+  const Vec2 p1 = mi == kNone ? s.p1 : mover_p1(movers_[mi], now_);
+  const Vec2 u = mi == kNone ? Vec2{} : movers_[mi].u;  // the wall's velocity
+  const double d = dot(min_image(a.x - p1), s.n);
   const Vec2 n = d >= 0.0 ? s.n : -s.n;
   note_contact(a.r - std::abs(d), a.r);
   if (is_turtle(i)) {
     ++stats_.turtle_wall;
     log(EventKind::turtle_wall, i - nb_, w);
     touch(i, EventKind::turtle_wall, w, n);
+    if (dot(u, n) > 0.0) {
+      // A moving wall pushing a turtle carries it along at its normal speed (both have
+      // infinite mass), until the wall's next keyframe.
+      a.v = dot(u, n) * n;
+      pushed_by_[i - nb_] = mi;
+    }
   } else {
-    a.v = bounce(i, a.v, n);
+    a.v = u + bounce(i, a.v - u, n);
     ++stats_.ball_wall;
     log(EventKind::ball_wall, i, w);
   }
@@ -990,6 +1057,115 @@ void Engine<Flight, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, co
 }
 
 template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::aim_mover(Mover& m) {
+  // From where it is now (at t_ref) towards its next pose, arriving at that pose's time.
+  const auto& keys = keys_[mover_of_[m.wall]];
+  if (m.next >= keys.size()) {
+    m.u = {};
+  } else {
+    const double t_key = keys[m.next].t - t_base_;
+    m.u = (keys[m.next].from - m.p1_ref) / (t_key - m.t_ref);
+  }
+  next_key_ = kNever;
+  for (const Mover& o : movers_) {
+    const auto& k = keys_[mover_of_[o.wall]];
+    if (o.next < k.size()) next_key_ = std::min(next_key_, k[o.next].t - t_base_);
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::keyframe() {
+  now_ = next_key_;
+  ++stats_.events;
+  for (Mover& m : movers_) {
+    const auto& keys = keys_[mover_of_[m.wall]];
+    if (m.next < keys.size() && keys[m.next].t - t_base_ <= now_) {
+      m.p1_ref = keys[m.next].from;  // exactly the keyframe's pose
+      m.t_ref = now_;
+      ++m.next;
+    }
+  }
+  for (Mover& m : movers_) aim_mover(m);
+  for (std::uint32_t i = 0; i < body_.size(); ++i) {
+    if (body_[i].cell == kNone) continue;
+    sync(i);
+    if (is_turtle(i) && pushed_by_[i - nb_] != kNone) {
+      // The push ends with the segment of motion that made it; the turtle stands where it is.
+      body_[i].v = {};
+      pushed_by_[i - nb_] = kNone;
+      ++body_[i].count;
+    }
+    // "Just collided, cannot meet again" does not survive a change of the wall's velocity.
+    const std::uint32_t kind = last_[i] == kNone ? 0 : last_[i] >> 29;
+    if (kind == static_cast<std::uint32_t>(Partner::moving_end) ||
+        (kind == static_cast<std::uint32_t>(Partner::wall) && mover_of_[last_[i] & ((1u << 29) - 1)] != kNone))
+      last_[i] = kNone;
+    repredict(i);
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::consider_mover(std::uint32_t i, const Body& bi, std::uint32_t mi,
+                                                               Pending& p) const {
+  // In the wall's frame the body flies with v - u; contacts after the next keyframe are not
+  // predicted (the keyframe makes everyone predict again).
+  const Mover& m = movers_[mi];
+  const std::uint32_t w = m.wall;
+  if (!meets_wall(i, w)) return;
+  const Segment& s = walls_[w];
+  const Vec2 p1 = mover_p1(m, now_);
+  const Vec2 v = bi.v - m.u;
+  const double horizon = std::min(p.t_coll, next_key_);
+  if (!(straight(i) && last_[i] == last_code(Partner::wall, w))) {
+    const double t = now_ + toi_disc_segment(bi.x - p1, v, accel(i), s, bi.r);
+    if (t < p.t_coll && t <= horizon) {
+      p.t_coll = t;
+      p.kind = Partner::wall;
+      p.partner = w;
+    }
+  }
+  for (std::uint32_t which = 0; which < 2; ++which) {
+    const std::uint32_t code = 2 * mi + which;
+    if (straight(i) && last_[i] == last_code(Partner::moving_end, code)) continue;
+    const Vec2 e = which == 0 ? p1 : p1 + s.len * s.u;
+    double dt;
+    if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(bi.x - e, v, flight_.a, bi.r, horizon - now_);
+    else dt = toi_disc_point(bi.x - e, v, bi.r);
+    const double t = now_ + dt;
+    if (t < p.t_coll && t <= horizon) {
+      p.t_coll = t;
+      p.kind = Partner::moving_end;
+      p.partner = code;
+    }
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::collide_moving_end(std::uint32_t i, std::uint32_t code) {
+  sync(i);
+  Body& a = body_[i];
+  const Mover& m = movers_[code / 2];
+  const Segment& s = walls_[m.wall];
+  const Vec2 p1 = mover_p1(m, now_);
+  const Vec2 e = code % 2 == 0 ? p1 : p1 + s.len * s.u;
+  const Vec2 F = a.x - e;
+  const double dist = norm(F);
+  note_contact(a.r - dist, a.r);
+  if (is_turtle(i)) {
+    ++stats_.turtle_wall_end;
+    log(EventKind::turtle_wall_end, i - nb_, m.wall);
+    touch(i, EventKind::turtle_wall_end, m.wall, F / dist);
+  } else {
+    a.v = m.u + bounce(i, a.v - m.u, F / dist);
+    ++stats_.ball_wall_end;
+    log(EventKind::ball_wall_end, i, m.wall);
+  }
+  after_change(i);
+  last_[i] = last_code(Partner::moving_end, code);
+  repredict(i);
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
 void Engine<Flight, kBallBall, kStep, kExtras>::add_end_layers(Vec2 p, const Layers& l) {
   // An end is there for a body if any wall that ends there is.
   for (std::size_t e = 0; e < ends_.size(); ++e)
@@ -1037,7 +1213,10 @@ std::size_t Engine<Flight, kBallBall, kStep, kExtras>::add_wall(const WallDef& w
     wall_layers_.push_back(wall.layers);
     for (Vec2 p : {wall.from, wall.to}) add_end_layers(p, wall.layers);
   }
-  grid_ = CellGrid(width_, height_, cell_, grid_.periodic(), walls_, ends_);  // same cells, new lists
+  mover_of_.push_back(kNone);
+  std::vector<bool> moving(walls_.size());
+  for (std::uint32_t k = 0; k < walls_.size(); ++k) moving[k] = mover_of_[k] != kNone;
+  grid_ = CellGrid(width_, height_, cell_, grid_.periodic(), walls_, ends_, moving);  // same cells, new lists
   if constexpr (kStep) stamp_.assign(walls_.size() * 9 + ends_.size() * 9, 0);
   // Every prediction may now meet the new wall first.
   for (std::uint32_t i = 0; i < body_.size(); ++i) {
@@ -1137,6 +1316,8 @@ double Engine<Flight, kBallBall, kStep, kExtras>::rebase() {
     r.t_start -= shift;
     r.t_end -= shift;
   }
+  for (Mover& m : movers_) m.t_ref -= shift;
+  next_key_ -= shift;
   t_base_ += shift;
   now_ = 0.0;
   heap_.shift_keys(shift);
@@ -1257,10 +1438,12 @@ Overlap Engine<Flight, kBallBall, kStep, kExtras>::measure_overlap() const {
     alive[i] = b.cell != kNone;
   }
   const bool periodic = boundary_ == Boundary::periodic;
+  std::vector<Segment> walls_now = walls_;
+  for (const Mover& m : movers_) walls_now[m.wall].p1 = mover_p1(m, now_);
   if (!kBallBall && nb_ > 0) {
     // Balls pass through each other by request: measure walls for everyone, and pairs among the
     // turtles and between turtles and balls.
-    Overlap worst = reference::overlap(pos, rad, alive, walls_, periodic ? width_ : 0.0, periodic ? height_ : 0.0, false,
+    Overlap worst = reference::overlap(pos, rad, alive, walls_now, periodic ? width_ : 0.0, periodic ? height_ : 0.0, false,
                                        kExtras ? &layers_ : nullptr, kExtras ? &wall_layers_ : nullptr);
     for (std::uint32_t t = nb_; t < n; ++t) {
       if (!alive[t]) continue;
@@ -1273,7 +1456,7 @@ Overlap Engine<Flight, kBallBall, kStep, kExtras>::measure_overlap() const {
     }
     return worst;
   }
-  return reference::overlap(pos, rad, alive, walls_, periodic ? width_ : 0.0, periodic ? height_ : 0.0, true,
+  return reference::overlap(pos, rad, alive, walls_now, periodic ? width_ : 0.0, periodic ? height_ : 0.0, true,
                             kExtras ? &layers_ : nullptr, kExtras ? &wall_layers_ : nullptr);
 }
 
@@ -1289,7 +1472,7 @@ std::unique_ptr<EngineBase> make_with_turtles(const WorldDef& def, Mode mode) {
   bool layered = false;
   for (const auto& b : def.balls) layered = layered || !(b.layers == plain);
   for (const auto& t : def.turtles) layered = layered || !(t.layers == plain);
-  for (const auto& w : def.walls) layered = layered || !(w.layers == plain);
+  for (const auto& w : def.walls) layered = layered || !(w.layers == plain) || !w.keys.empty();
   if (def.turtles.empty() && !layered) return make_for_mode<Flight, kBallBall, false>(def, mode);
   return make_for_mode<Flight, kBallBall, true>(def, mode);
 }

@@ -58,12 +58,23 @@ struct Layers {
   bool collides_with(const Layers& o) const { return (category & o.mask) != 0 && (o.category & mask) != 0; }
 };
 
+/// A moving wall's pose at a time (seconds).
+struct WallKey {
+  double t = 0.0;
+  Vec2 from;
+  Vec2 to;
+};
+
 /// A line-segment wall. Its two ends are collision objects of their own.
 struct WallDef {
   std::string id;
-  Vec2 from;
+  Vec2 from;  ///< the pose at t = 0
   Vec2 to;
   Layers layers{};
+  /// Empty: the wall is fixed. Otherwise it moves through these poses (times increasing, > 0),
+  /// linearly from one to the next, and stays at the last. Translation only so far: every pose
+  /// must keep `to - from`. Exact mode only.
+  std::vector<WallKey> keys{};
 };
 
 /// A disc ("ball", a gas molecule).

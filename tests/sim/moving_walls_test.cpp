@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: MIT
+// Walls that move in time: exact collisions with translating walls, momentum transfer.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "scenes.hpp"
+#include "turtlegas/sim/world.hpp"
+
+using namespace turtlegas::sim;
+using namespace turtlegas::test;
+
+namespace {
+WallDef moving(std::string id, Vec2 from, Vec2 to, std::vector<WallKey> keys) {
+  WallDef w{std::move(id), from, to};
+  w.keys = std::move(keys);
+  return w;
+}
+}  // namespace
+
+TEST_CASE("a ball at rest is struck by a moving wall at the exact time and leaves at twice its speed", "[moving]") {
+  WorldDef d = box(200, 100, Boundary::none);
+  // x = 100 - 10 t until t = 5.
+  d.walls.push_back(moving("piston", {100, 0}, {100, 100}, {{5.0, {50, 0}, {50, 100}}}));
+  d.balls.push_back(ball("b", {80, 50}, {0, 0}, 1));
+  World w(d, Mode::exact);
+  std::vector<Event> log;
+  w.set_event_log(&log);
+  w.advance_to(3.0);
+  REQUIRE(log.size() == 1);
+  CHECK(log[0].kind == EventKind::ball_wall);
+  CHECK(log[0].t == Approx(1.9).epsilon(1e-12));  // the wall reaches x = 81
+  CHECK(w.ball(0).vel.x == Approx(-20).epsilon(1e-12));
+  CHECK(w.measure_overlap().relative <= 1e-9);
+  // After t = 5 the wall stands at x = 50.
+  w.advance_to(6.0);
+  CHECK(w.walls()[0].keys.size() == 1);
+}
+
+TEST_CASE("a piston compressing a dilute gas heats it as the adiabatic law says (T A^(gamma-1), gamma = 2)", "[moving][physics]") {
+  // A 2-D ideal gas has two degrees of freedom per molecule: gamma = 2, so T A is constant. A slow
+  // piston (speed 0.1 against thermal speeds of 10) halving the area should double the temperature.
+  WorldDef d = box(100, 100, Boundary::none);
+  d.walls.push_back({"left", {0, 0}, {0, 100}});
+  d.walls.push_back({"bottom", {0, 0}, {120, 0}});
+  d.walls.push_back({"top", {0, 100}, {120, 100}});
+  d.walls.push_back(moving("piston", {100, 0}, {100, 100}, {{500.0, {50, 0}, {50, 100}}}));
+  std::mt19937_64 rng(81);
+  auto uniform = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  for (int k = 0; k < 150; ++k) {
+    const Vec2 p{3 + (k % 15) * 6.3, 3 + (k / 15) * 9.5};
+    const double a = 2 * M_PI * uniform();
+    d.balls.push_back(ball("g" + std::to_string(k), p, {10 * std::cos(a), 10 * std::sin(a)}, 0.3));
+  }
+  World w(d, Mode::exact);
+  const double e0 = w.energy();
+  w.advance_to(500.0);
+  const double ratio = w.energy() / e0;
+  INFO("temperature ratio " << ratio << " after halving the area");
+  CHECK(ratio == Approx(2.0).epsilon(0.08));
+  CHECK(w.stats().exits == 0);
+  CHECK(w.measure_overlap().relative <= 1e-9);
+  for (std::size_t i = 0; i < w.ball_count(); ++i) CHECK(w.ball(i).pos.x <= 50.0);
+}
+
+TEST_CASE("a turtle pushed by a moving wall is touched and carried along", "[moving][turtle]") {
+  WorldDef d = box(200, 100, Boundary::none);
+  // x = 100 - 5 t until t = 10 (x = 50).
+  d.walls.push_back(moving("pusher", {100, 0}, {100, 100}, {{10.0, {50, 0}, {50, 100}}}));
+  TurtleDef t;
+  t.id = "t";
+  t.pos = {50, 50};
+  t.radius = 10;
+  d.turtles.push_back(t);
+  World w(d, Mode::exact);
+  w.advance_to(12.0);
+  // Contact when the wall reaches x = 60 (t = 8); pushed to x = 40 by t = 10, then left there.
+  const auto contacts = w.take_turtle_contacts();
+  REQUIRE(contacts.size() == 1);
+  CHECK(contacts[0].kind == EventKind::turtle_wall);
+  CHECK(contacts[0].t == Approx(8.0).epsilon(1e-12));
+  CHECK(contacts[0].normal.x == Approx(-1));
+  CHECK(w.turtle(0).pos.x == Approx(40).epsilon(1e-12));
+  CHECK(norm(w.turtle(0).vel) == 0.0);
+  CHECK(w.measure_overlap().relative <= 1e-9);
+}
+
+TEST_CASE("moving walls: what is not supported yet is a clear error", "[moving]") {
+  WorldDef d = box(200, 100);
+  d.walls.push_back(moving("p", {100, 10}, {100, 90}, {{5.0, {50, 10}, {50, 90}}}));
+  CHECK_THROWS_WITH(World(d, Mode::step), Catch::Contains("need --mode exact"));
+  d.walls[0].keys = {{5.0, {50, 10}, {60, 90}}};
+  CHECK_THROWS_WITH(World(d, Mode::exact), Catch::Contains("only translation"));
+  d.walls[0].keys = {{0.0, {50, 10}, {50, 90}}};
+  CHECK_THROWS_WITH(World(d, Mode::exact), Catch::Contains("must increase"));
+}
