@@ -1467,7 +1467,7 @@ std::unique_ptr<EngineBase> make_for_mode(const WorldDef& def, Mode mode) {
 }
 
 template <class Flight, bool kBallBall>
-std::unique_ptr<EngineBase> make_with_turtles(const WorldDef& def, Mode mode) {
+std::unique_ptr<EngineBase> make_with_extras(const WorldDef& def, Mode mode) {
   const Layers plain{};
   bool layered = false;
   for (const auto& b : def.balls) layered = layered || !(b.layers == plain);
@@ -1484,9 +1484,9 @@ std::unique_ptr<EngineBase> make_engine(const WorldDef& def, Mode mode) {
   const bool gravity = def.effects.gravity.x != 0.0 || def.effects.gravity.y != 0.0;
   const bool ball_ball = def.effects.ball_ball;
   if (gravity) {
-    return ball_ball ? make_with_turtles<GravityFlight, true>(def, mode) : make_with_turtles<GravityFlight, false>(def, mode);
+    return ball_ball ? make_with_extras<GravityFlight, true>(def, mode) : make_with_extras<GravityFlight, false>(def, mode);
   }
-  return ball_ball ? make_with_turtles<FreeFlight, true>(def, mode) : make_with_turtles<FreeFlight, false>(def, mode);
+  return ball_ball ? make_with_extras<FreeFlight, true>(def, mode) : make_with_extras<FreeFlight, false>(def, mode);
 }
 
 }  // namespace turtlegas::sim::detail
