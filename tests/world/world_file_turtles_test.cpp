@@ -170,7 +170,7 @@ TEST_CASE("bad turtle entries name their JSON path") {
   CHECK_ERROR(one(R"(, "bounce": true)"), "/turtles/0/bounce", "expected a number");
   CHECK_ERROR(one(R"(, "controller": 3)"), "/turtles/0/controller", "expected a string, got a number");
   CHECK_ERROR(one(R"(, "params": [1, 2])"), "/turtles/0/params", "params must be a JSON object");
-  CHECK_ERROR(one(R"(, "pen": "sideways")"), "/turtles/0/pen", "pen must be \"up\", \"down\", true (down) or false (up), got \"sideways\"");
+  CHECK_ERROR(one(R"(, "pen": "sideways")"), "/turtles/0/pen", "pen must be \"up\", \"down\", \"wall\" (down, laying walls), true (down) or false (up), got \"sideways\"");
   CHECK_ERROR(one(R"(, "pen": 1)"), "/turtles/0/pen", "got a number");
   CHECK_ERROR(one(R"(, "gps": "yes")"), "/turtles/0/gps", "expected true or false, got a string");
 }

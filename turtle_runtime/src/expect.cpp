@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "turtlegas/world/game_file.hpp"
 #include "turtlegas/world/world_file.hpp"
 
 namespace turtlegas::world {
@@ -40,9 +41,21 @@ std::string vec(Vec2 v) {
 std::string at(const std::string& path, std::string_view key) { return path + "/" + std::string(key); }
 
 /// The event kinds a run's log carries (sim's kinds, plus the runtime's touch and fault).
-constexpr std::array<std::string_view, 10> event_kinds = {
-    "ball-ball",     "ball-wall",      "ball-wall-end", "exit",  "turtle-wall",
-    "turtle-wall-end", "turtle-turtle", "turtle-ball",   "touch", "fault"};
+constexpr std::array<std::string_view, 13> event_kinds = {
+    "ball-ball",       "ball-wall",     "ball-wall-end", "exit",       "turtle-wall",  "turtle-wall-end", "turtle-turtle",
+    "turtle-ball",     "touch",         "fault",         "wall-drawn", "wall-refused", "tag"};
+
+/// Whether `id` is `<turtle id>-w<digits>`: the id of a wall a turtle's pen may lay at run time.
+bool drawn_wall_id(const std::string& id, const sim::WorldDef& def) {
+  for (const auto& t : def.turtles) {
+    const std::string head = t.id + "-w";
+    if (id.size() > head.size() && id.starts_with(head) &&
+        std::all_of(id.begin() + static_cast<std::ptrdiff_t>(head.size()), id.end(),
+                    [](char c) { return c >= '0' && c <= '9'; }))
+      return true;
+  }
+  return false;
+}
 
 std::string join(const auto& items) {
   std::string s;
@@ -480,6 +493,143 @@ std::shared_ptr<const Assertion> parse_max_overlap(const json& e, const std::str
   return std::make_shared<OverlapAssertion>(p.non_negative(e.at("max_overlap"), at(path, "max_overlap")));
 }
 
+// ---- {"it": id, "at": "end"|t}: the game's "it" (the tag game's score names it)
+
+class ItAssertion final : public Assertion {
+ public:
+  ItAssertion(std::string who, std::optional<double> when) : who_(std::move(who)), at_(when) {}
+  std::vector<double> sample_times() const override { return at_ ? std::vector<double>{*at_} : std::vector<double>{}; }
+  std::unique_ptr<Check> start(const RunView&) const override {
+    struct C final : Check {
+      const ItAssertion& self;
+      std::optional<std::string> result;
+      bool sampled = false;
+      explicit C(const ItAssertion& s) : self(s) {}
+      void on_step(const RunView& v) override {
+        if (sampled || !self.at_ || v.time() != *self.at_) return;
+        sampled = true;
+        result = self.test(v);
+      }
+      std::optional<std::string> finish(const RunView& v) override {
+        if (!self.at_) return self.test(v);
+        if (!sampled) return "it " + self.who_ + ": the run ended at t = " + num(v.time()) + " before t = " + num(*self.at_);
+        return result;
+      }
+    };
+    return std::make_unique<C>(*this);
+  }
+
+ private:
+  std::optional<std::string> test(const RunView& v) const {
+    const turtle::Game* game = v.server().game();
+    if (!game) return "it " + who_ + ": the world plays no game";
+    const json score = game->score(v.time());
+    const std::string it = score.is_object() ? score.value("it", std::string()) : std::string();
+    if (it == who_) return std::nullopt;
+    return "it " + who_ + ": \"it\" is " + (it.empty() ? std::string("nobody") : it) + " at t = " + num(v.time());
+  }
+  std::string who_;
+  std::optional<double> at_;
+};
+
+std::shared_ptr<const Assertion> parse_it(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "it", {"at"});
+  std::string who = p.turtle_id(e.at("it"), at(path, "it"));
+  return std::make_shared<ItAssertion>(std::move(who), parse_at(e, path, p));
+}
+
+// ---- walls in the world at the end: {"walls": N} (or min/max), {"wall": id, "exists": bool}
+
+class WallsAssertion final : public Assertion {
+ public:
+  WallsAssertion(std::optional<std::size_t> min, std::optional<std::size_t> max, std::string drawn_by)
+      : min_(min), max_(max), drawn_by_(std::move(drawn_by)) {}
+  std::unique_ptr<Check> start(const RunView&) const override {
+    struct C final : Check {
+      const WallsAssertion& self;
+      explicit C(const WallsAssertion& s) : self(s) {}
+      std::optional<std::string> finish(const RunView& v) override {
+        std::size_t n = 0;
+        const std::string head = self.drawn_by_ + "-w";
+        for (const auto& w : v.world().walls())
+          if (self.drawn_by_.empty() || w.id.starts_with(head)) ++n;
+        if ((!self.min_ || n >= *self.min_) && (!self.max_ || n <= *self.max_)) return std::nullopt;
+        std::string wanted = self.min_ && self.max_ && *self.min_ == *self.max_ ? "= " + std::to_string(*self.min_)
+                             : self.min_ && n < *self.min_                     ? ">= " + std::to_string(*self.min_)
+                                                                                : "<= " + std::to_string(*self.max_);
+        return "walls" + (self.drawn_by_.empty() ? std::string() : " drawn by " + self.drawn_by_) + " = " +
+               std::to_string(n) + " at t = " + num(v.time()) + ", wanted " + wanted;
+      }
+    };
+    return std::make_unique<C>(*this);
+  }
+
+ private:
+  std::optional<std::size_t> min_, max_;
+  std::string drawn_by_;
+};
+
+std::size_t whole(const json& v, const std::string& path, const ExpectParser& p) {
+  const double d = p.non_negative(v, path);
+  if (std::floor(d) != d || d > 1e15) p.fail(path, "expected a whole number >= 0, got " + num(d));
+  return static_cast<std::size_t>(d);
+}
+
+std::shared_ptr<const Assertion> parse_walls(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "walls", {"min", "max", "drawn_by"});
+  std::optional<std::size_t> min, max;
+  const json& n = e.at("walls");
+  if (n.is_string() && n == "*") {
+    if (auto it = e.find("min"); it != e.end()) min = whole(*it, at(path, "min"), p);
+    if (auto it = e.find("max"); it != e.end()) max = whole(*it, at(path, "max"), p);
+    if (!min && !max) p.fail(path, "{\"walls\": \"*\"} needs \"min\", \"max\" or both");
+  } else {
+    if (e.contains("min") || e.contains("max"))
+      p.fail(path, "give either a count ({\"walls\": 4}) or bounds ({\"walls\": \"*\", \"min\": 1}), not both");
+    min = max = whole(n, at(path, "walls"), p);
+  }
+  std::string by;
+  if (auto it = e.find("drawn_by"); it != e.end()) by = p.turtle_id(*it, at(path, "drawn_by"));
+  return std::make_shared<WallsAssertion>(min, max, std::move(by));
+}
+
+class WallExistsAssertion final : public Assertion {
+ public:
+  WallExistsAssertion(std::string id, bool exists) : id_(std::move(id)), exists_(exists) {}
+  std::unique_ptr<Check> start(const RunView&) const override {
+    struct C final : Check {
+      const WallExistsAssertion& self;
+      explicit C(const WallExistsAssertion& s) : self(s) {}
+      std::optional<std::string> finish(const RunView& v) override {
+        const auto& walls = v.world().walls();
+        const auto it = std::find_if(walls.begin(), walls.end(), [&](const sim::WallDef& w) { return w.id == self.id_; });
+        const bool found = it != walls.end();
+        if (found == self.exists_) return std::nullopt;
+        if (!found) return "wall " + self.id_ + ": no such wall at t = " + num(v.time());
+        return "wall " + self.id_ + ": exists at t = " + num(v.time()) + " (from " + vec(it->from) + " to " +
+               vec(it->to) + "), wanted none";
+      }
+    };
+    return std::make_unique<C>(*this);
+  }
+
+ private:
+  std::string id_;
+  bool exists_;
+};
+
+std::shared_ptr<const Assertion> parse_wall(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "wall", {"exists"});
+  std::string id = p.string(e.at("wall"), at(path, "wall"));
+  if (id.empty()) p.fail(at(path, "wall"), "a wall id must not be empty");
+  bool exists = true;
+  if (auto it = e.find("exists"); it != e.end()) {
+    if (!it->is_boolean()) p.fail(at(path, "exists"), "expected true or false, got " + it->dump());
+    exists = it->get<bool>();
+  }
+  return std::make_shared<WallExistsAssertion>(std::move(id), exists);
+}
+
 /// The settings an `expect` list may hold besides assertions.
 constexpr std::array<std::string_view, 2> setting_keys = {"until", "mode"};
 
@@ -499,6 +649,9 @@ const std::vector<AssertionKind>& assertion_kinds() {
       {"speed", "a ball's or turtle's speed is within min..max at the end (or at t)", parse_speed},
       {"energy", "\"conserved\": relative change within tolerance at every control step", parse_energy},
       {"max_overlap", "no overlap deeper than this fraction of a radius", parse_max_overlap},
+      {"it", "the game's \"it\" is this turtle at the end (or at t)", parse_it},
+      {"walls", "the number of walls (all, or drawn_by a turtle) at the end", parse_walls},
+      {"wall", "a wall with this id exists (or, with \"exists\": false, does not) at the end", parse_wall},
   };
   return kinds;
 }
@@ -579,7 +732,8 @@ std::string ExpectParser::body_id(const json& v, const std::string& path) const 
   if (def_.arena.boundary == sim::Boundary::walls &&
       (id == "arena-bottom" || id == "arena-right" || id == "arena-top" || id == "arena-left"))
     return id;
-  fail(path, "no wall, ball or turtle has id \"" + id + "\"");
+  if (drawn_wall_id(id, def_)) return id;  // a wall a turtle's pen may lay while the world runs
+  fail(path, "no wall, ball or turtle has id \"" + id + "\" (nor is it <turtle>-w<k>, a wall a turtle may draw)");
 }
 
 std::string ExpectParser::turtle_id(const json& v, const std::string& path) const {
@@ -687,7 +841,9 @@ ExpectResult run_expectations(const Scene& scene, const turtle::Registry& regist
   if (!expect.until) throw std::invalid_argument("the scene's expect list has no {\"until\": T}");
   const double until = *expect.until;
   options.mode = mode;
-  turtle::WorldServer server(def, scene.programs, registry, options);
+  // With the scene's game, so that {"it": ...} sees it played.
+  const std::unique_ptr<turtle::WorldServer> played = make_server(scene, registry, options);
+  turtle::WorldServer& server = *played;
   std::vector<turtle::LogEvent> log;
   server.set_event_log(&log);
   const RunView view(server, def);

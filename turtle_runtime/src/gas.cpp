@@ -193,6 +193,7 @@ sim::BallDef make_ball(const GasSpec& gas, std::size_t k, Vec2 pos, Vec2 vel) {
   b.vel = vel;
   b.radius = gas.radius;
   b.mass = gas.mass;
+  b.layers = gas.layers;
   return b;
 }
 

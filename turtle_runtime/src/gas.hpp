@@ -18,6 +18,7 @@ struct GasSpec {
   sim::Vec2 lo, hi;     ///< the region's corners, lo < hi
   std::uint64_t seed = 1;
   std::string id_prefix = "g";
+  sim::Layers layers{};  ///< the collision layers every ball of the gas gets
 };
 
 /// Area fraction (of the placement rectangle) above which place_gas lays a jittered hexagonal

@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gas.hpp"
+#include "turtlegas/world/draw_walker.hpp"
 #include "turtlegas/world/game_file.hpp"
 
 namespace turtlegas::world {
@@ -91,10 +92,18 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 
 /// Features that later versions add to the format: named so that a file written for them fails
 /// with a clear message rather than as an unknown key.
-constexpr std::array<std::string_view, 2> reserved_keys = {"views", "draw"};
+constexpr std::array<std::string_view, 1> reserved_keys = {"views"};
 
 /// The commands of the built-in `script` controller; pendown and penup take no amount.
 constexpr std::array<std::string_view, 7> script_commands = {"forward", "back", "left", "right", "wait", "pendown", "penup"};
+
+/// The commands of a `draw` builder: turtle geometry only, no time.
+constexpr std::array<std::string_view, 6> draw_commands = {"forward", "back", "left", "right", "pendown", "penup"};
+
+/// The category every object is in unless it names others; bit 0, sim::Layers' default.
+constexpr std::string_view default_category = "default";
+/// Bits 0..31 of a category mask: "default" and at most 31 names.
+constexpr std::size_t max_categories = 32;
 
 /// Degrees (world files, the controller API) to radians (everything inside).
 constexpr double radians_per_degree = std::numbers::pi / 180.0;
@@ -201,7 +210,12 @@ class Reader {
 
   void read_arena(const json& v, sim::ArenaDef& arena);
   void read_effects(const json& v, sim::EffectsDef& effects);
+  void collect_categories(const json& doc);
+  void collect_category(const json& obj, const std::string& path);
+  sim::Layers layers(const json& obj, const std::string& path) const;
+  std::uint32_t category_bits(const json& v, const std::string& path) const;
   void read_walls(const json& v, std::vector<sim::WallDef>& walls);
+  void read_draw(const json& v, std::vector<sim::WallDef>& walls);
   void read_balls(const json& v, std::vector<sim::BallDef>& balls);
   void read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles, std::vector<turtle::TurtleProgram>& programs);
   std::vector<turtle::SensorArc> read_sensors(const json& v, const std::string& path) const;
@@ -215,7 +229,71 @@ class Reader {
   std::unordered_map<std::string, std::string> ids_;  // id -> JSON path of its "id" ("" for arena walls)
   std::size_t explicit_balls_ = 0;
   std::vector<std::size_t> gas_first_;  // index in WorldDef::balls of each gas entry's first ball
+  std::vector<std::string> wall_paths_;  // JSON path of each of WorldDef::walls (file walls, then drawn)
+  std::vector<std::string> categories_{std::string(default_category)};  // name of bit k
 };
+
+void Reader::collect_category(const json& obj, const std::string& path) {
+  if (!obj.is_object()) return;  // reported by the section's reader
+  const json* c = find(obj, "category");
+  if (!c) return;
+  const std::string p = at(path, "category");
+  auto add = [&](const json& name, const std::string& np) {
+    const std::string n = string(name, np);
+    if (n.empty()) fail(np, "a category name must not be empty");
+    if (std::find(categories_.begin(), categories_.end(), n) != categories_.end()) return;
+    if (categories_.size() == max_categories)
+      fail(np, "too many collision categories: \"" + n + "\" would be number " + std::to_string(max_categories + 1) +
+                   "; a world has at most " + std::to_string(max_categories - 1) + " names besides \"default\"");
+    categories_.push_back(n);
+  };
+  if (c->is_array()) {
+    if (c->empty()) fail(p, "category must be a name or a non-empty list of names, got []");
+    for (std::size_t k = 0; k < c->size(); ++k) add((*c)[k], at(p, k));
+  } else if (c->is_string()) {
+    add(*c, p);
+  } else {
+    fail(p, "category must be a name (\"walls\") or a list of names, got " + kind_of(*c));
+  }
+}
+
+void Reader::collect_categories(const json& doc) {
+  // Bits are given in a fixed section order (JSON objects do not keep their key order):
+  // walls, balls, gas, turtles, draw; within a section, in list order.
+  for (std::string_view section : {"walls", "balls", "gas", "turtles", "draw"})
+    if (const json* v = find(doc, section); v && v->is_array())
+      for (std::size_t i = 0; i < v->size(); ++i) collect_category((*v)[i], at(at("", section), i));
+}
+
+std::uint32_t Reader::category_bits(const json& v, const std::string& path) const {
+  auto bit = [&](const json& name, const std::string& np) -> std::uint32_t {
+    const std::string n = string(name, np);
+    const auto it = std::find(categories_.begin(), categories_.end(), n);
+    if (it == categories_.end()) {
+      std::string known;
+      for (const auto& k : categories_) known += (known.empty() ? "" : ", ") + k;
+      fail(np, "unknown category \"" + n + "\"; no wall, ball, gas or turtle has it as its \"category\" (known: " +
+                   known + "). A misspelt name would silently turn collisions off");
+    }
+    return std::uint32_t{1} << static_cast<unsigned>(it - categories_.begin());
+  };
+  if (v.is_string()) return bit(v, path);
+  if (!v.is_array()) fail(path, "expected a category name or a list of names, got " + kind_of(v));
+  std::uint32_t bits = 0;
+  for (std::size_t k = 0; k < v.size(); ++k) bits |= bit(v[k], at(path, k));
+  return bits;
+}
+
+sim::Layers Reader::layers(const json& obj, const std::string& path) const {
+  sim::Layers l;  // category "default" (bit 0), collides with everything
+  if (const json* c = find(obj, "category")) {
+    l.category = category_bits(*c, at(path, "category"));
+    if (l.category == 0) fail(at(path, "category"), "category must name at least one category");
+  }
+  // An empty collides_with is allowed: the object collides with nothing (a pure spectator).
+  if (const json* m = find(obj, "collides_with")) l.mask = category_bits(*m, at(path, "collides_with"));
+  return l;
+}
 
 void Reader::read_arena(const json& v, sim::ArenaDef& arena) {
   const std::string path = "/arena";
@@ -266,12 +344,65 @@ void Reader::read_walls(const json& v, std::vector<sim::WallDef>& walls) {
     const std::string p = at(path, i);
     const json& w = v[i];
     expect_object(w, p, "a wall");
-    check_keys(w, p, "a wall", {"id", "from", "to"});
+    check_keys(w, p, "a wall", {"id", "from", "to", "category", "collides_with"});
     sim::WallDef def;
     def.id = id(w, p, "a wall");
     def.from = vec2(require(w, p, "from", "a wall"), at(p, "from"));
     def.to = vec2(require(w, p, "to", "a wall"), at(p, "to"));
+    def.layers = layers(w, p);
     walls.push_back(std::move(def));
+    wall_paths_.push_back(p);
+  }
+}
+
+void Reader::read_draw(const json& v, std::vector<sim::WallDef>& walls) {
+  const std::string path = "/draw";
+  expect_array(v, path, "draw");
+  std::string known;
+  for (std::string_view c : draw_commands) known += (known.empty() ? "" : ", ") + std::string(c);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::string p = at(path, i);
+    const json& b = v[i];
+    expect_object(b, p, "a draw builder");
+    check_keys(b, p, "a draw builder", {"id", "pos", "heading", "commands", "category", "collides_with"});
+    const std::string builder = id(b, p, "a draw builder");
+    DrawWalker walker(builder, vec2(require(b, p, "pos", "a draw builder"), at(p, "pos")), 0.0);
+    if (const json* h = find(b, "heading")) walker.heading = number(*h, at(p, "heading"));
+    const sim::Layers layers_of_walls = layers(b, p);
+    const std::string cp = at(p, "commands");
+    const json& commands = require(b, p, "commands", "a draw builder");
+    expect_array(commands, cp, "commands");
+    for (std::size_t k = 0; k < commands.size(); ++k) {
+      const std::string kp = at(cp, k);
+      const json& c = commands[k];
+      if (!c.is_array() || c.empty() || !c[0].is_string())
+        fail(kp, "a command must be [command, amount], e.g. [\"forward\", 100], got " + c.dump());
+      const std::string name = c[0].get<std::string>();
+      if (std::find(draw_commands.begin(), draw_commands.end(), name) == draw_commands.end())
+        fail(at(kp, 0), "unknown command '" + name + "'; a draw builder knows: " + known +
+                            " (it runs at load time, so there is no wait)");
+      if (name == "pendown" || name == "penup") {
+        if (c.size() != 1) fail(kp, "'" + name + "' takes no amount: [\"" + name + "\"]");
+        walker.pen_down = name == "pendown";
+        continue;
+      }
+      if (c.size() != 2) fail(kp, "'" + name + "' needs one number, e.g. [\"" + name + "\", 100], got " + c.dump());
+      const double amount = number(c[1], at(kp, 1));
+      if (name == "left" || name == "right") {
+        walker.turn(name == "right" ? amount : -amount);
+        continue;
+      }
+      if (auto wall = walker.move(name == "forward" ? amount : -amount)) {
+        wall->layers = layers_of_walls;
+        auto [it, fresh] = ids_.emplace(wall->id, kp);
+        if (!fresh)
+          fail(kp, "the wall this command lays gets the id \"" + wall->id + "\", already used " +
+                       (it->second.empty() ? std::string("by an arena wall") : "at " + it->second) +
+                       "; rename the builder or that object");
+        walls.push_back(std::move(*wall));
+        wall_paths_.push_back(kp);
+      }
+    }
   }
 }
 
@@ -283,7 +414,7 @@ void Reader::read_balls(const json& v, std::vector<sim::BallDef>& balls) {
     const std::string p = at(path, i);
     const json& b = v[i];
     expect_object(b, p, "a ball");
-    check_keys(b, p, "a ball", {"id", "pos", "vel", "radius", "mass", "charge"});
+    check_keys(b, p, "a ball", {"id", "pos", "vel", "radius", "mass", "charge", "category", "collides_with"});
     sim::BallDef def;
     def.id = id(b, p, "a ball");
     def.pos = vec2(require(b, p, "pos", "a ball"), at(p, "pos"));
@@ -291,6 +422,7 @@ void Reader::read_balls(const json& v, std::vector<sim::BallDef>& balls) {
     def.radius = positive(require(b, p, "radius", "a ball"), at(p, "radius"), "radius");
     if (const json* x = find(b, "mass")) def.mass = positive(*x, at(p, "mass"), "mass");
     if (const json* x = find(b, "charge")) def.charge = number(*x, at(p, "charge"));
+    def.layers = layers(b, p);
     balls.push_back(std::move(def));
   }
 }
@@ -307,11 +439,12 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
     expect_object(t, p, "a turtle");
     check_keys(t, p, "a turtle",
                {"id", "pos", "heading", "radius", "speed", "turn_rate", "controller", "params", "sensors", "pen", "gps",
-                "bounce"});
+                "bounce", "category", "collides_with", "builder"});
     sim::TurtleDef body;
     turtle::TurtleProgram program;
     body.id = id(t, p, "a turtle");
     body.pos = vec2(require(t, p, "pos", "a turtle"), at(p, "pos"));
+    body.layers = layers(t, p);
     // Angles are degrees in the file and radians inside: converted here, once. The heading is
     // wrapped into [0, 360) first so that a state written back reads like the file.
     double heading = 0.0;
@@ -351,12 +484,27 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
       const std::string pp = at(p, "pen");
       if (x->is_boolean()) {
         program.pen_down = x->get<bool>();
-      } else if (x->is_string() && (*x == "up" || *x == "down")) {
-        program.pen_down = *x == "down";
+      } else if (x->is_string() && (*x == "up" || *x == "down" || *x == "wall")) {
+        program.pen_down = *x != "up";
+        program.pen_walls = *x == "wall";
       } else {
-        fail(pp, "pen must be \"up\", \"down\", true (down) or false (up), got " +
+        fail(pp, "pen must be \"up\", \"down\", \"wall\" (down, laying walls), true (down) or false (up), got " +
                      (x->is_string() ? "\"" + x->get<std::string>() + "\"" : kind_of(*x)));
       }
+    }
+    // A turtle that may lay walls gets a private collision category in the world server; it must
+    // be known before the run. A wall pen or a script with ["pendown", "wall"] says so itself.
+    program.builder = program.pen_walls;
+    if (program.controller == "script")
+      if (const json* cs = find(program.params, "commands"); cs && cs->is_array())
+        for (const json& c : *cs)
+          if (c.is_array() && c.size() == 2 && c[0] == "pendown" && c[1] == "wall") program.builder = true;
+    if (const json* x = find(t, "builder")) {
+      const bool b = boolean(*x, at(p, "builder"));
+      if (!b && program.builder)
+        fail(at(p, "builder"), "builder is false but this turtle lays walls (its pen is \"wall\" or its script has "
+                               "[\"pendown\", \"wall\"]); remove \"builder\"");
+      program.builder = b;
     }
     if (const json* x = find(t, "gps")) program.gps = boolean(*x, at(p, "gps"));
     turtles.push_back(std::move(body));
@@ -421,8 +569,15 @@ void Reader::check_script(const json& params, const std::string& path) const {
     const std::string name = c[0].get<std::string>();
     if (std::find(script_commands.begin(), script_commands.end(), name) == script_commands.end())
       fail(at(p, 0), "unknown command '" + name + "'; known: " + known);
+    if (name == "pendown" && c.size() == 2 && c[1].is_string()) {
+      if (c[1] != "wall" && c[1] != "line")
+        fail(at(p, 1), "a pen mode is \"line\" (draws the path) or \"wall\" (lays walls), got " + c[1].dump());
+      continue;
+    }
     if (name == "pendown" || name == "penup") {
-      if (c.size() != 1) fail(p, "'" + name + "' takes no amount: [\"" + name + "\"]");
+      if (c.size() != 1)
+        fail(p, "'" + name + "' takes no amount: [\"" + name + "\"]" +
+                    (name == "pendown" ? " (or a pen mode: [\"pendown\", \"wall\"])" : ""));
       continue;
     }
     if (c.size() != 2) fail(p, "'" + name + "' needs one number, e.g. [\"" + name + "\", 100], got " + c.dump());
@@ -446,7 +601,7 @@ std::vector<detail::GasSpec> Reader::read_gases(const json& v, const sim::WorldD
     const std::string p = at(path, k);
     const json& g = v[k];
     expect_object(g, p, "a gas");
-    check_keys(g, p, "a gas", {"count", "radius", "mass", "speed", "region", "seed", "id_prefix"});
+    check_keys(g, p, "a gas", {"count", "radius", "mass", "speed", "region", "seed", "id_prefix", "category", "collides_with"});
     detail::GasSpec gas;
     const std::uint64_t count = natural(require(g, p, "count", "a gas"), at(p, "count"));
     constexpr std::uint64_t max_count = 100'000'000;
@@ -476,6 +631,7 @@ std::vector<detail::GasSpec> Reader::read_gases(const json& v, const sim::WorldD
     if (const json* s = find(g, "seed")) gas.seed = natural(*s, at(p, "seed"));
     gas.id_prefix = k == 0 ? "g" : "g" + std::to_string(k) + "-";
     if (const json* x = find(g, "id_prefix")) gas.id_prefix = string(*x, at(p, "id_prefix"));
+    gas.layers = layers(g, p);
 
     Vec2 lo, hi;
     detail::centre_range(gas, def.arena, lo, hi);
@@ -539,7 +695,9 @@ std::string Reader::path_of(const sim::DefProblem& p) const {
     case Where::world: return p.field.empty() ? "" : at("", p.field);
     case Where::arena: return with_field("/arena");
     case Where::effects: return with_field("/effects");
-    case Where::wall: return with_field(at("/walls", p.index));
+    case Where::wall:  // a file wall's field, or the draw command that laid it
+      if (p.index < wall_paths_.size() && !wall_paths_[p.index].starts_with("/walls/")) return wall_paths_[p.index];
+      return with_field(at("/walls", p.index));
     case Where::ball: {
       if (p.index < explicit_balls_) return with_field(at("/balls", p.index));
       const auto k = static_cast<std::size_t>(std::upper_bound(gas_first_.begin(), gas_first_.end(), p.index) -
@@ -562,7 +720,8 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
       fail(at("", key), "\"" + std::string(key) + "\" is not supported yet by this version of turtlegas; remove it (or rename it \"x-" +
                             std::string(key) + "\" to keep it in the file)");
   check_keys(doc, "", "the world",
-             {"format", "name", "seed", "dt", "arena", "effects", "walls", "balls", "turtles", "gas", "expect", "game"});
+             {"format", "name", "seed", "dt", "arena", "effects", "walls", "balls", "turtles", "gas", "expect", "game",
+              "draw"});
 
   Scene scene;
   sim::WorldDef& def = scene.def;
@@ -574,10 +733,23 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
   if (const json* v = find(doc, "effects")) read_effects(*v, def.effects);
   if (def.arena.boundary == sim::Boundary::walls)
     for (std::string_view id : arena_wall_ids) ids_.emplace(std::string(id), "");
+  collect_categories(doc);
   if (const json* v = find(doc, "walls")) read_walls(*v, def.walls);
+  if (const json* v = find(doc, "draw")) read_draw(*v, def.walls);
   if (const json* v = find(doc, "balls")) read_balls(*v, def.balls);
   explicit_balls_ = def.balls.size();
   if (const json* v = find(doc, "turtles")) read_turtles(*v, def.turtles, scene.programs);
+  {
+    std::size_t builders = 0;
+    for (std::size_t k = 0; k < scene.programs.size(); ++k) {
+      builders += scene.programs[k].builder ? 1 : 0;
+      if (scene.programs[k].builder && categories_.size() + builders > max_categories)
+        fail(at("/turtles", k), "this turtle lays walls and needs a collision category of its own, but the world's " +
+                                    std::to_string(categories_.size()) + " categories and " + std::to_string(builders) +
+                                    " builders are more than " + std::to_string(max_categories) +
+                                    "; use fewer category names or builders");
+    }
+  }
   if (const json* v = find(doc, "game"))  // game_file.hpp
     scene.game = read_game(*v, def, [this](const std::string& path, const std::string& reason) { fail(path, reason); });
 
@@ -604,7 +776,12 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
     check_gas_ids(gases);
   }
   // Scripted test worlds (expect.hpp): read last, so that their ids can name any body.
-  if (const json* v = find(doc, "expect")) scene.expect = parse_expect(*v, file_, def);
+  if (const json* v = find(doc, "expect")) {
+    scene.expect = parse_expect(*v, file_, def);
+    for (const auto& e : scene.expect.entries)
+      if (e.kind == "it" && !scene.game)
+        fail(at(at("/expect", e.index), "it"), "an \"it\" expectation needs a game; add \"game\": {\"kind\": \"tag\", ...}");
+  }
   return scene;
 }
 

@@ -98,6 +98,13 @@ void script_controller(Turtle& t, const Params& p) {
     if (!c.is_array() || c.empty() || !c[0].is_string())
       throw std::invalid_argument(where + " must be [command, amount], e.g. [\"forward\", 100]");
     const std::string name = c[0].get<std::string>();
+    if (name == "pendown" && c.size() == 2 && c[1].is_string()) {
+      const std::string mode = c[1].get<std::string>();
+      if (mode != "wall" && mode != "line")
+        throw std::invalid_argument(where + ": a pen mode is \"line\" or \"wall\", got \"" + mode + "\"");
+      t.pen_down(mode == "wall" ? PenMode::wall : PenMode::line);
+      continue;
+    }
     if (name == "pendown") { t.pen_down(); continue; }
     if (name == "penup") { t.pen_up(); continue; }
     if (c.size() != 2 || !c[1].is_number())
@@ -145,6 +152,8 @@ class Agent {
   std::vector<std::string> sensor_names;                  // what Touch::sensor_names points to
 
   bool pen_down = false;
+  PenMode pen_mode = PenMode::line;
+  std::size_t walls_laid = 0;                 // k of the next `<id>-w<k>`
   std::vector<sim::Vec2> trail;
   double odometer = 0.0;
   bool started = false;
@@ -167,12 +176,14 @@ class WorldServer::Impl : public GameHost {
   std::uint64_t step = 0;        // index of the next control boundary
   bool boundary_done = false;    // whether the programs have run at boundary `step`
 
-  Impl(const sim::WorldDef& d, ServerOptions o) : def(d), world(d, o.mode), options(o) {}
+  Impl(sim::WorldDef d, ServerOptions o) : def(std::move(d)), world(def, o.mode), options(o) {}
 
   double boundary_time(std::uint64_t k) const { return static_cast<double>(k) * def.dt; }
   void control_step();
   void run_program(Agent& a);
   void drain_sim_events();
+  void lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to);
+  bool id_taken(const std::string& id) const;
   void emit(LogEvent e) {
     if (log) log->push_back(std::move(e));
   }
@@ -224,6 +235,9 @@ Result Agent::issue(sim::TurtleCommand c) {
   if (detail::Fiber::current() != fiber.get())
     throw std::logic_error("turtle '" + id + "': commands must be issued from its own program");
   command = c;
+  // The wall pen lays the stroke this command drives, in the pen mode it was issued in.
+  const bool lays_wall = pen_down && pen_mode == PenMode::wall && c.kind == sim::TurtleCommand::Kind::move;
+  const sim::Vec2 start = server->world.turtle(index).pos;
   fiber->suspend();
   // Resumed by the scheduler: the command has ended. Interrupts first, then the answer.
   const sim::TurtleState s = server->world.turtle(index);
@@ -233,6 +247,7 @@ Result Agent::issue(sim::TurtleCommand c) {
   if (s.touched && !delivered.empty()) cut = delivered.front();
   if (c.kind == sim::TurtleCommand::Kind::move) odometer += s.done;
   if (pen_down) trail.push_back(s.pos);
+  if (lays_wall && s.pos != start) server->lay_wall(*this, start, s.pos);
   if (handler)
     for (const Touch& t : delivered) handler(t);
   std::vector<Message> letters;
@@ -253,10 +268,16 @@ Result Turtle::left(double degrees) { return agent_->issue({sim::TurtleCommand::
 Result Turtle::wait(double seconds) { return agent_->issue({sim::TurtleCommand::Kind::wait, seconds}); }
 void Turtle::yield() { agent_->issue({sim::TurtleCommand::Kind::stop, 0.0}); }
 void Turtle::pen_up() { agent_->pen_down = false; }
-void Turtle::pen_down() {
+void Turtle::pen_down(PenMode mode) {
+  if (mode == PenMode::wall && !agent_->program.builder)
+    throw std::logic_error("turtle '" + agent_->id +
+                           "' may not lay walls: give it \"builder\": true (or \"pen\": \"wall\") in the world file, "
+                           "so that the world server can give it a collision category of its own");
   if (!agent_->pen_down) agent_->trail.push_back(agent_->server->world.turtle(agent_->index).pos);
   agent_->pen_down = true;
+  agent_->pen_mode = mode;
 }
+PenMode Turtle::pen_mode() const { return agent_->pen_mode; }
 bool Turtle::pen_is_down() const { return agent_->pen_down; }
 void Turtle::on_touch(std::function<void(const Touch&)> handler) { agent_->handler = std::move(handler); }
 void Turtle::on_message(std::function<void(const Message&)> handler) { agent_->message_handler = std::move(handler); }
@@ -287,11 +308,77 @@ std::vector<Touch> Turtle::touching() const {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Wall-laying turtles
+
+sim::WorldDef with_builder_layers(sim::WorldDef def, const std::vector<TurtleProgram>& programs) {
+  std::uint32_t used = 0;
+  for (const auto& w : def.walls) used |= w.layers.category;
+  for (const auto& b : def.balls) used |= b.layers.category;
+  for (const auto& t : def.turtles) used |= t.layers.category;
+  const std::size_t n = std::min(programs.size(), def.turtles.size());
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!programs[k].builder) continue;
+    // Free bits from the top down, away from the world file's named categories (bit 0 upwards).
+    int bit = 31;
+    while (bit >= 0 && ((used >> bit) & 1u) != 0) --bit;
+    if (bit < 0)
+      throw std::invalid_argument("turtle '" + def.turtles[k].id +
+                                  "' lays walls but no collision category is free for it (32 in use); use fewer "
+                                  "category names or fewer builder turtles");
+    const std::uint32_t own = std::uint32_t{1} << bit;
+    used |= own;
+    sim::TurtleDef& builder = def.turtles[k];
+    // Whoever collided with the builder's categories collides with its private one too, so moving
+    // it there changes nothing but its own walls (whose mask leaves `own` out).
+    const std::uint32_t was = builder.layers.category;
+    auto widen = [&](sim::Layers& l) {
+      if ((l.mask & was) != 0) l.mask |= own;
+    };
+    for (auto& w : def.walls) widen(w.layers);
+    for (auto& b : def.balls) widen(b.layers);
+    for (std::size_t j = 0; j < def.turtles.size(); ++j)
+      if (j != k) widen(def.turtles[j].layers);
+    builder.layers.category = own;
+  }
+  return def;
+}
+
+bool WorldServer::Impl::id_taken(const std::string& id) const {
+  for (const auto& w : world.walls())
+    if (w.id == id) return true;
+  for (const auto& b : def.balls)
+    if (b.id == id) return true;
+  for (const auto& t : def.turtles)
+    if (t.id == id) return true;
+  return false;
+}
+
+void WorldServer::Impl::lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to) {
+  const double now = world.time();
+  sim::WallDef w;
+  do w.id = a.id + "-w" + std::to_string(a.walls_laid++);
+  while (id_taken(w.id));
+  w.from = from;
+  w.to = to;
+  // In the default category, colliding with everything except the builder's private category.
+  w.layers.category = 1;
+  w.layers.mask = ~def.turtles[a.index].layers.category;
+  try {
+    world.add_wall(w);
+  } catch (const std::invalid_argument& e) {
+    spdlog::warn("turtle '{}' t={:.6g}: wall {} not laid: {}", a.id, now, w.id, e.what());
+    emit({now, "wall-refused", a.id, w.id, {}, 0.0, e.what()});
+    return;
+  }
+  emit({now, "wall-drawn", a.id, w.id, {}, 0.0, {}});
+}
+
+// ---------------------------------------------------------------------------------------------
 // The scheduler
 
 WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> programs, const Registry& registry,
                          ServerOptions options)
-    : impl_(std::make_unique<Impl>(def, options)) {
+    : impl_(std::make_unique<Impl>(with_builder_layers(def, programs), options)) {
   if (programs.size() != def.turtles.size())
     throw std::invalid_argument("WorldServer: " + std::to_string(programs.size()) + " programs for " +
                                 std::to_string(def.turtles.size()) + " turtles");
@@ -314,7 +401,12 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
     for (const SensorArc& arc : a->program.sensors) a->sensor_names.push_back(arc.name);
     a->controller = *c;
     a->params = Params(a->program.params);
-    a->pen_down = a->program.pen_down;
+    a->pen_down = a->program.pen_down || a->program.pen_walls;
+    if (a->program.pen_walls) {
+      if (!a->program.builder)
+        throw std::invalid_argument("turtle '" + a->id + "': its pen starts in wall mode but it is not a builder");
+      a->pen_mode = PenMode::wall;
+    }
     if (a->pen_down) a->trail.push_back(def.turtles[k].pos);
     a->rng.seed(def.seed ^ fnv1a(a->id));
     impl_->agents.push_back(std::move(a));

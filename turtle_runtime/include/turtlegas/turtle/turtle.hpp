@@ -100,6 +100,12 @@ struct Message {
   std::string kind() const { return data.is_object() ? data.value("kind", std::string()) : std::string(); }
 };
 
+/// What a lowered pen does. `line` draws the turtle's path (in snapshots); `wall` lays a wall
+/// along each forward/back stroke (a real wall that every other body collides with; the turtle
+/// itself passes through its own walls). Wall mode needs a turtle the world lets build walls
+/// (`"builder": true` or `"pen": "wall"` in the world file).
+enum class PenMode { line, wall };
+
 class Agent;  // the runtime's side of a turtle
 
 /// The handle a controller program drives its turtle with. Valid for the program's lifetime.
@@ -115,8 +121,16 @@ class Turtle {
   /// Gives up the rest of this control step without a command.
   void yield();
   void pen_up();
-  void pen_down();
+  /// Lowers the pen. In PenMode::wall, each forward/back command from now on lays a wall from
+  /// where it started to where it ended (also when a touch cut it short), at the control step at
+  /// which the command returns; it is logged as a `wall-drawn` event with the id
+  /// `<turtle id>-w<k>`. A wall that would overlap a body it collides with is not laid (a
+  /// `wall-refused` event says why). Throws std::logic_error for PenMode::wall when the turtle is
+  /// not a builder (which stops its program with a fault naming the fix).
+  void pen_down(PenMode mode = PenMode::line);
   bool pen_is_down() const;
+  /// The mode of the pen (the last pen_down's; PenMode::line before any).
+  PenMode pen_mode() const;
 
   /// The touches in contact now (sensors computed for the current heading); empty if none.
   std::vector<Touch> touching() const;

@@ -11,7 +11,9 @@
 //      and each is logged as a `touch` event), then its messages (its on_message handler runs for
 //      each), then its program runs until it issues its next command (or yields, or returns); the
 //      command starts at once, at t. (A turtle-turtle contact ends both turtles' commands, so
-//      both hear about a tag at the boundary right after it.)
+//      both hear about a tag at the boundary right after it.) A turtle whose pen is in wall mode
+//      lays the wall of its finished forward/back stroke when its program resumes, before its
+//      handlers run: the wall is in the world, for everyone, from t on (a `wall-drawn` event).
 //   3. The physics advances every body to (k+1) dt, earliest collision first. A turtle that
 //      touches something stops at the contact point at the exact contact time; its command ends
 //      there and the interrupt waits for the next step.
@@ -51,6 +53,10 @@ struct TurtleProgram {
   nlohmann::json params = nlohmann::json::object();
   std::vector<SensorArc> sensors = default_sensors();
   bool pen_down = false;
+  bool pen_walls = false;  ///< the pen starts in wall mode (PenMode::wall; needs builder)
+  /// The turtle may lay walls with its pen (PenMode::wall). The server then moves it into a
+  /// private collision category, so that it passes through its own walls (see WorldServer).
+  bool builder = false;
   bool gps = false;  ///< whether the program may read its global position
 };
 
@@ -72,6 +78,13 @@ void script_controller(Turtle& t, const Params& p);
 
 /// A registry holding `script` only.
 Registry base_registry();
+
+/// The scene the world server runs: `def` with every builder turtle (programs[k].builder) moved
+/// into a collision category of its own, a free bit from the top down, and that bit added to the
+/// mask of every wall, ball and turtle that collided with the turtle's old categories. The walls a
+/// builder lays leave its bit out of their mask, so it passes through them and nobody else does.
+/// Throws std::invalid_argument when no bit is free.
+sim::WorldDef with_builder_layers(sim::WorldDef def, const std::vector<TurtleProgram>& programs);
 
 struct ServerOptions {
   sim::Mode mode = sim::Mode::exact;
