@@ -413,3 +413,18 @@ TEST_CASE("a dense gas is placed on a jittered lattice") {
   CHECK(e.json_path == "/gas/0");
   CHECK(contains(e.reason, "could only place"));
 }
+
+TEST_CASE("moving walls: keyframes parse, and bad ones name their path") {
+  const sim::WorldDef def = tw::parse_world(
+      world(R"(, "walls": [{"id": "p", "from": [10, 0], "to": [10, 5], "keys": [{"t": 2, "from": [20, 0], "to": [20, 5]}, {"t": 3, "from": [20, 1], "to": [20, 6]}]}])"),
+      "w.json");
+  REQUIRE(def.walls[0].keys.size() == 2);
+  CHECK(def.walls[0].keys[1].t == 3);
+  CHECK(def.walls[0].keys[1].from.y == 1);
+  CHECK_ERROR(world(R"(, "walls": [{"id": "p", "from": [10, 0], "to": [10, 5], "keys": [{"t": 2, "from": [20, 0], "to": [20, 5]}, {"t": 2, "from": [20, 1], "to": [20, 6]}]}])"),
+              "/walls/0/keys/1/t", "keyframe times must increase");
+  CHECK_ERROR(world(R"(, "walls": [{"id": "p", "from": [10, 0], "to": [10, 5], "keys": [{"t": 2, "from": [20, 0], "to": [25, 5]}]}])"),
+              "/walls/0/keys/0", "may only translate");
+  CHECK_ERROR(world(R"(, "walls": [{"id": "p", "from": [10, 0], "to": [10, 5], "keys": [{"t": 2, "from": [20, 0], "to": [20, 5], "angle": 3}]}])"),
+              "/walls/0/keys/0/angle", "unknown key");
+}

@@ -344,12 +344,34 @@ void Reader::read_walls(const json& v, std::vector<sim::WallDef>& walls) {
     const std::string p = at(path, i);
     const json& w = v[i];
     expect_object(w, p, "a wall");
-    check_keys(w, p, "a wall", {"id", "from", "to", "category", "collides_with"});
+    check_keys(w, p, "a wall", {"id", "from", "to", "category", "collides_with", "keys"});
     sim::WallDef def;
     def.id = id(w, p, "a wall");
     def.from = vec2(require(w, p, "from", "a wall"), at(p, "from"));
     def.to = vec2(require(w, p, "to", "a wall"), at(p, "to"));
     def.layers = layers(w, p);
+    if (const json* keys = find(w, "keys")) {
+      // A moving wall: poses at later times, translation only (the engine says so if not).
+      const std::string kp = at(p, "keys");
+      expect_array(*keys, kp, "keys");
+      double prev = 0.0;
+      for (std::size_t k = 0; k < keys->size(); ++k) {
+        const std::string pk = at(kp, k);
+        const json& key = (*keys)[k];
+        expect_object(key, pk, "a keyframe");
+        check_keys(key, pk, "a keyframe", {"t", "from", "to"});
+        sim::WallKey wk;
+        wk.t = number(require(key, pk, "t", "a keyframe"), at(pk, "t"));
+        if (!(wk.t > prev)) fail(at(pk, "t"), "keyframe times must increase and be > 0 (got " + num(wk.t) + " after " + num(prev) + ")");
+        prev = wk.t;
+        wk.from = vec2(require(key, pk, "from", "a keyframe"), at(pk, "from"));
+        wk.to = vec2(require(key, pk, "to", "a keyframe"), at(pk, "to"));
+        if (std::hypot((wk.to - wk.from).x - (def.to - def.from).x, (wk.to - wk.from).y - (def.to - def.from).y) >
+            1e-12 * std::hypot((def.to - def.from).x, (def.to - def.from).y))
+          fail(pk, "a moving wall may only translate so far: keep to - from as at t = 0 (rotation and stretching are not simulated yet)");
+        def.keys.push_back(wk);
+      }
+    }
     walls.push_back(std::move(def));
     wall_paths_.push_back(p);
   }
