@@ -2,12 +2,13 @@
 //
 // The GAS engine. One class template, instantiated once per combination of the physics a scene
 // can ask for (straight flights or parabolas under gravity; ball-ball collisions on or off; exact
-// or step mode), chosen when the World is built, so nothing is decided per collision.
+// or step mode; extras or not), chosen when the World is built, so nothing is decided per
+// collision.
 //
 // Order of work, exact mode (event-driven):
 //   1. Every ball holds one pending prediction: its earliest collision among the objects in its
-//      3x3 cell neighbourhood, and the time it leaves its cell. An indexed heap orders balls by the
-//      earlier of the two. Balls keep their own local time; a ball is moved only when an event
+//      3x3 cell neighbourhood, and the time it leaves its cell. A calendar queue orders balls by
+//      the earlier of the two. Balls keep their own local time; a ball is moved only when an event
 //      touches it.
 //   2. Pop the earliest ball. A collision whose partner ball has changed course since the
 //      prediction (its collision counter moved on) is stale: re-predict and go on.
@@ -26,7 +27,10 @@
 //   3. Move every ball to the end of the step and apply the field kick v += a dt. Balls outside an
 //      open arena exit; a periodic arena wraps them.
 //
-// kExtras: the scene has turtles or collision layers (or both); without them neither costs a thing.
+// kExtras: the scene has turtles, collision layers or moving walls; without them none of these
+// costs a thing. Layers are checked on each candidate pair before any time of impact. Moving walls
+// live outside the grid: every prediction checks them, in the wall's frame, up to the next
+// keyframe, and a keyframe makes every body predict again.
 // Turtles are bodies too (ids after the balls', in cell lists of their own): discs of infinite
 // mass that fly straight at the velocity their current command gives, never feel fields, and stop
 // dead at a contact (or bounce, if asked). The end of a command is one more candidate in a
