@@ -213,6 +213,8 @@ class Engine final : public EngineBase {
   void add_end_layers(Vec2 p, const Layers& l);
   Vec2 mover_p1(const Mover& m, double t) const { return m.p1_ref + (t - m.t_ref) * m.u; }
   void aim_mover(Mover& m);
+  void refresh_next_key();
+  void apply_visibility();
   void keyframe();
   void consider_mover(std::uint32_t i, const Body& bi, std::uint32_t mi, Pending& p) const;
   void collide_moving_end(std::uint32_t i, std::uint32_t code);
@@ -315,6 +317,9 @@ class Engine final : public EngineBase {
   std::vector<std::vector<WallKey>> keys_;    ///< their keyframes, by mover
   std::vector<std::uint32_t> mover_of_;       ///< per wall: its mover, or kNone
   std::vector<std::uint32_t> pushed_by_;      ///< per turtle: the mover pushing it, or kNone
+  std::vector<std::uint32_t> blinkers_;       ///< walls whose visibility changes in time
+  std::vector<std::size_t> blink_next_;       ///< per blinker: its next visibility key
+  std::vector<std::uint32_t> base_mask_;      ///< per wall: its mask while it is there
   double next_key_ = kNever;                  ///< internal time of the next keyframe of any mover
   EventQueue heap_;
 
@@ -372,7 +377,6 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
   for (std::uint32_t w = 0; w < wall_defs_.size(); ++w) {
     const WallDef& wd = wall_defs_[w];
     if (wd.keys.empty()) continue;
-    if constexpr (kStep) throw std::invalid_argument("wall '" + wd.id + "' moves: moving walls need --mode exact for now");
     if (boundary_ == Boundary::periodic) throw std::invalid_argument("wall '" + wd.id + "' moves: moving walls are not supported in a periodic arena yet");
     const Vec2 span = wd.to - wd.from;
     double prev = 0.0;
@@ -484,8 +488,24 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
     link(id, static_cast<std::uint32_t>(grid_.arena_cell_of(d.pos)));
   }
   if constexpr (kExtras) {
+    base_mask_.resize(wall_defs_.size());
+    for (std::uint32_t w = 0; w < wall_defs_.size(); ++w) {
+      base_mask_[w] = wall_layers_[w].mask;
+      const auto& vis = wall_defs_[w].visibility;
+      if (vis.empty()) continue;
+      double prev = -1.0;
+      for (const VisibilityKey& k : vis) {
+        if (!(k.t > prev) || k.t < 0.0)
+          throw std::invalid_argument("wall '" + wall_defs_[w].id + "': visibility times must increase and be >= 0");
+        prev = k.t;
+      }
+      blinkers_.push_back(w);
+      blink_next_.push_back(0);
+    }
+    apply_visibility();
     pushed_by_.assign(def.turtles.size(), kNone);
     for (Mover& m : movers_) aim_mover(m);
+    refresh_next_key();
   }
   rebase_every_ = std::max<std::uint64_t>(4 * n, 4096);
   if constexpr (kStep) {
@@ -704,6 +724,8 @@ void Engine<Flight, kBallBall, kStep, kExtras>::predict(std::uint32_t i) {
           consider_end(i, bi, *it, nb.shift, p);
         }
       }
+    if constexpr (kExtras)
+      for (std::uint32_t m = 0; m < movers_.size(); ++m) consider_mover(i, bi, m, p);
     if (p.t_coll > step_end) {
       p.t_coll = kNever;
       p.kind = Partner::none;
@@ -1070,11 +1092,43 @@ void Engine<Flight, kBallBall, kStep, kExtras>::aim_mover(Mover& m) {
     const double t_key = keys[m.next].t - t_base_;
     m.u = (keys[m.next].from - m.p1_ref) / (t_key - m.t_ref);
   }
+  refresh_next_key();
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::refresh_next_key() {
+  // Always from the keyframes' own times and the current base, never by shifting the old value:
+  // keyframe() must find, at next_key_, the very keyframe that set it.
   next_key_ = kNever;
   for (const Mover& o : movers_) {
     const auto& k = keys_[mover_of_[o.wall]];
     if (o.next < k.size()) next_key_ = std::min(next_key_, k[o.next].t - t_base_);
   }
+  for (std::size_t b = 0; b < blinkers_.size(); ++b) {
+    const auto& vis = wall_defs_[blinkers_[b]].visibility;
+    if (blink_next_[b] < vis.size()) next_key_ = std::min(next_key_, vis[blink_next_[b]].t - t_base_);
+  }
+}
+
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+void Engine<Flight, kBallBall, kStep, kExtras>::apply_visibility() {
+  // Take every visibility key that is due, then rebuild the ends' layers (an end is there when any
+  // of its walls is).
+  bool changed = false;
+  for (std::size_t b = 0; b < blinkers_.size(); ++b) {
+    const std::uint32_t w = blinkers_[b];
+    const auto& vis = wall_defs_[w].visibility;
+    while (blink_next_[b] < vis.size() && !(vis[blink_next_[b]].t - t_base_ > now_)) {
+      wall_layers_[w].mask = vis[blink_next_[b]].visible ? base_mask_[w] : 0u;
+      ++blink_next_[b];
+      changed = true;
+    }
+  }
+  if (!changed) return;
+  std::fill(end_layers_.begin(), end_layers_.end(), Layers{0u, 0u});
+  for (std::uint32_t w = 0; w < wall_defs_.size(); ++w)
+    if (mover_of_[w] == kNone)
+      for (Vec2 p : {wall_defs_[w].from, wall_defs_[w].to}) add_end_layers(p, wall_layers_[w]);
 }
 
 template <class Flight, bool kBallBall, bool kStep, bool kExtras>
@@ -1083,13 +1137,15 @@ void Engine<Flight, kBallBall, kStep, kExtras>::keyframe() {
   ++stats_.events;
   for (Mover& m : movers_) {
     const auto& keys = keys_[mover_of_[m.wall]];
-    if (m.next < keys.size() && keys[m.next].t - t_base_ <= now_) {
+    if (m.next < keys.size() && !(keys[m.next].t - t_base_ > now_)) {
       m.p1_ref = keys[m.next].from;  // exactly the keyframe's pose
       m.t_ref = now_;
       ++m.next;
     }
   }
+  apply_visibility();
   for (Mover& m : movers_) aim_mover(m);
+  refresh_next_key();
   for (std::uint32_t i = 0; i < body_.size(); ++i) {
     if (body_[i].cell == kNone) continue;
     sync(i);
@@ -1215,6 +1271,7 @@ std::size_t Engine<Flight, kBallBall, kStep, kExtras>::add_wall(const WallDef& w
   }
   if constexpr (kExtras) {
     wall_layers_.push_back(wall.layers);
+    base_mask_.push_back(wall.layers.mask);
     for (Vec2 p : {wall.from, wall.to}) add_end_layers(p, wall.layers);
   }
   mover_of_.push_back(kNone);
@@ -1321,8 +1378,8 @@ double Engine<Flight, kBallBall, kStep, kExtras>::rebase() {
     r.t_end -= shift;
   }
   for (Mover& m : movers_) m.t_ref -= shift;
-  next_key_ -= shift;
   t_base_ += shift;
+  refresh_next_key();
   now_ = 0.0;
   heap_.shift_keys(shift);
   return shift;
@@ -1386,9 +1443,11 @@ void Engine<Flight, kBallBall, kStep, kExtras>::finish_step() {
     r.t_start -= dt_;
     r.t_end -= dt_;
   }
+  for (Mover& m : movers_) m.t_ref -= dt_;
   if (inelastic_)
     for (double& t : last_time_) t -= dt_;
   t_base_ = static_cast<double>(step_index_) * dt_;
+  refresh_next_key();
   now_ = 0.0;
   begin_step();
 }
@@ -1476,7 +1535,7 @@ std::unique_ptr<EngineBase> make_with_extras(const WorldDef& def, Mode mode) {
   bool layered = false;
   for (const auto& b : def.balls) layered = layered || !(b.layers == plain);
   for (const auto& t : def.turtles) layered = layered || !(t.layers == plain);
-  for (const auto& w : def.walls) layered = layered || !(w.layers == plain) || !w.keys.empty();
+  for (const auto& w : def.walls) layered = layered || !(w.layers == plain) || !w.keys.empty() || !w.visibility.empty();
   if (def.turtles.empty() && !layered) return make_for_mode<Flight, kBallBall, false>(def, mode);
   return make_for_mode<Flight, kBallBall, true>(def, mode);
 }

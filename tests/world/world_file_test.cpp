@@ -428,3 +428,16 @@ TEST_CASE("moving walls: keyframes parse, and bad ones name their path") {
   CHECK_ERROR(world(R"(, "walls": [{"id": "p", "from": [10, 0], "to": [10, 5], "keys": [{"t": 2, "from": [20, 0], "to": [20, 5], "angle": 3}]}])"),
               "/walls/0/keys/0/angle", "unknown key");
 }
+
+TEST_CASE("walls that come and go: visibility keys parse, and bad ones name their path") {
+  const sim::WorldDef def = tw::parse_world(
+      world(R"(, "walls": [{"id": "g", "from": [10, 0], "to": [10, 5], "visible": [{"t": 0, "visible": false}, {"t": 4, "visible": true}]}])"),
+      "w.json");
+  REQUIRE(def.walls[0].visibility.size() == 2);
+  CHECK_FALSE(def.walls[0].visibility[0].visible);
+  CHECK(def.walls[0].visibility[1].t == 4);
+  CHECK_ERROR(world(R"(, "walls": [{"id": "g", "from": [10, 0], "to": [10, 5], "visible": [{"t": 3, "visible": false}, {"t": 2, "visible": true}]}])"),
+              "/walls/0/visible/1/t", "visibility times must increase");
+  CHECK_ERROR(world(R"(, "walls": [{"id": "g", "from": [10, 0], "to": [10, 5], "visible": [{"t": 3, "visible": 1}]}])"),
+              "/walls/0/visible/0/visible", "expected");
+}

@@ -344,7 +344,7 @@ void Reader::read_walls(const json& v, std::vector<sim::WallDef>& walls) {
     const std::string p = at(path, i);
     const json& w = v[i];
     expect_object(w, p, "a wall");
-    check_keys(w, p, "a wall", {"id", "from", "to", "category", "collides_with", "keys"});
+    check_keys(w, p, "a wall", {"id", "from", "to", "category", "collides_with", "keys", "visible"});
     sim::WallDef def;
     def.id = id(w, p, "a wall");
     def.from = vec2(require(w, p, "from", "a wall"), at(p, "from"));
@@ -370,6 +370,25 @@ void Reader::read_walls(const json& v, std::vector<sim::WallDef>& walls) {
             1e-12 * std::hypot((def.to - def.from).x, (def.to - def.from).y))
           fail(pk, "a moving wall may only translate so far: keep to - from as at t = 0 (rotation and stretching are not simulated yet)");
         def.keys.push_back(wk);
+      }
+    }
+    if (const json* vis = find(w, "visible")) {
+      // From each time on the wall is there or not (for everything); before the first, it is.
+      const std::string vp = at(p, "visible");
+      expect_array(*vis, vp, "visible");
+      double prev = -1.0;
+      for (std::size_t k = 0; k < vis->size(); ++k) {
+        const std::string pk = at(vp, k);
+        const json& key = (*vis)[k];
+        expect_object(key, pk, "a visibility key");
+        check_keys(key, pk, "a visibility key", {"t", "visible"});
+        sim::VisibilityKey vk;
+        vk.t = number(require(key, pk, "t", "a visibility key"), at(pk, "t"));
+        if (!(vk.t > prev) || vk.t < 0.0)
+          fail(at(pk, "t"), "visibility times must increase and be >= 0 (got " + num(vk.t) + ")");
+        prev = vk.t;
+        vk.visible = boolean(require(key, pk, "visible", "a visibility key"), at(pk, "visible"));
+        def.visibility.push_back(vk);
       }
     }
     walls.push_back(std::move(def));

@@ -65,6 +65,12 @@ struct WallKey {
   Vec2 to;
 };
 
+/// From time t (seconds) on, a wall is there (visible) or not really there (for everything).
+struct VisibilityKey {
+  double t = 0.0;
+  bool visible = true;
+};
+
 /// A line-segment wall. Its two ends are collision objects of their own.
 struct WallDef {
   std::string id;
@@ -73,8 +79,12 @@ struct WallDef {
   Layers layers{};
   /// Empty: the wall is fixed. Otherwise it moves through these poses (times increasing, > 0),
   /// linearly from one to the next, and stays at the last. Translation only so far: every pose
-  /// must keep `to - from`. Exact mode only.
+  /// must keep `to - from`. Not in periodic arenas.
   std::vector<WallKey> keys{};
+  /// Empty: always there. Otherwise times (increasing, >= 0) from which the wall is there or not;
+  /// before the first it is there. A wall that appears through a body lets it out (only
+  /// approaching bodies collide). Works with the wall's layers: "not there" ignores everyone.
+  std::vector<VisibilityKey> visibility{};
 };
 
 /// A disc ("ball", a gas molecule).
