@@ -10,6 +10,7 @@
 #include <functional>
 #include <vector>
 
+#include "turtlegas/sim/format.hpp"
 #include "turtlegas/sim/world_def.hpp"
 
 namespace turtlegas::sim {
@@ -17,22 +18,8 @@ namespace {
 
 using Where = DefProblem::Where;
 
-/// Shortest decimal that round-trips, so messages show "-1" rather than "-1.000000".
-std::string num(double v) {
-  std::array<char, 32> buf{};
-  auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  return std::string(buf.data(), r.ptr);
-}
-
-// Appended piecewise: GCC 12 gives a false -Wrestrict for "literal" + std::string (bug 105329).
-std::string vec(Vec2 v) {
-  std::string s = "[";
-  s += num(v.x);
-  s += ", ";
-  s += num(v.y);
-  s += ']';
-  return s;
-}
+std::string num(double v) { return format_number(v); }
+std::string vec(Vec2 v) { return format_vec(v); }
 
 std::string quoted(std::string_view id) {
   std::string s = "'";

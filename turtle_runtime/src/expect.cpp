@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "turtlegas/sim/format.hpp"
 #include "turtlegas/world/game_file.hpp"
 #include "turtlegas/world/world_file.hpp"
 
@@ -22,21 +23,8 @@ namespace {
 using json = nlohmann::json;
 using sim::Vec2;
 
-/// Shortest decimal that reads back as the same double.
-std::string num(double v) {
-  std::array<char, 32> buf{};
-  auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  return std::string(buf.data(), r.ptr);
-}
-
-std::string vec(Vec2 v) {
-  std::string s = "[";
-  s += num(v.x);
-  s += ", ";
-  s += num(v.y);
-  s += ']';
-  return s;
-}
+std::string num(double v) { return sim::format_number(v); }
+std::string vec(Vec2 v) { return sim::format_vec(v); }
 
 std::string at(const std::string& path, std::string_view key) { return path + "/" + std::string(key); }
 

@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gas.hpp"
+#include "turtlegas/sim/format.hpp"
 #include "turtlegas/world/draw_walker.hpp"
 #include "turtlegas/world/game_file.hpp"
 
@@ -36,21 +37,8 @@ std::string prefix(const std::string& file, const std::string& path, const std::
   return file + ": " + reason;
 }
 
-std::string num(double v) {
-  std::array<char, 32> buf{};
-  auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  return std::string(buf.data(), r.ptr);
-}
-
-// Appended piecewise: GCC 12 gives a false -Wrestrict for "literal" + std::string (bug 105329).
-std::string vec(Vec2 v) {
-  std::string s = "[";
-  s += num(v.x);
-  s += ", ";
-  s += num(v.y);
-  s += ']';
-  return s;
-}
+std::string num(double v) { return sim::format_number(v); }
+std::string vec(Vec2 v) { return sim::format_vec(v); }
 
 /// A JSON-pointer reference token: `~` and `/` escaped as RFC 6901 has it.
 std::string token(std::string_view key) {
