@@ -15,14 +15,31 @@ Segment make_segment(Vec2 from, Vec2 to) {
 
 double toi_disc_segment(Vec2 rel, Vec2 v, Vec2 a, const Segment& s, double radius) {
   const double d0 = dot(rel, s.n);
-  // Walls are two-sided: measure the separation on the side the centre is on.
+  const double vn = dot(v, s.n), an = dot(a, s.n);
+  auto on_segment = [&](double t) {
+    const double foot = dot(rel + t * v + (0.5 * t * t) * a, s.u);
+    return foot >= 0.0 && foot <= s.len;
+  };
+  // Walls are two-sided: measure the separation on the side the centre is on. Its gap is a
+  // quadratic, so it falls at most once.
   const double side = d0 >= 0.0 ? 1.0 : -1.0;
-  const double t = first_approach_quadratic(side * d0 - radius, side * dot(v, s.n),
-                                            0.5 * side * dot(a, s.n));
-  if (t == kNever) return kNever;
-  const Vec2 at = rel + t * v + (0.5 * t * t) * a;
-  const double foot = dot(at, s.u);
-  return foot >= 0.0 && foot <= s.len ? t : kNever;
+  double best = kNever;
+  const double t = first_approach_quadratic(side * d0 - radius, side * vn, 0.5 * side * an);
+  if (t != kNever && on_segment(t)) best = t;
+  // A field pulling the disc back towards its own side can carry it across the wall's line beyond
+  // an end and bring it down onto the other face (a ball thrown up past the end of a shelf lands on
+  // it). The other side's gap -side d - r starts negative, so it has to rise before it falls: its
+  // fall is the larger root, where it opens downwards and both roots are positive (c1 > 0).
+  if (side * an > 0.0) {
+    const double c0 = -side * d0 - radius, c1 = -side * vn, c2 = -0.5 * side * an;
+    const double disc = c1 * c1 - 4.0 * c2 * c0;
+    if (c1 > 0.0 && disc > 0.0) {
+      const double q = -0.5 * (c1 + std::sqrt(disc));  // both roots: q / c2 (the larger) and c0 / q
+      const double t_far = q / c2;
+      if (t_far < best && on_segment(t_far)) best = t_far;
+    }
+  }
+  return best;
 }
 
 double toi_disc_point_accel(Vec2 rel, Vec2 v, Vec2 a, double radius, double t_max) {
