@@ -95,14 +95,26 @@ static_assert(sizeof(Body) == 64);
 /// is the end of a turtle's own command.
 enum class Partner : std::uint8_t { none, body, wall, end, command, moving_end };
 
-/// A wall moving through keyframes: between two poses it translates at constant velocity u, so
-/// in its own frame every flight is the usual one with v - u.
+/// A moving wall's pose at a keyframe: its first end and the vector to its second.
+struct MoverKey {
+  double t = 0.0;  ///< scene time, seconds
+  Vec2 p1;
+  Vec2 d;
+};
+
+/// A wall moving through keyframes: between two poses each end moves in a straight line at
+/// constant velocity. When both ends move alike (w == 0) the wall translates at u, and in its own
+/// frame every flight is the usual one with v - u (closed forms); otherwise it turns and stretches
+/// as well, and contacts with its interior are found by bracketed root finding.
 struct Mover {
   std::uint32_t wall = 0;
   std::size_t next = 0;  ///< the keyframe it is heading for (keys.size(): it has stopped)
   Vec2 p1_ref;           ///< its first end at internal time t_ref
+  Vec2 d_ref;            ///< second end minus first, at t_ref
   double t_ref = 0.0;
-  Vec2 u{};              ///< velocity, units/s
+  Vec2 u{};              ///< the first end's velocity, units/s
+  Vec2 w{};              ///< d(d_ref)/dt: the second end's velocity minus the first's
+  bool rigid() const { return w.x == 0.0 && w.y == 0.0; }
 };
 
 /// The earliest predicted collision of a ball, and when it leaves its cell (exact mode).
@@ -139,6 +151,22 @@ struct TurtleRun {
 };
 
 double path_length(Vec2 v, double dt) { return norm(v) * dt; }
+
+/// A moving wall's keyframes as the engine keeps them (validate() has checked them). A span that
+/// differs from the previous pose's by round-off only (1e-12 of its length) is taken as exactly
+/// the previous one, so that a wall meant to translate runs on the translation's closed forms.
+std::vector<MoverKey> mover_keys(const WallDef& wd) {
+  std::vector<MoverKey> out;
+  out.reserve(wd.keys.size());
+  Vec2 d_prev = wd.to - wd.from;
+  for (const WallKey& key : wd.keys) {
+    Vec2 d = key.to - key.from;
+    if (norm(d - d_prev) <= 1e-12 * norm(d_prev)) d = d_prev;
+    out.push_back({key.t, key.from, d});
+    d_prev = d;
+  }
+  return out;
+}
 
 /// The unit vector of a Logo heading (radians; 0 is +y, clockwise). Headings within 1e-9 degrees
 /// of a multiple of 90 give the exact axis: cos(pi/2) is 6e-17, not 0, and a turtle that has
@@ -212,6 +240,17 @@ class Engine final : public EngineBase {
   }
   void add_end_layers(Vec2 p, const Layers& l);
   Vec2 mover_p1(const Mover& m, double t) const { return m.p1_ref + (t - m.t_ref) * m.u; }
+  Vec2 mover_d(const Mover& m, double t) const { return m.d_ref + (t - m.t_ref) * m.w; }
+  /// The wall of mover m as a segment at internal time t.
+  Segment mover_segment(const Mover& m, double t) const {
+    if (m.rigid()) {
+      Segment s = walls_[m.wall];
+      s.p1 = mover_p1(m, t);
+      return s;
+    }
+    const Vec2 p1 = mover_p1(m, t);
+    return make_segment(p1, p1 + mover_d(m, t));
+  }
   void aim_mover(Mover& m);
   void refresh_next_key();
   void apply_visibility();
@@ -314,7 +353,7 @@ class Engine final : public EngineBase {
   std::vector<Layers> wall_layers_;  ///< per wall (kExtras only)
   std::vector<Layers> end_layers_;   ///< per end: its walls' categories and masks together
   std::vector<Mover> movers_;                 ///< moving walls (kExtras only), outside the grid
-  std::vector<std::vector<WallKey>> keys_;    ///< their keyframes, by mover
+  std::vector<std::vector<MoverKey>> keys_;   ///< their keyframes, by mover
   std::vector<std::uint32_t> mover_of_;       ///< per wall: its mover, or kNone
   std::vector<std::uint32_t> pushed_by_;      ///< per turtle: the mover pushing it, or kNone
   std::vector<std::uint32_t> blinkers_;       ///< walls whose visibility changes in time
@@ -378,17 +417,9 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
     const WallDef& wd = wall_defs_[w];
     if (wd.keys.empty()) continue;
     if (boundary_ == Boundary::periodic) throw std::invalid_argument("wall '" + wd.id + "' moves: moving walls are not supported in a periodic arena yet");
-    const Vec2 span = wd.to - wd.from;
-    double prev = 0.0;
-    for (const WallKey& k : wd.keys) {
-      if (!(k.t > prev)) throw std::invalid_argument("wall '" + wd.id + "': keyframe times must increase and be > 0");
-      if (norm(k.to - k.from - span) > 1e-12 * norm(span))
-        throw std::invalid_argument("wall '" + wd.id + "' rotates or stretches between keyframes; only translation is supported yet (keep to - from)");
-      prev = k.t;
-    }
     mover_of_[w] = static_cast<std::uint32_t>(movers_.size());
-    movers_.push_back(Mover{w, 0, wd.from, 0.0, {}});
-    keys_.push_back(wd.keys);
+    movers_.push_back(Mover{w, 0, wd.from, wd.to - wd.from, 0.0, {}, {}});
+    keys_.push_back(mover_keys(wd));
   }
   // Wall ends, one per distinct point: a corner shared by two walls is one collision object.
   for (std::uint32_t w = 0; w < wall_defs_.size(); ++w)
@@ -966,11 +997,17 @@ template <class Flight, bool kBallBall, bool kStep, bool kExtras>
 void Engine<Flight, kBallBall, kStep, kExtras>::collide_wall(std::uint32_t i, std::uint32_t w) {
   sync(i);
   Body& a = body_[i];
-  const Segment& s = walls_[w];
   const std::uint32_t mi = mover_of_[w];
-  const Vec2 p1 = mi == kNone ? s.p1 : mover_p1(movers_[mi], now_);
-  const Vec2 u = mi == kNone ? Vec2{} : movers_[mi].u;  // the wall's velocity
-  const double d = dot(min_image(a.x - p1), s.n);
+  const Segment s = mi == kNone ? walls_[w] : mover_segment(movers_[mi], now_);
+  // The velocity of the wall's material point at the contact: the ends' velocities interpolated
+  // at the foot (the same for every point of a translating wall).
+  Vec2 u{};
+  if (mi != kNone) {
+    const Mover& m = movers_[mi];
+    u = m.u;
+    if (!m.rigid()) u += std::clamp(dot(a.x - s.p1, s.u) / s.len, 0.0, 1.0) * m.w;
+  }
+  const double d = dot(min_image(a.x - s.p1), s.n);
   const Vec2 n = d >= 0.0 ? s.n : -s.n;
   note_contact(a.r - std::abs(d), a.r);
   if (is_turtle(i)) {
@@ -979,8 +1016,10 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_wall(std::uint32_t i, st
     touch(i, EventKind::turtle_wall, w, n);
     if (dot(u, n) > 0.0) {
       // A moving wall pushing a turtle carries it along at its normal speed (both have
-      // infinite mass), until the wall's next keyframe.
-      a.v = dot(u, n) * n;
+      // infinite mass), until the wall's next keyframe. A turning or stretching wall's push
+      // changes along the way, so it knocks the turtle off instead, at twice its normal speed
+      // (an elastic bounce off the wall), which the wall can only catch up with by speeding up.
+      a.v = (movers_[mi].rigid() ? 1.0 : 2.0) * dot(u, n) * n;
       pushed_by_[i - nb_] = mi;
     }
   } else {
@@ -1088,9 +1127,12 @@ void Engine<Flight, kBallBall, kStep, kExtras>::aim_mover(Mover& m) {
   const auto& keys = keys_[mover_of_[m.wall]];
   if (m.next >= keys.size()) {
     m.u = {};
+    m.w = {};
   } else {
     const double t_key = keys[m.next].t - t_base_;
-    m.u = (keys[m.next].from - m.p1_ref) / (t_key - m.t_ref);
+    m.u = (keys[m.next].p1 - m.p1_ref) / (t_key - m.t_ref);
+    // Exactly zero when the pose keeps its span: the translation's closed forms apply.
+    m.w = keys[m.next].d == m.d_ref ? Vec2{} : (keys[m.next].d - m.d_ref) / (t_key - m.t_ref);
   }
   refresh_next_key();
 }
@@ -1138,7 +1180,11 @@ void Engine<Flight, kBallBall, kStep, kExtras>::keyframe() {
   for (Mover& m : movers_) {
     const auto& keys = keys_[mover_of_[m.wall]];
     if (m.next < keys.size() && !(keys[m.next].t - t_base_ > now_)) {
-      m.p1_ref = keys[m.next].from;  // exactly the keyframe's pose
+      m.p1_ref = keys[m.next].p1;  // exactly the keyframe's pose
+      if (keys[m.next].d != m.d_ref) {
+        m.d_ref = keys[m.next].d;
+        walls_[m.wall] = make_segment(m.p1_ref, m.p1_ref + m.d_ref);  // the shape translations use
+      }
       m.t_ref = now_;
       ++m.next;
     }
@@ -1176,7 +1222,15 @@ void Engine<Flight, kBallBall, kStep, kExtras>::consider_mover(std::uint32_t i, 
   const Vec2 p1 = mover_p1(m, now_);
   const Vec2 v = bi.v - m.u;
   const double horizon = std::min(p.t_coll, next_key_);
-  if (!(straight(i) && last_[i] == last_code(Partner::wall, w))) {
+  if (!m.rigid()) {
+    // Turning or stretching: no straight-line argument rules out meeting the same wall again.
+    const double t = now_ + toi_disc_deforming_segment(bi.x - p1, v, accel(i), mover_d(m, now_), m.w, bi.r, horizon - now_);
+    if (t < p.t_coll && t <= horizon) {
+      p.t_coll = t;
+      p.kind = Partner::wall;
+      p.partner = w;
+    }
+  } else if (!(straight(i) && last_[i] == last_code(Partner::wall, w))) {
     const double t = now_ + toi_disc_segment(bi.x - p1, v, accel(i), s, bi.r);
     if (t < p.t_coll && t <= horizon) {
       p.t_coll = t;
@@ -1187,10 +1241,12 @@ void Engine<Flight, kBallBall, kStep, kExtras>::consider_mover(std::uint32_t i, 
   for (std::uint32_t which = 0; which < 2; ++which) {
     const std::uint32_t code = 2 * mi + which;
     if (straight(i) && last_[i] == last_code(Partner::moving_end, code)) continue;
-    const Vec2 e = which == 0 ? p1 : p1 + s.len * s.u;
+    // Each end moves in a straight line, so its contacts have the closed forms of a fixed point.
+    const Vec2 e = which == 0 ? p1 : (m.rigid() ? p1 + s.len * s.u : p1 + mover_d(m, now_));
+    const Vec2 ve = which == 0 ? v : v - m.w;
     double dt;
-    if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(bi.x - e, v, flight_.a, bi.r, horizon - now_);
-    else dt = toi_disc_point(bi.x - e, v, bi.r);
+    if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(bi.x - e, ve, flight_.a, bi.r, horizon - now_);
+    else dt = toi_disc_point(bi.x - e, ve, bi.r);
     const double t = now_ + dt;
     if (t < p.t_coll && t <= horizon) {
       p.t_coll = t;
@@ -1207,7 +1263,9 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_moving_end(std::uint32_t
   const Mover& m = movers_[code / 2];
   const Segment& s = walls_[m.wall];
   const Vec2 p1 = mover_p1(m, now_);
-  const Vec2 e = code % 2 == 0 ? p1 : p1 + s.len * s.u;
+  const bool second = code % 2 == 1;
+  const Vec2 e = !second ? p1 : (m.rigid() ? p1 + s.len * s.u : p1 + mover_d(m, now_));
+  const Vec2 ue = second ? m.u + m.w : m.u;  // the end's velocity
   const Vec2 F = a.x - e;
   const double dist = norm(F);
   note_contact(a.r - dist, a.r);
@@ -1216,7 +1274,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_moving_end(std::uint32_t
     log(EventKind::turtle_wall_end, i - nb_, m.wall);
     touch(i, EventKind::turtle_wall_end, m.wall, F / dist);
   } else {
-    a.v = m.u + bounce(i, a.v - m.u, F / dist);
+    a.v = ue + bounce(i, a.v - ue, F / dist);
     ++stats_.ball_wall_end;
     log(EventKind::ball_wall_end, i, m.wall);
   }
@@ -1241,6 +1299,8 @@ std::size_t Engine<Flight, kBallBall, kStep, kExtras>::add_wall(const WallDef& w
   const Vec2 d = wall.to - wall.from;
   if (!(norm2(d) > 0.0) || !is_finite(wall.from) || !is_finite(wall.to))
     throw std::invalid_argument("wall '" + wall.id + "' has zero length or a non-finite end; give it two distinct ends");
+  if (!wall.keys.empty() || !wall.visibility.empty())
+    throw std::invalid_argument("wall '" + wall.id + "': a wall added while the world runs cannot move or come and go (keys, visibility); put it in the scene");
   if (boundary_ == Boundary::periodic)
     for (Vec2 p : {wall.from, wall.to})
       if (p.x < 0.0 || p.x > width_ || p.y < 0.0 || p.y > height_)
@@ -1502,7 +1562,7 @@ Overlap Engine<Flight, kBallBall, kStep, kExtras>::measure_overlap() const {
   }
   const bool periodic = boundary_ == Boundary::periodic;
   std::vector<Segment> walls_now = walls_;
-  for (const Mover& m : movers_) walls_now[m.wall].p1 = mover_p1(m, now_);
+  for (const Mover& m : movers_) walls_now[m.wall] = mover_segment(m, now_);
   if (!kBallBall && nb_ > 0) {
     // Balls pass through each other by request: measure walls for everyone, and pairs among the
     // turtles and between turtles and balls.

@@ -7,6 +7,8 @@
 namespace turtlegas::sim {
 namespace {
 
+constexpr int kMaxDegree = 6;
+
 double eval(const double* c, int degree, double t) {
   double f = c[degree];
   for (int k = degree - 1; k >= 0; --k) f = f * t + c[k];
@@ -60,9 +62,9 @@ void derivative(const double* c, int degree, double* d) {
 // Critical points of f in (a, b), ascending; returns their count.
 int critical_points(const double* c, int degree, double a, double b, double* out) {
   if (degree < 2) return 0;
-  double d[4];
+  double d[kMaxDegree];
   derivative(c, degree, d);
-  double roots[4];
+  double roots[kMaxDegree];
   const int n = real_roots_in(d, degree - 1, a, b, roots);
   int m = 0;
   for (int k = 0; k < n; ++k)
@@ -99,9 +101,9 @@ int real_roots_in(const double* c, int degree, double a, double b, double* out) 
     }
     return 0;
   }
-  double crit[4];
+  double crit[kMaxDegree];
   const int nc = critical_points(c, degree, a, b, crit);
-  double knots[6];
+  double knots[kMaxDegree + 2];
   int nk = 0;
   knots[nk++] = a;
   for (int k = 0; k < nc; ++k) knots[nk++] = crit[k];
@@ -129,13 +131,13 @@ double first_approach_poly(const double* c, int degree, double t_max) {
                                               degree >= 2 ? c[2] : 0.0);
     return t <= t_max ? t : kNever;
   }
-  double d[4];
+  double d[kMaxDegree];
   derivative(c, degree, d);
   const double f0 = c[0];
   if (f0 <= 0.0 && (d[0] < 0.0 || (d[0] == 0.0 && d[1] < 0.0))) return 0.0;
   double hi = std::min(t_max, root_bound(c, degree));
   if (!(hi > 0.0)) return kNever;
-  double crit[4];
+  double crit[kMaxDegree];
   const int nc = critical_points(c, degree, 0.0, hi, crit);
   double lo = 0.0;
   double flo = f0;

@@ -42,6 +42,87 @@ double toi_disc_segment(Vec2 rel, Vec2 v, Vec2 a, const Segment& s, double radiu
   return best;
 }
 
+namespace {
+
+// The deforming segment of toi_disc_deforming_segment at time t, seen from the disc.
+struct DeformingContact {
+  Vec2 rel, v, a, d0, w;
+  double radius;
+
+  Vec2 d_at(double t) const { return d0 + t * w; }
+  Vec2 y_at(double t) const { return rel + t * v + (0.5 * t * t) * a; }
+  // Signed distance from the centre to the segment's line.
+  double distance(double t) const {
+    const Vec2 d = d_at(t);
+    return cross(d, y_at(t)) / norm(d);
+  }
+  bool foot_on_segment(double t) const {
+    const Vec2 d = d_at(t);
+    const double s = dot(y_at(t), d);
+    return s >= 0.0 && s <= norm2(d);
+  }
+  // d(distance)/dt at t = 0.
+  double distance_rate0() const {
+    const double l2 = norm2(d0);
+    const double f0 = cross(d0, rel);
+    const double f1 = cross(d0, v) + cross(w, rel);
+    return (f1 - f0 * dot(d0, w) / l2) / std::sqrt(l2);
+  }
+};
+
+}  // namespace
+
+double toi_disc_deforming_segment(Vec2 rel, Vec2 v, Vec2 a, Vec2 d0, Vec2 w, double radius, double t_max) {
+  const double f0 = cross(d0, rel);
+  if (f0 == 0.0 || !(t_max >= 0.0)) return kNever;  // on the line: overlapping, or beyond an end
+  const DeformingContact c{rel, v, a, d0, w, radius};
+  // Touching and approaching collides now; touching and receding looks for the next contact.
+  const double side0 = f0 > 0.0 ? 1.0 : -1.0;
+  if (side0 * c.distance(0.0) - radius <= 0.0 && c.foot_on_segment(0.0) && side0 * c.distance_rate0() < 0.0) return 0.0;
+  // f(t) = cross(D, Y) = f0 + f1 t + f2 t^2 + f3 t^3 and |D|^2 = l0 + l1 t + l2 t^2; the distance is
+  // +-radius only where h = f^2 - radius^2 |D|^2 is zero.
+  const Vec2 ah = 0.5 * a;
+  const double f[4] = {f0, cross(d0, v) + cross(w, rel), cross(d0, ah) + cross(w, v), cross(w, ah)};
+  const double l[3] = {norm2(d0), 2.0 * dot(d0, w), norm2(w)};
+  double h[7] = {};
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) h[i + j] += f[i] * f[j];
+  for (int i = 0; i < 3; ++i) h[i] -= radius * radius * l[i];
+  double roots[6];
+  const int n = real_roots_in(h, 6, 0.0, t_max, roots);
+  // Between consecutive roots of h neither side's gap (side * distance - radius) changes sign: read
+  // the distance at the midpoints and take the first fall of either gap from outside to inside with
+  // the foot on the segment. Both sides count: the disc may pass the line beyond an end and meet
+  // the other face later, the wall turning back onto it.
+  double knots[8];
+  int nk = 0;
+  knots[nk++] = 0.0;
+  for (int k = 0; k < n; ++k)
+    if (roots[k] > knots[nk - 1] && roots[k] < t_max) knots[nk++] = roots[k];
+  knots[nk++] = t_max;
+  double prev_mid = 0.0;
+  double prev_dist = c.distance(0.0);
+  for (int k = 0; k + 1 < nk; ++k) {
+    const double mid = knots[k] + 0.5 * (knots[k + 1] - knots[k]);
+    const double dist = c.distance(mid);
+    for (double side : {1.0, -1.0}) {
+      if (!(side * prev_dist - radius > 0.0 && side * dist - radius < 0.0)) continue;
+      // Bisect that gap itself between the two midpoints: exactly one sign change lies there.
+      double lo = prev_mid, hi = mid;
+      for (int it = 0; it < 200; ++it) {
+        const double m = lo + 0.5 * (hi - lo);
+        if (m <= lo || m >= hi) break;
+        (side * c.distance(m) - radius >= 0.0 ? lo : hi) = m;
+      }
+      if (c.foot_on_segment(lo)) return lo;
+    }
+    prev_mid = mid;
+    prev_dist = dist;
+  }
+  // A fall at t_max itself (the last root at the horizon) is left to the next prediction.
+  return kNever;
+}
+
 double toi_disc_point_accel(Vec2 rel, Vec2 v, Vec2 a, double radius, double t_max) {
   if (a.x == 0.0 && a.y == 0.0) {
     const double t = toi_disc_point(rel, v, radius);

@@ -156,6 +156,31 @@ std::optional<DefProblem> check_scalars(const WorldDef& def) {
   return std::nullopt;
 }
 
+/// A moving wall's keyframes: times increasing and > 0, finite poses of non-zero length, and
+/// between two poses (each end moving in a straight line) a wall that never shrinks to a point.
+std::optional<DefProblem> check_keyframes(const WallDef& w, std::size_t i) {
+  Vec2 d_prev = w.to - w.from;
+  double t_prev = 0.0;
+  for (std::size_t k = 0; k < w.keys.size(); ++k) {
+    const WallKey& key = w.keys[k];
+    const std::string head = wall_name(w, i) + " keyframe " + std::to_string(k) + ": ";
+    if (!std::isfinite(key.t) || !(key.t > t_prev))
+      return problem(Where::wall, i, "keys", head + "times must be finite, increase and be > 0 (got " + num(key.t) + " after " + num(t_prev) + ")");
+    if (!is_finite(key.from) || !is_finite(key.to))
+      return problem(Where::wall, i, "keys", head + "from and to must be finite (got " + vec(key.from) + " and " + vec(key.to) + ")");
+    const Vec2 d = key.to - key.from;
+    if (!(norm(d) > 0.0))
+      return problem(Where::wall, i, "keys", head + "the wall has zero length (from and to are both " + vec(key.from) + ")");
+    const Vec2 dd = d - d_prev;
+    const double s = norm2(dd) > 0.0 ? std::clamp(-dot(d_prev, dd) / norm2(dd), 0.0, 1.0) : 0.0;
+    if (!(norm(d_prev + s * dd) > 1e-9 * std::max(norm(d_prev), norm(d))))
+      return problem(Where::wall, i, "keys", head + "on the way to this pose the wall would shrink to a point (its ends pass through each other); add a keyframe in between");
+    d_prev = d;
+    t_prev = key.t;
+  }
+  return std::nullopt;
+}
+
 std::optional<DefProblem> check_walls(const WorldDef& def) {
   for (std::size_t i = 0; i < def.walls.size(); ++i) {
     const WallDef& w = def.walls[i];
@@ -165,6 +190,7 @@ std::optional<DefProblem> check_walls(const WorldDef& def) {
       return problem(Where::wall, i, "to", wall_name(w, i) + ": to must be finite (got " + vec(w.to) + ")");
     if (w.from == w.to)
       return problem(Where::wall, i, "to", wall_name(w, i) + " has zero length (from and to are both " + vec(w.from) + "); move one end or remove the wall");
+    if (auto p = check_keyframes(w, i)) return p;
   }
   return std::nullopt;
 }
@@ -464,6 +490,25 @@ std::vector<WallDef> arena_walls(const ArenaDef& arena) {
       WallDef{std::string(arena_ids[2]), {w, h}, {0.0, h}},
       WallDef{std::string(arena_ids[3]), {0.0, h}, {0.0, 0.0}},
   };
+}
+
+WallKey wall_pose(const WallDef& wall, double t) {
+  WallKey prev{0.0, wall.from, wall.to};
+  for (const WallKey& k : wall.keys) {
+    if (t < k.t) {
+      const double s = (t - prev.t) / (k.t - prev.t);
+      return {t, prev.from + s * (k.from - prev.from), prev.to + s * (k.to - prev.to)};
+    }
+    prev = k;
+  }
+  return {t, prev.from, prev.to};
+}
+
+bool wall_visible(const WallDef& wall, double t) {
+  bool visible = true;
+  for (const VisibilityKey& k : wall.visibility)
+    if (!(k.t > t)) visible = k.visible;
+  return visible;
 }
 
 }  // namespace turtlegas::sim

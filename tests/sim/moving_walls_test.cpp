@@ -86,13 +86,30 @@ TEST_CASE("a turtle pushed by a moving wall is touched and carried along", "[mov
   CHECK(w.measure_overlap().relative <= 1e-9);
 }
 
-TEST_CASE("moving walls: what is not supported yet is a clear error", "[moving]") {
+TEST_CASE("moving walls: bad keyframes and unsupported uses are clear errors", "[moving]") {
   WorldDef d = box(200, 100);
   d.walls.push_back(moving("p", {100, 10}, {100, 90}, {{5.0, {50, 10}, {50, 90}}}));
-  d.walls[0].keys = {{5.0, {50, 10}, {60, 90}}};
-  CHECK_THROWS_WITH(World(d, Mode::exact), Catch::Contains("only translation"));
   d.walls[0].keys = {{0.0, {50, 10}, {50, 90}}};
-  CHECK_THROWS_WITH(World(d, Mode::exact), Catch::Contains("must increase"));
+  CHECK_THROWS_WITH(World(d, Mode::exact), Catch::Contains("keyframe 0") && Catch::Contains("increase"));
+  d.walls[0].keys = {{5.0, {50, 10}, {50, 90}}, {4.0, {50, 10}, {50, 90}}};
+  CHECK_THROWS_WITH(World(d, Mode::exact), Catch::Contains("keyframe 1") && Catch::Contains("increase"));
+  d.walls[0].keys = {{5.0, {50, 10}, {50, 10}}};
+  CHECK_THROWS_WITH(World(d, Mode::exact), Catch::Contains("zero length"));
+  // The ends swap places: on the way the wall would be a point.
+  d.walls[0].keys = {{5.0, {100, 90}, {100, 10}}};
+  CHECK_THROWS_WITH(World(d, Mode::exact), Catch::Contains("shrink to a point"));
+  // Turning by 180 degrees in one step is the same; two steps of 90 degrees are fine.
+  d.walls[0].keys = {{5.0, {60, 50}, {140, 50}}, {10.0, {100, 90}, {100, 10}}};
+  CHECK_NOTHROW(World(d, Mode::exact));
+  d.arena.boundary = Boundary::periodic;
+  CHECK_THROWS_WITH(World(d, Mode::exact), Catch::Contains("periodic"));
+  // A wall added at run time cannot move.
+  WorldDef e = box(200, 100);
+  e.walls.push_back(moving("p", {100, 10}, {100, 90}, {{5.0, {50, 10}, {50, 90}}}));
+  World w(e, Mode::exact);
+  WallDef late{"late", {10, 10}, {10, 90}};
+  late.keys = {{5.0, {20, 10}, {20, 90}}};
+  CHECK_THROWS_WITH(w.add_wall(late), Catch::Contains("cannot move"));
 }
 
 TEST_CASE("moving walls in step mode: the memo's loop with the wall moving inside each step", "[moving][step]") {

@@ -81,3 +81,30 @@ TEST_CASE("an SVG snapshot draws turtles with a heading tick and their id, and p
   CHECK(svg.find("0 balls, 1 turtle<") != std::string::npos);
   CHECK(svg.find("linearGradient") == std::string::npos);  // no balls, no speed legend
 }
+
+TEST_CASE("an SVG snapshot draws moving walls where they are at its time, and absent walls dashed") {
+  sim::WorldDef def;
+  def.name = "moving";
+  def.arena.width = 100;
+  def.arena.height = 100;
+  sim::WallDef arm{"arm", {10, 10}, {30, 10}};
+  arm.keys = {{2.0, {10, 10}, {10, 30}}, {4.0, {50, 10}, {50, 30}}};
+  sim::WallDef gate{"gate", {80, 0}, {80, 100}};
+  gate.visibility = {{1.0, false}};
+  def.walls = {arm, gate};
+  // Halfway to the first keyframe the second end is at (20, 20); between the keyframes the wall
+  // translates; after the last it stays.
+  CHECK(sim::wall_pose(arm, 1.0).to == sim::Vec2{20, 20});
+  CHECK(sim::wall_pose(arm, 3.0).from == sim::Vec2{30, 10});
+  CHECK(sim::wall_pose(arm, 9.0).to == sim::Vec2{50, 30});
+  CHECK(sim::wall_visible(gate, 0.5));
+  CHECK_FALSE(sim::wall_visible(gate, 1.0));
+
+  tw::Snapshot snap = tw::snapshot_of(def);
+  snap.time = 1.0;
+  std::ostringstream out;
+  tw::write_svg(out, snap, 100.0);
+  const std::string svg = out.str();
+  CHECK(svg.find("x1=\"10\" y1=\"10\" x2=\"20\" y2=\"20\"") != std::string::npos);
+  CHECK(count(svg, "stroke-dasharray") == 1);
+}

@@ -112,10 +112,14 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
       << ' ' << fmt(-scale) << ")\">\n"
       << "<rect x=\"0\" y=\"0\" width=\"" << fmt(aw) << "\" height=\"" << fmt(ah)
       << "\" fill=\"#f7f7f7\" stroke=\"#999\" stroke-width=\"1\" vector-effect=\"non-scaling-stroke\"/>\n";
-  for (const auto& wall : snap.walls)
-    out << "<line x1=\"" << fmt(wall.from.x) << "\" y1=\"" << fmt(wall.from.y) << "\" x2=\"" << fmt(wall.to.x)
-        << "\" y2=\"" << fmt(wall.to.y)
-        << "\" stroke=\"#222\" stroke-width=\"2\" stroke-linecap=\"round\" vector-effect=\"non-scaling-stroke\"/>\n";
+  // Moving walls where they are at the snapshot's time; walls not there just now dashed and pale.
+  for (const auto& wall : snap.walls) {
+    const sim::WallKey pose = sim::wall_pose(wall, snap.time);
+    const bool there = sim::wall_visible(wall, snap.time);
+    out << "<line x1=\"" << fmt(pose.from.x) << "\" y1=\"" << fmt(pose.from.y) << "\" x2=\"" << fmt(pose.to.x)
+        << "\" y2=\"" << fmt(pose.to.y) << (there ? "\" stroke=\"#222\"" : "\" stroke=\"#bbb\" stroke-dasharray=\"4 3\"")
+        << " stroke-width=\"2\" stroke-linecap=\"round\" vector-effect=\"non-scaling-stroke\"/>\n";
+  }
   for (std::size_t i = 0; i < snap.balls.size(); ++i) {
     const auto& b = snap.balls[i];
     out << "<circle cx=\"" << fmt(b.pos.x) << "\" cy=\"" << fmt(b.pos.y) << "\" r=\"" << fmt(b.radius)

@@ -14,15 +14,15 @@ inline constexpr double kNever = std::numeric_limits<double>::infinity();
 /// roots are formed without cancellation (the product-of-roots form); kNever if there is none.
 double first_approach_quadratic(double c0, double c1, double c2);
 
-/// The same for a polynomial of degree <= 4 (coefficients c[0..degree], c[degree] may be 0),
+/// The same for a polynomial of degree <= 6 (coefficients c[0..degree], c[degree] may be 0),
 /// searched on [0, t_max]. Roots are isolated by recursing on the derivative: between consecutive
 /// critical points f is monotone, so each sign change brackets exactly one root, which is then
 /// refined by safeguarded bisection to adjacent doubles. The time returned is the bracket end where
 /// f >= 0, so the contact it yields never overlaps. t_max may be kNever (a root bound is used).
 double first_approach_poly(const double* c, int degree, double t_max);
 
-/// All real roots of the polynomial in [a, b], ascending, written to out (room for `degree`).
-/// Returns their number. Each is refined to adjacent doubles.
+/// All real roots of the polynomial (degree <= 6) in [a, b] (finite), ascending, written to out
+/// (room for `degree`). Returns their number. Each is refined to adjacent doubles.
 int real_roots_in(const double* c, int degree, double a, double b, double* out);
 
 }  // namespace turtlegas::sim

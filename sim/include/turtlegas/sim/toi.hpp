@@ -47,6 +47,19 @@ inline double toi_disc_point(Vec2 rel, Vec2 v, double radius) { return toi_disc_
 /// interior of segment s (contact foot on the segment, ends included).
 double toi_disc_segment(Vec2 rel, Vec2 v, Vec2 a, const Segment& s, double radius);
 
+/// A disc touching the interior of a segment whose two ends move in straight lines at constant
+/// velocities, so that it translates, turns and stretches at once (a wall between keyframes). In
+/// the frame of the segment's first end the disc's centre is at rel + v t + a t^2/2 and the second
+/// end at d0 + w t. Returns the first time in [0, t_max] (t_max finite) at which the disc's
+/// distance to the segment's line falls to `radius` with the contact foot on the segment (ends
+/// included), or kNever. Root finding, bracketed: the distance minus the radius changes sign only
+/// at real roots of the polynomial cross(D, Y)^2 - radius^2 |D|^2 (degree <= 6), which are isolated
+/// exactly; the fall between two of them is then bisected on the distance itself to adjacent
+/// doubles, and the end where the disc has not yet reached the wall is returned. Touching and
+/// approaching at t = 0 returns 0; a graze is not a contact. w == 0 gives the same times as
+/// toi_disc_segment to round-off (the engine uses that closed form for pure translation).
+double toi_disc_deforming_segment(Vec2 rel, Vec2 v, Vec2 a, Vec2 d0, Vec2 w, double radius, double t_max);
+
 /// A disc under constant acceleration a reaching a point: the quartic |rel + v t + a t^2/2| = radius,
 /// searched on [0, t_max] (a == 0 falls back to the closed form).
 double toi_disc_point_accel(Vec2 rel, Vec2 v, Vec2 a, double radius, double t_max);

@@ -78,8 +78,9 @@ struct WallDef {
   Vec2 to;
   Layers layers{};
   /// Empty: the wall is fixed. Otherwise it moves through these poses (times increasing, > 0),
-  /// linearly from one to the next, and stays at the last. Translation only so far: every pose
-  /// must keep `to - from`. Not in periodic arenas.
+  /// each end in a straight line at constant speed from one pose to the next, and stays at the
+  /// last: it may translate, turn and stretch (but not shrink to a point on the way). Not in
+  /// periodic arenas.
   std::vector<WallKey> keys{};
   /// Empty: always there. Otherwise times (increasing, >= 0) from which the wall is there or not;
   /// before the first it is there. A wall that appears through a body lets it out (only
@@ -141,5 +142,12 @@ std::optional<DefProblem> validate(const WorldDef& def);
 
 /// The arena walls that `Boundary::walls` adds, in the order and with the ids the engine uses.
 std::vector<WallDef> arena_walls(const ArenaDef& arena);
+
+/// Where a wall is at time t (seconds): its pose interpolated between keyframes as the engine
+/// moves it (each end linearly), the last pose after the last keyframe; from/to if it is fixed.
+WallKey wall_pose(const WallDef& wall, double t);
+
+/// Whether a wall is there at time t (its visibility keys; always, if it has none).
+bool wall_visible(const WallDef& wall, double t);
 
 }  // namespace turtlegas::sim
