@@ -16,15 +16,8 @@ using namespace turtlegas::test;
 
 namespace {
 
-WallDef moving(std::string id, Vec2 from, Vec2 to, std::vector<WallKey> keys) {
-  WallDef w{std::move(id), from, to};
-  w.keys = std::move(keys);
-  return w;
-}
-
-// Distance from the disc's centre to the line of the deforming segment, minus the radius, on the
-// side the centre starts on; and whether the foot lies on the segment. Written independently of
-// the engine (positions in absolute form, the line through both ends).
+// The signed distance from the disc's centre to the line of the deforming segment, and whether the
+// foot lies on the segment. Written independently of the engine (the line through both ends).
 struct Brute {
   Vec2 rel, v, a, d0, w;
   double r;

@@ -11,14 +11,6 @@
 using namespace turtlegas::sim;
 using namespace turtlegas::test;
 
-namespace {
-WallDef moving(std::string id, Vec2 from, Vec2 to, std::vector<WallKey> keys) {
-  WallDef w{std::move(id), from, to};
-  w.keys = std::move(keys);
-  return w;
-}
-}  // namespace
-
 TEST_CASE("a ball at rest is struck by a moving wall at the exact time and leaves at twice its speed", "[moving]") {
   WorldDef d = box(200, 100, Boundary::none);
   // x = 100 - 10 t until t = 5.

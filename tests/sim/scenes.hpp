@@ -27,6 +27,13 @@ inline WorldDef box(double w, double h, sim::Boundary boundary = sim::Boundary::
   return d;
 }
 
+/// A wall moving through keyframes (see WallDef::keys).
+inline WallDef moving(std::string id, Vec2 from, Vec2 to, std::vector<sim::WallKey> keys) {
+  WallDef w{std::move(id), from, to};
+  w.keys = std::move(keys);
+  return w;
+}
+
 inline BallDef ball(std::string id, Vec2 pos, Vec2 vel, double radius = 1.0, double mass = 1.0) {
   return BallDef{std::move(id), pos, vel, radius, mass, 0.0};
 }
