@@ -26,6 +26,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -73,6 +74,17 @@ bool reset_peak_rss() {
   out << "5";
   out.flush();
   return static_cast<bool>(out);
+}
+
+/// glibc raises its mmap threshold (up to 32 MB) each time a large block is freed; from then on,
+/// arrays of a few MB come from the brk heap, and the holes they leave when freed stay resident,
+/// so the peak would depend on the order of earlier allocations (up to 30 bytes a ball here). A
+/// fixed threshold sends every array above 128 KiB to mmap and back to the system when freed: the
+/// peak is then that of the memory alive at one time.
+void fix_mmap_threshold() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+#endif
 }
 
 /// Gives freed heap pages back to the system, so that what the loader freed does not hide the
@@ -230,6 +242,7 @@ Run run_steps(sim::World& world, std::uint64_t steps, double max_wall) {
 }
 
 int run_main(int argc, char** argv) {
+  fix_mmap_threshold();
   const std::uint64_t baseline_rss = proc_status_bytes("VmRSS");
   const Options opt = parse_options(argc, argv);
 
@@ -243,9 +256,11 @@ int run_main(int argc, char** argv) {
   const double phi = disc_area / (def->arena.width * def->arena.height);
 
   const auto construct_start = Clock::now();
-  sim::World world(*def, opt.mode);
+  // The World consumes the scene: it frees the ball list as soon as it has copied the balls, so
+  // the peak is not the scene plus the whole engine (see World(WorldDef&&)).
+  sim::World world(std::move(*def), opt.mode);
   const double construct_seconds = seconds_since(construct_start);
-  def.reset();  // the engine keeps its own copy of everything it needs
+  def.reset();  // the rest of it (walls, names); the engine keeps its own copy of what it needs
   trim_heap();
   const std::uint64_t setup_peak_rss = proc_status_bytes("VmHWM");
   const std::uint64_t engine_rss = proc_status_bytes("VmRSS");
@@ -305,7 +320,7 @@ int run_main(int argc, char** argv) {
   out["setup_peak_rss_bytes"] = setup_peak_rss;
   out["engine_rss_bytes"] = engine_rss;
   // Whole process, loading and World construction included (the scene as a WorldDef, ids and all,
-  // coexists with the engine while it is built).
+  // until the World has copied its balls).
   out["bytes_per_ball"] = per(static_cast<double>(peak_rss) - static_cast<double>(baseline_rss), nd);
   // The engine alone: the peak while running, with the WorldDef gone, above the program's start.
   if (peak_reset) {

@@ -189,7 +189,10 @@ Vec2 heading_vector(double heading) {
 template <class Flight, bool kBallBall, bool kStep, bool kExtras>
 class Engine final : public EngineBase {
  public:
-  Engine(const WorldDef& def, Mode mode);
+  /// Builds the engine for `def`. `release`, when given, is def's own ball list: it is emptied and
+  /// its memory freed as soon as the balls have been copied, before the rest of the engine is
+  /// allocated, so that the scene and the whole engine never take memory at the same time.
+  Engine(const WorldDef& def, std::vector<BallDef>* release);
 
   void advance_to(double t) override;
   void set_event_log(std::vector<Event>* log) override { log_ = log; }
@@ -387,7 +390,7 @@ class Engine final : public EngineBase {
 };
 
 template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
+Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<BallDef>* release) {
   if (auto problem = validate(def)) throw std::invalid_argument(problem->message);
   const EffectsDef& fx = def.effects;
   if constexpr (kStep) kick_ = fx.gravity;
@@ -467,35 +470,15 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
     // A periodic arena needs three cells across, so that no pair is seen through two images.
     if (boundary_ == Boundary::periodic) cell = std::max(rule * (1.0 + 1e-9), std::min(cell, std::min(width_, height_) / 3.0));
   }
-  const bool periodic = boundary_ == Boundary::periodic;
-  cell_ = cell;
-  std::vector<bool> moving(wall_defs_.size());
-  for (std::uint32_t w = 0; w < wall_defs_.size(); ++w) moving[w] = mover_of_[w] != kNone;
-  grid_ = CellGrid(width_, height_, cell, periodic, walls_, ends_, moving);
-  if (periodic && (grid_.nx() < 3 || grid_.ny() < 3))
-    throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell) +
-                                "); enlarge the arena or use smaller balls");
-
+  // The bodies first, then (for a consumed scene) free the ball list before anything else per
+  // ball or per cell is allocated: the peak is the scene plus bodies and masses, not the scene
+  // plus the whole engine.
   body_.resize(n);
   mass_.resize(nb_);
-  last_.assign(n, kNone);
-  if (inelastic_) last_time_.assign(n, -kNever);
-  pending_.assign(n, Pending{});
-  head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
-  if constexpr (kExtras) turtle_head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
-  heap_.reset(n);
-  if constexpr (kStep) {
-    travel_.assign(n, 0.0);
-    stamp_.assign(walls_.size() * 9 + ends_.size() * 9, 0);
-  }
   if constexpr (kExtras) {
     layers_.resize(n);
     for (std::uint32_t i = 0; i < nb_; ++i) layers_[i] = def.balls[i].layers;
     for (std::size_t k = 0; k < def.turtles.size(); ++k) layers_[nb_ + k] = def.turtles[k].layers;
-    for (const auto& w : wall_defs_) wall_layers_.push_back(w.layers);
-    end_layers_.assign(ends_.size(), Layers{0u, 0u});
-    for (const auto& w : wall_defs_)
-      for (Vec2 p : {w.from, w.to}) add_end_layers(p, w.layers);
   }
   for (std::uint32_t i = 0; i < nb_; ++i) {
     const BallDef& d = def.balls[i];
@@ -503,8 +486,8 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
     body_[i].v = d.vel;
     body_[i].r = d.radius;
     mass_[i] = d.mass;
-    link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(d.pos)));
   }
+  if (release) std::vector<BallDef>().swap(*release);
   run_.resize(def.turtles.size());
   for (std::size_t k = 0; k < def.turtles.size(); ++k) {
     const TurtleDef& d = def.turtles[k];
@@ -516,8 +499,35 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, Mode) {
     r.speed = d.speed;
     r.turn_rate = d.turn_rate;
     r.bounce = d.bounce;
-    link(id, static_cast<std::uint32_t>(grid_.arena_cell_of(d.pos)));
   }
+
+  const bool periodic = boundary_ == Boundary::periodic;
+  cell_ = cell;
+  std::vector<bool> moving(wall_defs_.size());
+  for (std::uint32_t w = 0; w < wall_defs_.size(); ++w) moving[w] = mover_of_[w] != kNone;
+  grid_ = CellGrid(width_, height_, cell, periodic, walls_, ends_, moving);
+  if (periodic && (grid_.nx() < 3 || grid_.ny() < 3))
+    throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell) +
+                                "); enlarge the arena or use smaller balls");
+
+  last_.assign(n, kNone);
+  if (inelastic_) last_time_.assign(n, -kNever);
+  pending_.assign(n, Pending{});
+  head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
+  if constexpr (kExtras) turtle_head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
+  heap_.reset(n);
+  if constexpr (kStep) {
+    travel_.assign(n, 0.0);
+    stamp_.assign(walls_.size() * 9 + ends_.size() * 9, 0);
+  }
+  if constexpr (kExtras) {
+    for (const auto& w : wall_defs_) wall_layers_.push_back(w.layers);
+    end_layers_.assign(ends_.size(), Layers{0u, 0u});
+    for (const auto& w : wall_defs_)
+      for (Vec2 p : {w.from, w.to}) add_end_layers(p, w.layers);
+  }
+  // Balls, then turtles, each in list order, as the cell lists have always been built.
+  for (std::uint32_t i = 0; i < n; ++i) link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(body_[i].x)));
   if constexpr (kExtras) {
     base_mask_.resize(wall_defs_.size());
     for (std::uint32_t w = 0; w < wall_defs_.size(); ++w) {
@@ -1584,32 +1594,38 @@ Overlap Engine<Flight, kBallBall, kStep, kExtras>::measure_overlap() const {
 }
 
 template <class Flight, bool kBallBall, bool kExtras>
-std::unique_ptr<EngineBase> make_for_mode(const WorldDef& def, Mode mode) {
-  if (mode == Mode::step) return std::make_unique<Engine<FreeFlight, kBallBall, true, kExtras>>(def, mode);
-  return std::make_unique<Engine<Flight, kBallBall, false, kExtras>>(def, mode);
+std::unique_ptr<EngineBase> make_for_mode(const WorldDef& def, Mode mode, std::vector<BallDef>* release) {
+  if (mode == Mode::step) return std::make_unique<Engine<FreeFlight, kBallBall, true, kExtras>>(def, release);
+  return std::make_unique<Engine<Flight, kBallBall, false, kExtras>>(def, release);
 }
 
 template <class Flight, bool kBallBall>
-std::unique_ptr<EngineBase> make_with_extras(const WorldDef& def, Mode mode) {
+std::unique_ptr<EngineBase> make_with_extras(const WorldDef& def, Mode mode, std::vector<BallDef>* release) {
   const Layers plain{};
   bool layered = false;
   for (const auto& b : def.balls) layered = layered || !(b.layers == plain);
   for (const auto& t : def.turtles) layered = layered || !(t.layers == plain);
   for (const auto& w : def.walls) layered = layered || !(w.layers == plain) || !w.keys.empty() || !w.visibility.empty();
-  if (def.turtles.empty() && !layered) return make_for_mode<Flight, kBallBall, false>(def, mode);
-  return make_for_mode<Flight, kBallBall, true>(def, mode);
+  if (def.turtles.empty() && !layered) return make_for_mode<Flight, kBallBall, false>(def, mode, release);
+  return make_for_mode<Flight, kBallBall, true>(def, mode, release);
 }
 
-}  // namespace
-
-std::unique_ptr<EngineBase> make_engine(const WorldDef& def, Mode mode) {
+std::unique_ptr<EngineBase> make(const WorldDef& def, Mode mode, std::vector<BallDef>* release) {
   // The physics is chosen here, once per scene: one instantiation per combination of effects.
   const bool gravity = def.effects.gravity.x != 0.0 || def.effects.gravity.y != 0.0;
   const bool ball_ball = def.effects.ball_ball;
   if (gravity) {
-    return ball_ball ? make_with_extras<GravityFlight, true>(def, mode) : make_with_extras<GravityFlight, false>(def, mode);
+    return ball_ball ? make_with_extras<GravityFlight, true>(def, mode, release)
+                     : make_with_extras<GravityFlight, false>(def, mode, release);
   }
-  return ball_ball ? make_with_extras<FreeFlight, true>(def, mode) : make_with_extras<FreeFlight, false>(def, mode);
+  return ball_ball ? make_with_extras<FreeFlight, true>(def, mode, release)
+                   : make_with_extras<FreeFlight, false>(def, mode, release);
 }
+
+}  // namespace
+
+std::unique_ptr<EngineBase> make_engine(const WorldDef& def, Mode mode) { return make(def, mode, nullptr); }
+
+std::unique_ptr<EngineBase> make_engine(WorldDef&& def, Mode mode) { return make(def, mode, &def.balls); }
 
 }  // namespace turtlegas::sim::detail

@@ -38,5 +38,7 @@ class EngineBase {
 };
 
 std::unique_ptr<EngineBase> make_engine(const WorldDef& def, Mode mode);
+/// The same engine; def.balls is freed as soon as the engine has copied it (see World(WorldDef&&)).
+std::unique_ptr<EngineBase> make_engine(WorldDef&& def, Mode mode);
 
 }  // namespace turtlegas::sim::detail

@@ -34,7 +34,8 @@ class EventQueue {
   std::size_t memory_bytes() const;
 
  private:
-  enum : std::uint32_t { kInHeap = 0xFFFFFFF0u, kInOverflow, kInfinite, kNowhere };
+  /// Node::where beyond the bucket slots; kRebuilding marks the ids a rebuild re-inserts.
+  enum : std::uint32_t { kInHeap = 0xFFFFFFF0u, kInOverflow, kInfinite, kNowhere, kRebuilding };
   struct Node {
     double key = 0.0;
     std::uint32_t where = kNowhere;  ///< bucket slot, or one of the k* states

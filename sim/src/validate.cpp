@@ -72,7 +72,12 @@ class CoverGrid {
 
   struct Range {
     int x0, x1, y0, y1;
+    std::size_t cells() const {
+      return static_cast<std::size_t>(x1 - x0 + 1) * static_cast<std::size_t>(y1 - y0 + 1);
+    }
   };
+
+  void reserve(std::size_t entries) { entries_.reserve(entries); }
 
   /// The cells that the box [lo, hi] touches, clamped to the grid.
   Range cover(Vec2 lo, Vec2 hi) const {
@@ -389,6 +394,11 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
     auto box = [&](Vec2 p, double r) { return grid.cover(p - Vec2{r, r}, p + Vec2{r, r}); };
     // Items are disc * 4 + image, so a periodic pair is caught from whichever side crosses the edge.
     std::array<Vec2, 4> img{}, other{};
+    // Room for every entry first: a list grown by doubling would briefly hold three times as many.
+    std::size_t entries = 0;
+    for (std::size_t k = 0; k < n; ++k)
+      for (int m = 0, m_count = images(k, img); m < m_count; ++m) entries += box(img[m], d.radius(k)).cells();
+    grid.reserve(entries);
     for (std::size_t k = 0; k < n; ++k) {
       const int m_count = images(k, img);
       const double r = d.radius(k);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "turtlegas/sim/world.hpp"
 
+#include <utility>
+
 #include "engine.hpp"
 
 namespace turtlegas::sim {
@@ -12,6 +14,9 @@ class World::Impl {
 
 World::World(const WorldDef& def, Mode mode) : impl_(std::make_unique<Impl>()) {
   impl_->engine = detail::make_engine(def, mode);
+}
+World::World(WorldDef&& def, Mode mode) : impl_(std::make_unique<Impl>()) {
+  impl_->engine = detail::make_engine(std::move(def), mode);
 }
 World::~World() = default;
 World::World(World&&) noexcept = default;

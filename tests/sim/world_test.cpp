@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <utility>
+#include <vector>
 
 #include "scenes.hpp"
 #include "turtlegas/sim/reference.hpp"
@@ -196,6 +198,48 @@ TEST_CASE("runs are deterministic and do not depend on how time is cut into call
     const auto a = run_log(d, Mode::step, 5.0);
     CHECK(same_bits(a, run_log(d, Mode::step, 5.0, 71)));
     CHECK(a.size() > 500);
+  }
+}
+
+TEST_CASE("a World built from a consumed WorldDef runs as one built from a const ref", "[world][determinism]") {
+  WorldDef d = random_gas(300, 0.2, 1.0, 4.0, 43);
+  auto check_same = [](const WorldDef& def, Mode mode, double T) {
+    World kept(def, mode);
+    WorldDef spent = def;
+    World consumed(std::move(spent), mode);
+    // The ball list is freed at once, not merely moved from later.
+    CHECK(spent.balls.empty());
+    CHECK(spent.balls.capacity() == 0);
+    std::vector<Event> a, b;
+    kept.set_event_log(&a);
+    consumed.set_event_log(&b);
+    kept.advance_to(T);
+    consumed.advance_to(T);
+    CHECK(a.size() > 100);
+    CHECK(same_bits(a, b));
+    REQUIRE(kept.ball_count() == consumed.ball_count());
+    for (std::size_t i = 0; i < kept.ball_count(); ++i) {
+      const BallState x = kept.ball(i), y = consumed.ball(i);
+      CHECK(std::memcmp(&x.pos, &y.pos, sizeof(Vec2)) == 0);
+      CHECK(std::memcmp(&x.vel, &y.vel, sizeof(Vec2)) == 0);
+      CHECK(kept.mass(i) == consumed.mass(i));
+      CHECK(kept.radius(i) == consumed.radius(i));
+    }
+  };
+  SECTION("exact") { check_same(d, Mode::exact, 5.0); }
+  SECTION("exact under gravity") {
+    d.effects.gravity = {0, -5};
+    check_same(d, Mode::exact, 5.0);
+  }
+  SECTION("step") { check_same(d, Mode::step, 5.0); }
+  SECTION("periodic") { check_same(random_gas(300, 0.2, 1.0, 4.0, 47, Boundary::periodic), Mode::exact, 5.0); }
+  SECTION("with collision layers (the engine with extras)") {
+    for (auto& b : d.balls) b.layers = {2u, 0xffffffffu};
+    check_same(d, Mode::exact, 5.0);
+  }
+  SECTION("a scene the engine refuses gives the same error") {
+    d.arena.cell = 0.5;
+    CHECK_THROWS_WITH(World(WorldDef(d), Mode::exact), Catch::Contains("largest ball"));
   }
 }
 

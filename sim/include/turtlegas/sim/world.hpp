@@ -86,6 +86,11 @@ class World {
   /// Throws std::invalid_argument with the validate() message if the scene is not valid, or
   /// if a requested cell size breaks the memo's rule in step mode.
   World(const WorldDef& def, Mode mode);
+  /// The same World, built from a scene it may consume: def's ball list is freed as soon as the
+  /// engine has copied it, before the rest of the engine is allocated, so that a large scene and
+  /// the engine built from it are never in memory together. Afterwards (also when this throws)
+  /// def is valid but unspecified; keep what you still need (ball ids, say) before the call.
+  World(WorldDef&& def, Mode mode);
   ~World();
   World(World&&) noexcept;
   World& operator=(World&&) noexcept;
