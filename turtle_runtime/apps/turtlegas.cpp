@@ -4,6 +4,9 @@
 // through the world server (their programs between control steps); one without runs the bare engine.
 #include <dlfcn.h>
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>  // mallopt
+#endif
 
 #include <algorithm>
 #include <array>
@@ -133,11 +136,34 @@ struct RunOptions {
   double program_budget = 2.0;  ///< wall-clock seconds a program may run without a command
 };
 
-/// The event log as JSON lines, written in chunks while the world runs.
+/// Ball ids packed into one buffer (a std::string each would cost 32 bytes a ball, more than
+/// the engine's whole per-ball budget allows beside it).
+class IdTable {
+ public:
+  void reserve(std::size_t ids, std::size_t chars) {
+    end_.reserve(ids);
+    chars_.reserve(chars);
+  }
+  void push_back(std::string_view id) {
+    chars_.append(id);
+    end_.push_back(chars_.size());
+  }
+  std::string_view operator[](std::size_t i) const {
+    const std::size_t begin = i == 0 ? 0 : end_[i - 1];
+    return std::string_view(chars_).substr(begin, end_[i] - begin);
+  }
+
+ private:
+  std::string chars_;
+  std::vector<std::size_t> end_;
+};
+
+/// The event log as JSON lines, written in chunks while the world runs. Ball ids come apart from
+/// the scene, which the World may have taken over (World(WorldDef&&)).
 class EventWriter {
  public:
-  EventWriter(AtomicFile& file, const sim::WorldDef& def, const sim::World& world)
-      : file_(file), def_(def), world_(world) {}
+  EventWriter(AtomicFile& file, const IdTable& ball_ids, const sim::WorldDef& def, const sim::World& world)
+      : file_(file), ball_ids_(ball_ids), def_(def), world_(world) {}
 
   void write(const std::vector<sim::Event>& events) {
     buf_.clear();
@@ -148,16 +174,16 @@ class EventWriter {
       buf_ += sim::to_string(e.kind);
       buf_ += "\", \"a\": ";
       const bool turtle_a = sim::involves_turtle(e.kind) || (e.kind == sim::EventKind::exit && e.b == 1);
-      append_json_string(buf_, turtle_a ? def_.turtles[e.a].id : def_.balls[e.a].id);
-      const std::string* b = nullptr;
+      append_json_string(buf_, turtle_a ? std::string_view(def_.turtles[e.a].id) : ball_ids_[e.a]);
+      std::optional<std::string_view> b;
       switch (e.kind) {
         case sim::EventKind::ball_ball:
-        case sim::EventKind::turtle_ball: b = &def_.balls[e.b].id; break;
+        case sim::EventKind::turtle_ball: b = ball_ids_[e.b]; break;
         case sim::EventKind::ball_wall:
         case sim::EventKind::ball_wall_end:
         case sim::EventKind::turtle_wall:
-        case sim::EventKind::turtle_wall_end: b = &world_.walls()[e.b].id; break;
-        case sim::EventKind::turtle_turtle: b = &def_.turtles[e.b].id; break;
+        case sim::EventKind::turtle_wall_end: b = world_.walls()[e.b].id; break;
+        case sim::EventKind::turtle_turtle: b = def_.turtles[e.b].id; break;
         case sim::EventKind::exit: break;  // b only says what kind of body left
       }
       if (b) {
@@ -171,6 +197,7 @@ class EventWriter {
 
  private:
   AtomicFile& file_;
+  const IdTable& ball_ids_;
   const sim::WorldDef& def_;
   const sim::World& world_;
   std::string buf_;
@@ -270,17 +297,18 @@ std::unique_ptr<tt::WorldServer> make_server(const tw::Scene& scene, const tt::R
 
 /// The engine rejects a scene it cannot run (a cell size against the memo's rule, say) with
 /// std::invalid_argument: that is the world file's fault, so exit code 2.
-sim::World make_world(const sim::WorldDef& def, sim::Mode mode, const std::string& file) {
+template <class Def>  // const sim::WorldDef& or sim::WorldDef&&
+sim::World make_world(Def&& def, sim::Mode mode, const std::string& file) {
   try {
-    return sim::World(def, mode);
+    return sim::World(std::forward<Def>(def), mode);
   } catch (const std::invalid_argument& e) {
     throw BadInput(file + ": " + (mode == sim::Mode::exact ? "exact" : "step") + " mode: " + e.what());
   }
 }
 
-std::string count_summary(const sim::WorldDef& def) {
+std::string count_summary(const sim::WorldDef& def, std::size_t balls) {
   auto plural = [](std::size_t n, const char* noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); };
-  std::string s = plural(def.balls.size(), "ball") + ", " + plural(def.walls.size(), "wall");
+  std::string s = plural(balls, "ball") + ", " + plural(def.walls.size(), "wall");
   if (def.arena.boundary == sim::Boundary::walls) s += " (+4 arena walls)";
   if (!def.turtles.empty()) s += ", " + plural(def.turtles.size(), "turtle");
   return s;
@@ -320,7 +348,7 @@ int check_command(const std::string& file, const tt::Registry& registry) {
   const sim::World exact = make_world(def, sim::Mode::exact, file);
   const sim::World step = make_world(def, sim::Mode::step, file);
   std::printf("%s: ok: \"%s\", %s, arena %s x %s (boundary %s), cell %s (%d x %d), dt %s s\n", file.c_str(),
-              def.name.c_str(), count_summary(def).c_str(), fmt(def.arena.width).c_str(), fmt(def.arena.height).c_str(),
+              def.name.c_str(), count_summary(def, def.balls.size()).c_str(), fmt(def.arena.width).c_str(), fmt(def.arena.height).c_str(),
               boundary_name(def.arena.boundary), fmt(step.cell_size()).c_str(), step.cells_x(), step.cells_y(),
               fmt(def.dt).c_str());
   if (!def.turtles.empty()) {
@@ -411,7 +439,8 @@ double run_in_chunks(double from, double until, double first_chunk, double min_c
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-void write_state(AtomicFile& file, const sim::World& world, const sim::WorldDef& def) {
+void write_state(AtomicFile& file, const sim::World& world, const IdTable& ball_ids,
+                 const sim::WorldDef& def) {
   std::string buf = "{\"t\": ";
   append_number(buf, world.time());
   buf += ", \"balls\": [";
@@ -422,7 +451,7 @@ void write_state(AtomicFile& file, const sim::World& world, const sim::WorldDef&
     buf += first ? "\n  " : ",\n  ";
     first = false;
     buf += "{\"id\": ";
-    append_json_string(buf, def.balls[i].id);
+    append_json_string(buf, ball_ids[i]);
     buf += ", \"pos\": [";
     append_number(buf, b.pos.x);
     buf += ", ";
@@ -484,6 +513,11 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
   tw::Scene scene = load(opt.world, registry);
   sim::WorldDef& def = scene.def;
   if (opt.dt) def.dt = *opt.dt;
+  const std::size_t ball_count = def.balls.size();
+  IdTable ball_ids;  // for the event log and the state file
+  std::size_t id_chars = 0;
+  for (const sim::BallDef& b : def.balls) id_chars += b.id.size();
+  ball_ids.reserve(ball_count, id_chars);
 
   Progress progress(opt.until);
   RunTotals totals;
@@ -492,13 +526,22 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
   std::optional<sim::World> bare;
   std::unique_ptr<tt::WorldServer> server;
   if (def.turtles.empty()) {
-    bare.emplace(make_world(def, mode, opt.world));
+    // The World takes the balls over, so that the scene's copy of them (and their ids' strings)
+    // and the engine are never in memory together: a million balls then cost about 170 bytes each
+    // rather than 260. def keeps everything else.
+    for (const sim::BallDef& b : def.balls) ball_ids.push_back(b.id);
+    // (the ids' own strings go with the balls)
+    std::vector<sim::BallDef> balls = std::move(def.balls);
+    def.balls.clear();
+    sim::WorldDef given = def;  // everything but the balls: small
+    given.balls = std::move(balls);
+    bare.emplace(make_world(std::move(given), mode, opt.world));
     sim::World& world = *bare;
     totals.energy_start = world.energy();
     std::vector<sim::Event> events;
     std::optional<EventWriter> writer;
     if (events_file) {
-      writer.emplace(*events_file, def, world);
+      writer.emplace(*events_file, ball_ids, def, world);
       world.set_event_log(&events);
     }
     // A quarter step first: short enough for a million balls.
@@ -514,6 +557,7 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
         });
     world.set_event_log(nullptr);
   } else {
+    for (const sim::BallDef& b : def.balls) ball_ids.push_back(b.id);
     tt::ServerOptions options;
     options.mode = mode;
     options.stack_bytes = opt.stack_kib * 1024;
@@ -556,7 +600,7 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
   for (std::size_t i = 0; i < world.ball_count(); ++i) live += world.ball(i).alive ? 1 : 0;
 
   if (events_file) events_file->commit();
-  if (state_file) write_state(*state_file, world, def);
+  if (state_file) write_state(*state_file, world, ball_ids, def);
 
   const char* mode_name = mode == sim::Mode::exact ? "exact" : "step";
   const double per_second = wall_seconds > 0.0 ? static_cast<double>(st.collisions()) / wall_seconds : 0.0;
@@ -568,7 +612,7 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
         {"until", opt.until},
         {"dt", def.dt},
         {"seed", def.seed},
-        {"balls", def.balls.size()},
+        {"balls", ball_count},
         {"balls_alive", live},
         {"walls", world.walls().size()},
         {"turtles", def.turtles.size()},
@@ -608,7 +652,7 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
   if (opt.stats) {
     using ull = unsigned long long;
     const double de = energy_start != 0.0 ? (energy_end - energy_start) / std::abs(energy_start) : energy_end - energy_start;
-    std::printf("%s (%s): %s, %s mode, t = 0 -> %s s\n", def.name.c_str(), opt.world.c_str(), count_summary(def).c_str(),
+    std::printf("%s (%s): %s, %s mode, t = 0 -> %s s\n", def.name.c_str(), opt.world.c_str(), count_summary(def, ball_count).c_str(),
                 mode_name, fmt(world.time()).c_str());
     std::printf("  collisions   %llu  (ball-ball %llu, ball-wall %llu, ball-wall-end %llu)\n", ull(st.collisions()),
                 ull(st.ball_ball), ull(st.ball_wall), ull(st.ball_wall_end));
@@ -641,6 +685,12 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
 }  // namespace
 
 int main(int argc, char** argv) {
+#if defined(__GLIBC__)
+  // Arrays above 128 KiB come from mmap and go back to the system when freed. glibc otherwise
+  // raises this threshold after the first large free, and the loader's freed arrays would stay
+  // resident as holes in the heap under the engine's (see docs/performance.md, "Memory").
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+#endif
   auto log = spdlog::stderr_color_st("turtlegas");
   log->set_pattern("%^%l%$: %v");
   spdlog::set_default_logger(log);
