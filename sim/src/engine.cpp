@@ -281,6 +281,25 @@ class Engine final : public EngineBase {
     }
     return d;
   }
+  /// x - s.p1 for the image of x nearest to the segment. In a periodic arena the minimum image
+  /// relative to p1 is the wrong one near the far part of a wall longer than half the arena.
+  Vec2 rel_to_segment(Vec2 x, const Segment& s) const {
+    Vec2 best = min_image(x - s.p1);
+    if (!grid_.periodic()) return best;
+    auto distance = [&](Vec2 rel) { return norm(rel - std::clamp(dot(rel, s.u), 0.0, s.len) * s.u); };
+    double best_distance = distance(best);
+    const Vec2 base = best;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Vec2 rel = base + Vec2{dx * width_, dy * height_};
+        const double d = distance(rel);
+        if (d < best_distance) {
+          best = rel;
+          best_distance = d;
+        }
+      }
+    return best;
+  }
 
   // Bookkeeping.
   void link(std::uint32_t i, std::uint32_t cell);
@@ -1017,7 +1036,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_wall(std::uint32_t i, st
     u = m.u;
     if (!m.rigid()) u += std::clamp(dot(a.x - s.p1, s.u) / s.len, 0.0, 1.0) * m.w;
   }
-  const double d = dot(min_image(a.x - s.p1), s.n);
+  const double d = dot(rel_to_segment(a.x, s), s.n);
   const Vec2 n = d >= 0.0 ? s.n : -s.n;
   note_contact(a.r - std::abs(d), a.r);
   if (is_turtle(i)) {
@@ -1321,7 +1340,7 @@ std::size_t Engine<Flight, kBallBall, kStep, kExtras>::add_wall(const WallDef& w
     if (b.cell == kNone) continue;
     if constexpr (kExtras)
       if (!layers_[i].collides_with(wall.layers)) continue;  // it passes through this wall
-    const Vec2 rel = min_image(pos_at(b, i, now_ - b.t) - seg.p1);
+    const Vec2 rel = rel_to_segment(pos_at(b, i, now_ - b.t), seg);
     const double foot = std::clamp(dot(rel, seg.u), 0.0, seg.len);
     const double gap = norm(rel - foot * seg.u) - b.r;
     if (gap < 0.0)

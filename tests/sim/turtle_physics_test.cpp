@@ -292,3 +292,27 @@ TEST_CASE("after touching a wall and turning 90 degrees, a turtle drives along i
     CHECK(w.turtle(0).pos.x == 60.0);
   }
 }
+
+TEST_CASE("in a periodic arena a touch on the far part of a long wall has the right normal", "[turtle][periodic]") {
+  // A wall longer than half the arena: near its far end the nearest image of the turtle measured
+  // from the wall's first end is not the one touching it (the contact normal once came out flipped).
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(100, 100, Boundary::periodic);
+    d.dt = 0.05;
+    d.walls.push_back({"long", {5, 20}, {95, 63.5}});
+    d.turtles.push_back(turtle("t", {85, 50}, 0, 1, 10));  // below the wall, driving up (+y)
+    World w(d, mode);
+    w.command_turtle(0, move(100));
+    w.advance_to(2.0);
+    const auto contacts = w.take_turtle_contacts();
+    REQUIRE(contacts.size() == 1);
+    const Vec2 u = Vec2{90, 43.5} / std::hypot(90, 43.5);
+    const Vec2 towards_turtle{u.y, -u.x};  // the wall's normal on the turtle's (lower) side
+    CHECK(contacts[0].normal.x == Approx(towards_turtle.x).epsilon(1e-12));
+    CHECK(contacts[0].normal.y == Approx(towards_turtle.y).epsilon(1e-12));
+    // Stopped one radius below the line: its height there, 20 + 43.5 * 80 / 90, less 1 / cos.
+    CHECK(w.turtle(0).pos.y == Approx(20 + 43.5 * 80 / 90 - 1 / u.x).epsilon(1e-12));
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}
