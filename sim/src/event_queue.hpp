@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -29,6 +30,12 @@ class EventQueue {
   /// The earliest (key, id); only when !empty().
   double top_key() { settle(); return node_[heap_[0]].key; }
   std::uint32_t top_id() { settle(); return heap_[0]; }
+  /// Prefetches the queue's next few ids into cache (a hint; changes nothing).
+  template <class F>
+  void for_next(F&& f) const {
+    const std::size_t n = std::min<std::size_t>(heap_.size(), 3);
+    for (std::size_t k = 1; k < n; ++k) f(heap_[k]);
+  }
   /// Subtracts dt from every key (time rebasing) and rebuilds the calendar around them.
   void shift_keys(double dt);
   std::size_t memory_bytes() const;
@@ -45,9 +52,19 @@ class EventQueue {
   void insert(std::uint32_t id);
   void unlink(std::uint32_t id);
   void push_list(std::uint32_t& head, std::uint32_t id, std::uint32_t where);
-  void settle();
-  void rebuild(double start);
-  std::uint64_t bucket_of(double key) const;
+  /// Makes heap_ hold the earliest key (it is empty only between buckets).
+  void settle() {
+    if (heap_.empty()) refill();
+  }
+  void refill();
+  void rebuild();
+  std::uint64_t bucket_of(double key) const {
+    // Truncation is floor here: b is known to be >= 0 when it is converted.
+    const double b = (key - t0_) * inv_width_;
+    if (!(b >= 0.0)) return 0;
+    if (b >= year_d_) return year_;
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(b));
+  }
 
   // The small heap of the bucket being served.
   bool heap_before(std::uint32_t a, std::uint32_t b) const {
@@ -72,6 +89,8 @@ class EventQueue {
   double inv_width_ = 1.0;
   std::uint64_t current_ = 0;  ///< the bucket being served; keys before its end go to the heap
   std::uint64_t year_ = 0;     ///< number of buckets in a year
+  double year_d_ = 0.0;        ///< the same, as a double
+  double served_end_ = 1.0;    ///< current_ + 1, as a double: keys below t0_ + served_end_ w are served
 };
 
 }  // namespace turtlegas::sim::detail
