@@ -30,11 +30,12 @@ class EventQueue {
   /// The earliest (key, id); only when !empty().
   double top_key() { settle(); return node_[heap_[0]].key; }
   std::uint32_t top_id() { settle(); return heap_[0]; }
-  /// Prefetches the queue's next few ids into cache (a hint; changes nothing).
-  template <class F>
-  void for_next(F&& f) const {
-    const std::size_t n = std::min<std::size_t>(heap_.size(), 3);
-    for (std::size_t k = 1; k < n; ++k) f(heap_[k]);
+  /// An id likely to be served soon after the top, k = 0 or 1 (the top's children in the served
+  /// bucket, or the first id filed in the next bucket), or kAbsent; for prefetching.
+  std::uint32_t next_id(std::size_t k) const {
+    if (k + 1 < heap_.size()) return heap_[k + 1];
+    if (k == 1 && current_ + 1 < year_) return bucket_head_[current_ + 1];
+    return kAbsent;
   }
   /// Subtracts dt from every key (time rebasing) and rebuilds the calendar around them.
   void shift_keys(double dt);
