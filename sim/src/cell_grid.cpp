@@ -39,6 +39,8 @@ CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
   ch_ = height / ny_;
   if (static_cast<double>(nx_ + 2) * (ny_ + 2) > 2.0e8)
     throw std::invalid_argument("the grid would need more than 2e8 cells; set a larger arena.cell");
+  for (int k = 0; k <= nx_ + 1; ++k) x_lines_.push_back(x_edge(k));
+  for (int k = 0; k <= ny_ + 1; ++k) y_lines_.push_back(y_edge(k));
   for (int sy = 0; sy < 3; ++sy)
     for (int sx = 0; sx < 3; ++sx) shifts_[sy * 3 + sx] = {(sx - 1) * width, (sy - 1) * height};
 
@@ -134,18 +136,6 @@ int CellGrid::arena_cell_of(Vec2 p) const {
   return index(ix, iy);
 }
 
-CellGrid::Neighbour CellGrid::neighbour(int ix, int iy, int dx, int dy) const {
-  int jx = ix + dx, jy = iy + dy;
-  Vec2 shift{};
-  if (periodic_) {
-    if (jx < 1) { jx += nx_; shift.x = -width_; }
-    else if (jx > nx_) { jx -= nx_; shift.x = width_; }
-    if (jy < 1) { jy += ny_; shift.y = -height_; }
-    else if (jy > ny_) { jy -= ny_; shift.y = height_; }
-  }
-  return {index(jx, jy), shift};
-}
-
 std::uint32_t CellGrid::shift_index(Vec2 s) const {
   const int sx = s.x < 0.0 ? 0 : (s.x > 0.0 ? 2 : 1);
   const int sy = s.y < 0.0 ? 0 : (s.y > 0.0 ? 2 : 1);
@@ -153,7 +143,8 @@ std::uint32_t CellGrid::shift_index(Vec2 s) const {
 }
 
 std::size_t CellGrid::memory_bytes() const {
-  return sizeof(std::uint32_t) * (slot_.capacity() + wall_items_.capacity() + end_items_.capacity()) +
+  return sizeof(double) * (x_lines_.capacity() + y_lines_.capacity()) +
+         sizeof(std::uint32_t) * (slot_.capacity() + wall_items_.capacity() + end_items_.capacity()) +
          sizeof(Ranges) * records_.capacity() + sizeof(Near) * (near_walls_.capacity() + near_ends_.capacity());
 }
 

@@ -47,6 +47,11 @@ class CellGrid {
   /// The grid line between columns k and k+1 (rows, for y_edge); exact at the arena's edges.
   double x_edge(int k) const { return k < nx_ ? k * cw_ : width_ + (k - nx_) * cw_; }
   double y_edge(int k) const { return k < ny_ ? k * ch_ : height_ + (k - ny_) * ch_; }
+  /// x_edge(k) and y_edge(k) from a table, k in [0, nx+1] (resp. [0, ny+1]), for the hot paths.
+  double x_line(int k) const { return x_lines_[static_cast<std::size_t>(k)]; }
+  double y_line(int k) const { return y_lines_[static_cast<std::size_t>(k)]; }
+  /// False when a cell lists no walls or ends and has none in its 3x3 neighbourhood (most cells).
+  bool has_walls(int cell) const { return slot_[static_cast<std::size_t>(cell)] != 0; }
 
   /// Neighbour (ix+dx, iy+dy) of an arena cell, wrapped when periodic; `shift` is what to add to
   /// the positions of objects listed there to see them from the original cell.
@@ -54,7 +59,22 @@ class CellGrid {
     int cell;
     Vec2 shift;
   };
-  Neighbour neighbour(int ix, int iy, int dx, int dy) const;
+  Neighbour neighbour(int ix, int iy, int dx, int dy) const {
+    int jx = ix + dx, jy = iy + dy;
+    Vec2 shift{};
+    if (periodic_) {
+      if (jx < 1) { jx += nx_; shift.x = -width_; }
+      else if (jx > nx_) { jx -= nx_; shift.x = width_; }
+      if (jy < 1) { jy += ny_; shift.y = -height_; }
+      else if (jy > ny_) { jy -= ny_; shift.y = height_; }
+    }
+    return {index(jx, jy), shift};
+  }
+  /// Whether every cell of the 3x3 neighbourhood of arena cell (ix, iy) is seen without a shift,
+  /// so that neighbour (dx, dy) is simply index(ix, iy) + dy * stride() + dx.
+  bool plain_neighbourhood(int ix, int iy) const {
+    return !periodic_ || (ix > 1 && ix < nx_ && iy > 1 && iy < ny_);
+  }
 
   /// Walls passing through a cell, and wall ends inside it.
   const std::uint32_t* walls_begin(int cell) const { return wall_items_.data() + ranges(cell).walls[0]; }
@@ -96,6 +116,7 @@ class CellGrid {
   template <class T>
   void store(std::vector<std::pair<std::uint32_t, T>>& pairs, std::vector<T>& items, std::uint32_t (Ranges::*range)[2]);
 
+  std::vector<double> x_lines_, y_lines_;
   std::vector<std::uint32_t> slot_;
   std::vector<Ranges> records_;
   std::vector<std::uint32_t> wall_items_, end_items_;

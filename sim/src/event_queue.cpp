@@ -11,6 +11,7 @@ void EventQueue::reset(std::size_t ids) {
   std::size_t buckets = 1024;
   while (buckets < ids) buckets *= 2;
   year_ = buckets;
+  year_d_ = static_cast<double>(buckets);
   bucket_head_.assign(buckets, kAbsent);
   heap_.clear();
   overflow_head_ = kAbsent;
@@ -18,13 +19,6 @@ void EventQueue::reset(std::size_t ids) {
   t0_ = 0.0;
   width_ = 0.0;  // set at the first rebuild
   current_ = 0;
-}
-
-std::uint64_t EventQueue::bucket_of(double key) const {
-  const double b = std::floor((key - t0_) * inv_width_);
-  if (!(b >= 0.0)) return 0;
-  if (b >= static_cast<double>(year_)) return year_;
-  return static_cast<std::uint64_t>(b);
 }
 
 void EventQueue::push_list(std::uint32_t& head, std::uint32_t id, std::uint32_t where) {
@@ -75,24 +69,41 @@ void EventQueue::unlink(std::uint32_t id) {
 }
 
 void EventQueue::set(std::uint32_t id, double key) {
-  unlink(id);
-  node_[id].key = key;
+  Node& n = node_[id];
+  if (n.where == kInHeap && n.prev == 0) {
+    // The id just served gets its next key: the common case. Moved down from the root in place
+    // when the key stays in the bucket being served, else taken off the root and filed.
+    if ((key - t0_) * inv_width_ < served_end_) {  // bucket_of(key) <= current_ (and key finite)
+      n.key = key;
+      heap_down(0);
+      return;
+    }
+    const std::uint32_t last = heap_.back();
+    heap_.pop_back();
+    if (last != id) {
+      heap_place(0, last);
+      heap_down(0);
+    }
+    --finite_;
+    n.where = kNowhere;
+  } else {
+    unlink(id);
+  }
+  n.key = key;
   insert(id);
 }
 
 void EventQueue::remove(std::uint32_t id) { unlink(id); }
 
-void EventQueue::settle() {
+void EventQueue::refill() {
   while (heap_.empty()) {
     if (width_ == 0.0 || current_ + 1 >= year_) {
       // End of the year (or no calendar yet): rebuild around the earliest key.
-      double earliest = std::numeric_limits<double>::infinity();
-      for (std::uint32_t id = 0; id < node_.size(); ++id)
-        if (node_[id].where != kNowhere && node_[id].where != kInfinite) earliest = std::min(earliest, node_[id].key);
-      rebuild(earliest);
+      rebuild();
       continue;
     }
     ++current_;
+    served_end_ = static_cast<double>(current_ + 1);
     // Move the next bucket into the heap.
     std::uint32_t id = bucket_head_[current_];
     bucket_head_[current_] = kAbsent;
@@ -104,18 +115,22 @@ void EventQueue::settle() {
   }
 }
 
-void EventQueue::rebuild(double start) {
-  // Mark every stored id, then lay a new calendar whose year spans the bulk of them and insert
-  // the marked ids in id order. Marking in place rather than gathering the ids in a list keeps
-  // the rebuild free of a per-body temporary (4 bytes a body at the engine's peak).
+void EventQueue::rebuild() {
+  // Mark every stored id and find the earliest key, then lay a new calendar from there whose year
+  // spans the bulk of them and insert the marked ids in id order. Marking in place rather than
+  // gathering the ids in a list keeps the rebuild free of a per-body temporary (4 bytes a body at
+  // the engine's peak).
   std::size_t count = 0;
-  double sum = 0.0;
+  double start = std::numeric_limits<double>::infinity();
   for (Node& n : node_) {
     if (n.where == kNowhere || n.where == kInfinite) continue;
     n.where = kRebuilding;
     ++count;
-    sum += n.key - start;
+    start = std::min(start, n.key);
   }
+  double sum = 0.0;
+  for (const Node& n : node_)
+    if (n.where == kRebuilding) sum += n.key - start;
   std::fill(bucket_head_.begin(), bucket_head_.end(), kAbsent);
   heap_.clear();
   overflow_head_ = kAbsent;
@@ -130,6 +145,7 @@ void EventQueue::rebuild(double start) {
   inv_width_ = 1.0 / width_;
   t0_ = start;
   current_ = 0;
+  served_end_ = 1.0;
   for (std::uint32_t id = 0; id < node_.size(); ++id) {
     if (node_[id].where != kRebuilding) continue;
     node_[id].where = kNowhere;
@@ -140,10 +156,7 @@ void EventQueue::rebuild(double start) {
 void EventQueue::shift_keys(double dt) {
   for (auto& n : node_)
     if (n.where != kNowhere) n.key -= dt;
-  double earliest = std::numeric_limits<double>::infinity();
-  for (const auto& n : node_)
-    if (n.where != kNowhere && n.where != kInfinite) earliest = std::min(earliest, n.key);
-  if (finite_ > 0) rebuild(earliest);
+  if (finite_ > 0) rebuild();
 }
 
 void EventQueue::heap_push(std::uint32_t id) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -29,6 +30,13 @@ class EventQueue {
   /// The earliest (key, id); only when !empty().
   double top_key() { settle(); return node_[heap_[0]].key; }
   std::uint32_t top_id() { settle(); return heap_[0]; }
+  /// An id likely to be served soon after the top, k = 0 or 1 (the top's children in the served
+  /// bucket, or the first id filed in the next bucket), or kAbsent; for prefetching.
+  std::uint32_t next_id(std::size_t k) const {
+    if (k + 1 < heap_.size()) return heap_[k + 1];
+    if (k == 1 && current_ + 1 < year_) return bucket_head_[current_ + 1];
+    return kAbsent;
+  }
   /// Subtracts dt from every key (time rebasing) and rebuilds the calendar around them.
   void shift_keys(double dt);
   std::size_t memory_bytes() const;
@@ -46,9 +54,19 @@ class EventQueue {
   void insert(std::uint32_t id);
   void unlink(std::uint32_t id);
   void push_list(std::uint32_t& head, std::uint32_t id, std::uint32_t where);
-  void settle();
-  void rebuild(double start);
-  std::uint64_t bucket_of(double key) const;
+  /// Makes heap_ hold the earliest key (it is empty only between buckets).
+  void settle() {
+    if (heap_.empty()) refill();
+  }
+  void refill();
+  void rebuild();
+  std::uint64_t bucket_of(double key) const {
+    // Truncation is floor here: b is known to be >= 0 when it is converted.
+    const double b = (key - t0_) * inv_width_;
+    if (!(b >= 0.0)) return 0;
+    if (b >= year_d_) return year_;
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(b));
+  }
 
   // The small heap of the bucket being served.
   bool heap_before(std::uint32_t a, std::uint32_t b) const {
@@ -73,6 +91,8 @@ class EventQueue {
   double inv_width_ = 1.0;
   std::uint64_t current_ = 0;  ///< the bucket being served; keys before its end go to the heap
   std::uint64_t year_ = 0;     ///< number of buckets in a year
+  double year_d_ = 0.0;        ///< the same, as a double
+  double served_end_ = 1.0;    ///< current_ + 1, as a double: keys below t0_ + served_end_ w are served
 };
 
 }  // namespace turtlegas::sim::detail
