@@ -278,11 +278,12 @@ int run_main(int argc, char** argv) {
         std::max<std::uint64_t>(10, static_cast<std::uint64_t>(std::ceil(ball_steps / static_cast<double>(n)))));
     run = run_steps(world, steps, opt.max_wall);
   }
-  const std::uint64_t run_peak_rss = proc_status_bytes("VmHWM");
-  const std::uint64_t peak_rss = std::max(setup_peak_rss, run_peak_rss);
   const double energy_end = world.energy();
   const sim::Overlap overlap = world.measure_overlap();
   const sim::Overlap contact_overlap = world.max_contact_overlap();
+  // After the final overlap check too: the peak of everything the program did.
+  const std::uint64_t run_peak_rss = proc_status_bytes("VmHWM");
+  const std::uint64_t peak_rss = std::max(setup_peak_rss, run_peak_rss);
 
   const sim::Stats& s = world.stats();
   const auto collisions = static_cast<double>(s.collisions());
