@@ -10,6 +10,7 @@
 #include <functional>
 #include <vector>
 
+#include "turtlegas/sim/cover_grid.hpp"
 #include "turtlegas/sim/format.hpp"
 #include "turtlegas/sim/world_def.hpp"
 
@@ -39,101 +40,6 @@ std::string wall_name(const WallDef& w, std::size_t i) {
 DefProblem problem(Where where, std::size_t index, std::string field, std::string message) {
   return DefProblem{where, index, std::move(field), std::move(message)};
 }
-
-/// Squared distance from p to the segment a-b (a != b).
-double segment_distance2(Vec2 p, Vec2 a, Vec2 b) {
-  const Vec2 ab = b - a;
-  const double t = std::clamp(dot(p - a, ab) / norm2(ab), 0.0, 1.0);
-  return norm2(p - (a + t * ab));
-}
-
-/// A uniform grid over a rectangle with singly linked per-cell lists, filled incrementally so that
-/// each object is tested only against objects inserted before it (the first problem is found
-/// without building the whole grid when a scene is badly broken).
-class CoverGrid {
- public:
-  CoverGrid(Vec2 lo, Vec2 hi, double side, std::size_t max_cells) : lo_(lo) {
-    const double w = hi.x - lo.x;
-    const double h = hi.y - lo.y;
-    const double cap = static_cast<double>(max_cells);
-    double nx = std::clamp(std::ceil(w / side), 1.0, cap);
-    double ny = std::clamp(std::ceil(h / side), 1.0, cap);
-    if (nx * ny > cap) {
-      const double shrink = std::sqrt(nx * ny / cap);
-      nx = std::max(1.0, std::floor(nx / shrink));
-      ny = std::max(1.0, std::floor(ny / shrink));
-    }
-    nx_ = static_cast<int>(nx);
-    ny_ = static_cast<int>(ny);
-    sx_ = w / nx_;
-    sy_ = h / ny_;
-    head_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_), npos);
-  }
-
-  struct Range {
-    int x0, x1, y0, y1;
-    std::size_t cells() const {
-      return static_cast<std::size_t>(x1 - x0 + 1) * static_cast<std::size_t>(y1 - y0 + 1);
-    }
-  };
-
-  void reserve(std::size_t entries) { entries_.reserve(entries); }
-
-  /// The cells that the box [lo, hi] touches, clamped to the grid.
-  Range cover(Vec2 lo, Vec2 hi) const {
-    return Range{cx(lo.x), cx(hi.x), cy(lo.y), cy(hi.y)};
-  }
-
-  int cx(double x) const { return clamp_index((x - lo_.x) / sx_, nx_); }
-  int cy(double y) const { return clamp_index((y - lo_.y) / sy_, ny_); }
-  double cell_x0(int ix) const { return lo_.x + ix * sx_; }
-  double cell_w() const { return sx_; }
-
-  void insert(int ix, int iy, std::uint32_t item) {
-    const std::size_t c = cell(ix, iy);
-    entries_.push_back(Entry{item, head_[c]});
-    head_[c] = static_cast<std::uint32_t>(entries_.size() - 1);
-  }
-
-  void insert(Range r, std::uint32_t item) {
-    for (int iy = r.y0; iy <= r.y1; ++iy)
-      for (int ix = r.x0; ix <= r.x1; ++ix) insert(ix, iy, item);
-  }
-
-  /// Calls f(item) for every item in the cells of r (an item may be seen more than once).
-  /// Stops and returns true as soon as f returns true.
-  template <class F>
-  bool any(Range r, F&& f) const {
-    for (int iy = r.y0; iy <= r.y1; ++iy)
-      for (int ix = r.x0; ix <= r.x1; ++ix)
-        for (std::uint32_t e = head_[cell(ix, iy)]; e != npos; e = entries_[e].next)
-          if (f(entries_[e].item)) return true;
-    return false;
-  }
-
- private:
-  static constexpr std::uint32_t npos = std::numeric_limits<std::uint32_t>::max();
-  struct Entry {
-    std::uint32_t item;
-    std::uint32_t next;
-  };
-
-  static int clamp_index(double u, int n) {
-    // Written so that NaN-free but huge values cannot overflow the int conversion.
-    if (!(u > 0.0)) return 0;
-    if (u >= n - 1) return n - 1;
-    return static_cast<int>(u);
-  }
-  std::size_t cell(int ix, int iy) const {
-    return static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
-  }
-
-  Vec2 lo_;
-  int nx_ = 1, ny_ = 1;
-  double sx_ = 1.0, sy_ = 1.0;
-  std::vector<std::uint32_t> head_;
-  std::vector<Entry> entries_;
-};
 
 std::optional<DefProblem> check_scalars(const WorldDef& def) {
   if (!std::isfinite(def.dt) || def.dt <= 0.0)
@@ -391,13 +297,12 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
   const bool balls_collide = def.effects.ball_ball;
   if (balls_collide || !def.turtles.empty()) {
     CoverGrid grid(lo, hi, side, max_cells);
-    auto box = [&](Vec2 p, double r) { return grid.cover(p - Vec2{r, r}, p + Vec2{r, r}); };
     // Items are disc * 4 + image, so a periodic pair is caught from whichever side crosses the edge.
     std::array<Vec2, 4> img{}, other{};
     // Room for every entry first: a list grown by doubling would briefly hold three times as many.
     std::size_t entries = 0;
     for (std::size_t k = 0; k < n; ++k)
-      for (int m = 0, m_count = images(k, img); m < m_count; ++m) entries += box(img[m], d.radius(k)).cells();
+      for (int m = 0, m_count = images(k, img); m < m_count; ++m) entries += grid.cover_disc(img[m], d.radius(k)).cells();
     grid.reserve(entries);
     for (std::size_t k = 0; k < n; ++k) {
       const int m_count = images(k, img);
@@ -405,7 +310,7 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
       std::optional<std::size_t> hit;
       for (int m = 0; m < m_count && !hit; ++m) {
         const Vec2 p = img[m];
-        grid.any(box(p, r), [&](std::uint32_t item) {
+        grid.any(grid.cover_disc(p, r), [&](std::uint32_t item) {
           const std::size_t j = item / 4;
           if (!balls_collide && d.is_ball(j) && d.is_ball(k)) return false;
           if (!d.layers(j).collides_with(d.layers(k))) return false;
@@ -425,32 +330,14 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
                              " (radii " + num(r) + " + " + num(d.radius(*hit)) +
                              "); move them apart or make them smaller");
       for (int m = 0; m < m_count; ++m)
-        grid.insert(box(img[m], r), static_cast<std::uint32_t>(k * 4 + static_cast<std::size_t>(m)));
+        grid.insert(grid.cover_disc(img[m], r), static_cast<std::uint32_t>(k * 4 + static_cast<std::size_t>(m)));
     }
   }
 
   if (def.walls.empty()) return std::nullopt;
   CoverGrid walls_grid(lo, hi, side, max_cells);
-  for (std::size_t w = 0; w < def.walls.size(); ++w) {
-    // Enter the segment column by column: in each column of cells, the cells between the lowest and
-    // highest y the segment reaches there. The padding absorbs rounding at cell borders.
-    Vec2 p = def.walls[w].from, q = def.walls[w].to;
-    if (p.x > q.x) std::swap(p, q);
-    const double pad = 1e-9 * (walls_grid.cell_w() + std::abs(q.x - p.x) + std::abs(q.y - p.y));
-    const int x0 = walls_grid.cx(p.x - pad), x1 = walls_grid.cx(q.x + pad);
-    for (int ix = x0; ix <= x1; ++ix) {
-      double ya = p.y, yb = q.y;
-      if (q.x > p.x) {
-        const double slope = (q.y - p.y) / (q.x - p.x);
-        const double xa = std::clamp(walls_grid.cell_x0(ix), p.x, q.x);
-        const double xb = std::clamp(walls_grid.cell_x0(ix) + walls_grid.cell_w(), p.x, q.x);
-        ya = ix == x0 ? p.y : p.y + slope * (xa - p.x);
-        yb = ix == x1 ? q.y : p.y + slope * (xb - p.x);
-      }
-      const int y0 = walls_grid.cy(std::min(ya, yb) - pad), y1 = walls_grid.cy(std::max(ya, yb) + pad);
-      for (int iy = y0; iy <= y1; ++iy) walls_grid.insert(ix, iy, static_cast<std::uint32_t>(w));
-    }
-  }
+  for (std::size_t w = 0; w < def.walls.size(); ++w)
+    walls_grid.insert_segment(def.walls[w].from, def.walls[w].to, static_cast<std::uint32_t>(w));
   std::array<Vec2, 4> img{};
   for (std::size_t k = 0; k < n; ++k) {
     const int m_count = images(k, img);
@@ -458,7 +345,7 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
     std::optional<std::size_t> hit;
     for (int m = 0; m < m_count && !hit; ++m) {
       const Vec2 p = img[m];
-      walls_grid.any(walls_grid.cover(p - Vec2{r, r}, p + Vec2{r, r}), [&](std::uint32_t w) {
+      walls_grid.any(walls_grid.cover_disc(p, r), [&](std::uint32_t w) {
         const WallDef& wall = def.walls[w];
         if (!wall.layers.collides_with(d.layers(k))) return false;
         if (segment_distance2(p, wall.from, wall.to) < r * r) hit = w;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "gas.hpp"
 
+#include "turtlegas/sim/cover_grid.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -46,12 +48,6 @@ class Random {
   std::mt19937_64 engine_;
 };
 
-double segment_distance2(Vec2 p, Vec2 a, Vec2 b) {
-  const Vec2 ab = b - a;
-  const double t = std::clamp(sim::dot(p - a, ab) / sim::norm2(ab), 0.0, 1.0);
-  return sim::norm2(p - (a + t * ab));
-}
-
 /// Clips segment p-q to the box [lo, hi] (Liang-Barsky); false when nothing is left.
 bool clip(Vec2& p, Vec2& q, Vec2 lo, Vec2 hi) {
   double t0 = 0.0, t1 = 1.0;
@@ -77,118 +73,42 @@ bool clip(Vec2& p, Vec2& q, Vec2 lo, Vec2 hi) {
 /// every cell their (clipped) segment crosses, so an overlapping pair always shares a cell.
 class ObstacleGrid {
  public:
-  ObstacleGrid(Vec2 lo, Vec2 hi, double side, std::size_t max_cells) : lo_(lo), hi_(hi) {
-    const double w = hi.x - lo.x, h = hi.y - lo.y;
-    const double cap = static_cast<double>(max_cells);
-    double nx = std::clamp(std::ceil(w / side), 1.0, cap);
-    double ny = std::clamp(std::ceil(h / side), 1.0, cap);
-    if (nx * ny > cap) {
-      const double shrink = std::sqrt(nx * ny / cap);
-      nx = std::max(1.0, std::floor(nx / shrink));
-      ny = std::max(1.0, std::floor(ny / shrink));
-    }
-    nx_ = static_cast<int>(nx);
-    ny_ = static_cast<int>(ny);
-    sx_ = w / nx_;
-    sy_ = h / ny_;
-    head_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_), npos);
-  }
+  ObstacleGrid(Vec2 lo, Vec2 hi, double side, std::size_t max_cells) : lo_(lo), hi_(hi), grid_(lo, hi, side, max_cells) {}
 
-  /// Row-major number of the cell holding c: sorting by it puts neighbours near each other.
-  std::size_t cell_of(Vec2 c) const { return cell(cx(c.x), cy(c.y)); }
-
-  /// The average number of cells a disc of radius r placed at random covers: room to reserve
-  /// for `count` of them, so that the list does not double (and briefly triple) at a million.
-  double cells_per_disc(double r) const { return (1.0 + 2.0 * r / sx_) * (1.0 + 2.0 * r / sy_); }
-  void reserve(std::size_t entries) { entries_.reserve(entries_.size() + entries); }
-
-  /// Frees the cell lists; cell_of still works. For when the obstacles are no longer needed.
-  void release_lists() {
-    head_ = {};
-    entries_ = {};
-  }
+  std::size_t cell_of(Vec2 c) const { return grid_.cell_of(c); }
+  double cells_per_disc(double r) const { return grid_.cells_per_disc(r); }
+  void reserve(std::size_t entries) { grid_.reserve(entries); }
+  void release_lists() { grid_.release_lists(); }
 
   bool touches(Vec2 c, double r) const {
     return c.x + r >= lo_.x && c.x - r <= hi_.x && c.y + r >= lo_.y && c.y - r <= hi_.y;
   }
-
-  void add_disc(Vec2 c, double r, std::uint32_t item) {
-    const int x0 = cx(c.x - r), x1 = cx(c.x + r), y0 = cy(c.y - r), y1 = cy(c.y + r);
-    for (int iy = y0; iy <= y1; ++iy)
-      for (int ix = x0; ix <= x1; ++ix) push(ix, iy, item);
-  }
-
+  void add_disc(Vec2 c, double r, std::uint32_t item) { grid_.insert(grid_.cover_disc(c, r), item); }
   void add_segment(Vec2 p, Vec2 q, std::uint32_t item) {
-    if (!clip(p, q, lo_, hi_)) return;
-    if (p.x > q.x) std::swap(p, q);
-    // Column by column, the cells between the lowest and highest y the segment reaches there;
-    // the padding absorbs rounding at cell borders.
-    const double pad = 1e-9 * (sx_ + sy_ + std::abs(q.x - p.x) + std::abs(q.y - p.y));
-    const int x0 = cx(p.x - pad), x1 = cx(q.x + pad);
-    const double slope = q.x > p.x ? (q.y - p.y) / (q.x - p.x) : 0.0;
-    for (int ix = x0; ix <= x1; ++ix) {
-      double ya = p.y, yb = q.y;
-      if (q.x > p.x) {
-        const double xa = std::clamp(lo_.x + ix * sx_, p.x, q.x);
-        const double xb = std::clamp(lo_.x + (ix + 1) * sx_, p.x, q.x);
-        ya = p.y + slope * (xa - p.x);
-        yb = p.y + slope * (xb - p.x);
-      }
-      const int y0 = cy(std::min(ya, yb) - pad), y1 = cy(std::max(ya, yb) + pad);
-      for (int iy = y0; iy <= y1; ++iy) push(ix, iy, item);
-    }
+    if (clip(p, q, lo_, hi_)) grid_.insert_segment(p, q, item);
   }
 
   /// Whether a disc at c of radius r overlaps (not merely touches) anything in the grid.
   bool blocked(Vec2 c, double r, const sim::WorldDef& def) const {
-    const int x0 = cx(c.x - r), x1 = cx(c.x + r), y0 = cy(c.y - r), y1 = cy(c.y + r);
-    for (int iy = y0; iy <= y1; ++iy)
-      for (int ix = x0; ix <= x1; ++ix)
-        for (std::uint32_t e = head_[cell(ix, iy)]; e != npos; e = entries_[e].next) {
-          const std::uint32_t item = entries_[e].item;
-          if (item % 2 == 0) {
-            const sim::BallDef& b = def.balls[item / 2];
-            const double s = r + b.radius;
-            if (sim::norm2(c - b.pos) < s * s) return true;
-          } else if (item / 2 < def.walls.size()) {
-            const sim::WallDef& w = def.walls[item / 2];
-            if (segment_distance2(c, w.from, w.to) < r * r) return true;
-          } else {
-            const sim::TurtleDef& t = def.turtles[item / 2 - def.walls.size()];
-            const double s = r + t.radius;
-            if (sim::norm2(c - t.pos) < s * s) return true;
-          }
-        }
-    return false;
+    return grid_.any(grid_.cover_disc(c, r), [&](std::uint32_t item) {
+      if (item % 2 == 0) {
+        const sim::BallDef& b = def.balls[item / 2];
+        const double s = r + b.radius;
+        return sim::norm2(c - b.pos) < s * s;
+      }
+      if (item / 2 < def.walls.size()) {
+        const sim::WallDef& w = def.walls[item / 2];
+        return sim::segment_distance2(c, w.from, w.to) < r * r;
+      }
+      const sim::TurtleDef& t = def.turtles[item / 2 - def.walls.size()];
+      const double s = r + t.radius;
+      return sim::norm2(c - t.pos) < s * s;
+    });
   }
 
  private:
-  static constexpr std::uint32_t npos = std::numeric_limits<std::uint32_t>::max();
-  struct Entry {
-    std::uint32_t item;
-    std::uint32_t next;
-  };
-  static int index(double u, int n) {
-    if (!(u > 0.0)) return 0;
-    if (u >= n - 1) return n - 1;
-    return static_cast<int>(u);
-  }
-  int cx(double x) const { return index((x - lo_.x) / sx_, nx_); }
-  int cy(double y) const { return index((y - lo_.y) / sy_, ny_); }
-  std::size_t cell(int ix, int iy) const {
-    return static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
-  }
-  void push(int ix, int iy, std::uint32_t item) {
-    const std::size_t c = cell(ix, iy);
-    entries_.push_back(Entry{item, head_[c]});
-    head_[c] = static_cast<std::uint32_t>(entries_.size() - 1);
-  }
-
   Vec2 lo_, hi_;
-  int nx_ = 1, ny_ = 1;
-  double sx_ = 1.0, sy_ = 1.0;
-  std::vector<std::uint32_t> head_;
-  std::vector<Entry> entries_;
+  sim::CoverGrid grid_;
 };
 
 /// The exact tests validate() applies, so that no rounding in lo + u (hi - lo) can put a disc a
