@@ -1,74 +1,21 @@
 // SPDX-License-Identifier: MIT
 // Controllers loaded from shared-library plugins (`--plugin`), built by CMake with
 // turtlegas_add_plugin: the example of docs/controllers.md, and a busy loop.
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include "run_cli.hpp"
+
 namespace fs = std::filesystem;
 using json = nlohmann::json;
+using namespace turtlegas::test;
 
 namespace {
-
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-/// Runs turtlegas with `args` in a fresh directory (dir), capturing its output.
-Result run(const fs::path& dir, const std::vector<std::string>& args) {
-  std::string cmd = quote(TURTLEGAS_BIN);
-  // Appended piecewise: GCC 12 gives a false -Wrestrict for "literal" + std::string (bug 105329).
-  for (const auto& a : args) {
-    cmd += ' ';
-    cmd += quote(a);
-  }
-  cmd += " >" + quote((dir / "out.txt").string()) + " 2>" + quote((dir / "err.txt").string()) + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  Result r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = read(dir / "out.txt");
-  r.err = read(dir / "err.txt");
-  return r;
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() / ("turtlegas-plugin-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
 
 const std::string feeler_world = std::string(TURTLEGAS_SOURCE_DIR) + "/controllers/examples/feeler.json";
 

@@ -1,50 +1,16 @@
 // SPDX-License-Identifier: MIT
 // `turtlegas tag` as a user runs it: the table, the JSON, determinism and bad input.
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include "run_cli.hpp"
+
 namespace fs = std::filesystem;
-
-namespace {
-
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-Result run(const fs::path& dir, const std::vector<std::string>& args) {
-  std::string cmd = quote(TURTLEGAS_BIN);
-  for (const auto& a : args) cmd += " " + quote(a);
-  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  cmd += " >" + quote(out.string()) + " 2>" + quote(err.string()) + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read(out), read(err)};
-}
-
-}  // namespace
+using namespace turtlegas::test;
 
 TEST_CASE("turtlegas tag prints a ranking and writes it as JSON, the same every time", "[cli][tag]") {
   const fs::path dir = fs::temp_directory_path() / ("turtlegas-cli-tag-" + std::to_string(::getpid()));
