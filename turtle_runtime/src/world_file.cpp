@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gas.hpp"
+#include "suggest.hpp"
 #include "turtlegas/sim/format.hpp"
 #include "turtlegas/world/draw_walker.hpp"
 #include "turtlegas/world/game_file.hpp"
@@ -63,20 +64,6 @@ std::string kind_of(const json& v) {
   return (vowel ? "an " : "a ") + name;
 }
 
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diag = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diag = up;
-    }
-  }
-  return row[b.size()];
-}
 
 /// Features that later versions add to the format: named so that a file written for them fails
 /// with a clear message rather than as an unknown key.
@@ -124,15 +111,9 @@ class Reader {
                   std::initializer_list<std::string_view> known) const {
     for (const auto& [key, value] : obj.items()) {
       if (key.starts_with("x-") || std::find(known.begin(), known.end(), key) != known.end()) continue;
-      std::string list, best;
-      std::size_t best_distance = 3;  // suggest only close misspellings
-      for (std::string_view k : known) {
-        list += (list.empty() ? "" : ", ") + std::string(k);
-        const std::size_t dist = edit_distance(key, k);
-        if (dist < best_distance) best_distance = dist, best = k;
-      }
-      std::string reason = "unknown key \"" + key + "\" in " + std::string(what);
-      if (!best.empty()) reason += "; did you mean \"" + best + "\"?";
+      std::string list;
+      for (std::string_view k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+      std::string reason = "unknown key \"" + key + "\" in " + std::string(what) + detail::suggestion(key, known);
       reason += " (known keys: " + list + "; keys starting with x- are ignored)";
       fail(at(path, key), reason);
     }
