@@ -3,6 +3,8 @@
 // with them (it, walls, wall).
 #include <catch2/catch.hpp>
 
+#include "file_errors.hpp"
+
 #include <string>
 
 #include "turtlegas/world/draw_walker.hpp"
@@ -12,31 +14,15 @@ namespace tw = turtlegas::world;
 namespace tt = turtlegas::turtle;
 namespace sim = turtlegas::sim;
 
+using turtlegas::test::contains;
+
 namespace {
 
 std::string world(const std::string& body) { return R"({"format": "turtlegas-world/1")" + body + "}"; }
 
 tw::Scene scene(const std::string& text) { return tw::parse_scene(text, "w.json", tt::base_registry()); }
 
-tw::WorldFileError error_of(const std::string& text) {
-  try {
-    scene(text);
-  } catch (const tw::WorldFileError& e) {
-    return e;
-  }
-  FAIL("expected a WorldFileError for: " << text);
-  throw std::logic_error("unreachable");
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-#define CHECK_ERROR(text, path, part)         \
-  do {                                        \
-    const tw::WorldFileError e_ = error_of(text); \
-    INFO(e_.what());                          \
-    CHECK(e_.json_path == (path));            \
-    CHECK(contains(e_.reason, (part)));       \
-  } while (false)
+tw::WorldFileError error_of(const std::string& text) { return turtlegas::test::error_of(scene, text); }
 
 }  // namespace
 

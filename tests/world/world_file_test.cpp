@@ -10,8 +10,12 @@
 
 #include <catch2/catch.hpp>
 
+#include "file_errors.hpp"
+
 namespace tw = turtlegas::world;
 namespace sim = turtlegas::sim;
+
+using turtlegas::test::contains;
 
 namespace {
 
@@ -22,26 +26,8 @@ std::string world(const std::string& body) { return "{" + head + body + "}"; }
 
 /// The error that parsing `text` raises; fails the test if it parses.
 tw::WorldFileError error_of(const std::string& text) {
-  try {
-    tw::parse_world(text, "w.json");
-  } catch (const tw::WorldFileError& e) {
-    return e;
-  }
-  FAIL("expected a WorldFileError for: " << text);
-  throw std::logic_error("unreachable");
+  return turtlegas::test::error_of([](const std::string& t) { return tw::parse_world(t, "w.json"); }, text);
 }
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-#define CHECK_ERROR(text, path, part)                          \
-  do {                                                         \
-    const tw::WorldFileError e_ = error_of(text);              \
-    INFO(e_.what());                                           \
-    CHECK(e_.file == "w.json");                                \
-    CHECK(e_.json_path == (path));                             \
-    CHECK(contains(e_.reason, (part)));                        \
-    CHECK(std::string(e_.what()) == "w.json: " + std::string(path).append(std::string(path).empty() ? "" : ": ") + e_.reason); \
-  } while (false)
 
 std::uint64_t fnv(std::uint64_t h, double v) {
   const auto bits = std::bit_cast<std::uint64_t>(v);

@@ -7,12 +7,16 @@
 
 #include <catch2/catch.hpp>
 
+#include "file_errors.hpp"
+
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/world/world_file.hpp"
 
 namespace tw = turtlegas::world;
 namespace tt = turtlegas::turtle;
 namespace sim = turtlegas::sim;
+
+using turtlegas::test::contains;
 
 namespace {
 
@@ -34,26 +38,7 @@ std::string one(const std::string& keys) { return world(R"([{"id": "t", "pos": [
 
 tw::Scene parse(const std::string& text) { return tw::parse_scene(text, "w.json", registry()); }
 
-tw::WorldFileError error_of(const std::string& text) {
-  try {
-    parse(text);
-  } catch (const tw::WorldFileError& e) {
-    return e;
-  }
-  FAIL("expected a WorldFileError for: " << text);
-  throw std::logic_error("unreachable");
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-#define CHECK_ERROR(text, path, part)                                                        \
-  do {                                                                                       \
-    const tw::WorldFileError e_ = error_of(text);                                            \
-    INFO(e_.what());                                                                         \
-    CHECK(e_.json_path == (path));                                                           \
-    CHECK(contains(e_.reason, (part)));                                                      \
-    CHECK(std::string(e_.what()) == "w.json: " + std::string(path) + ": " + e_.reason);      \
-  } while (false)
+tw::WorldFileError error_of(const std::string& text) { return turtlegas::test::error_of(parse, text); }
 
 }  // namespace
 
