@@ -178,6 +178,10 @@ class Engine final : public EngineBase {
   std::size_t turtle_count() const override { return run_.size(); }
   TurtleState turtle(std::size_t k) const override;
   double turtle_radius(std::size_t k) const override { return body_[nb_ + k].r; }
+  void idle_turtles(std::vector<std::uint32_t>& out) const override {
+    for (std::uint32_t k = 0; k < run_.size(); ++k)
+      if (!run_[k].busy) out.push_back(k);
+  }
   void command_turtle(std::size_t k, const TurtleCommand& command) override;
   std::size_t add_wall(const WallDef& wall) override;
   std::vector<TurtleContact> take_turtle_contacts() override {
