@@ -176,6 +176,13 @@ class alignas(64) Agent {
     const char* end = reinterpret_cast<const char*>(&trail + 1);
     for (; p < end; p += 64) __builtin_prefetch(p);
   }
+  /// Cache hint for make_touch(), in two stages: the agent and where its sensor arcs are listed,
+  /// then (once those have arrived) the arcs themselves.
+  void prefetch_for_touch() const {
+    prefetch();
+    __builtin_prefetch(&program.sensors);
+  }
+  void prefetch_sensors() const { __builtin_prefetch(program.sensors.data()); }
 };
 
 class WorldServer::Impl : public GameHost {
@@ -493,8 +500,16 @@ void WorldServer::Impl::control_step() {
   // 1. Contacts of the previous step become interrupts.
   const double now = world.time();
   const std::vector<sim::TurtleContact> contacts = world.take_turtle_contacts();
+  // Contacts come in time order, so each starts with cache misses on its agent, the agent's
+  // sensor arcs and the other body's id: asked for one and two contacts ahead.
   for (std::size_t k = 0; k < contacts.size(); ++k) {
-    if (k + 2 < contacts.size()) agents[contacts[k + 2].turtle]->prefetch();
+    if (k + 2 < contacts.size()) agents[contacts[k + 2].turtle]->prefetch_for_touch();
+    if (k + 1 < contacts.size()) {
+      const sim::TurtleContact& next = contacts[k + 1];
+      agents[next.turtle]->prefetch_sensors();
+      if (next.kind == sim::EventKind::turtle_turtle) __builtin_prefetch(&def.turtles[next.other].id);
+      else if (next.kind == sim::EventKind::turtle_ball) __builtin_prefetch(&def.balls[next.other].id);
+    }
     const sim::TurtleContact& c = contacts[k];
     Agent& a = *agents[c.turtle];
     Touch t = a.make_touch(c);
