@@ -155,7 +155,7 @@ class alignas(64) Agent {
   std::vector<Message> messages;              // messages to deliver when the program resumes
   std::function<void(const Touch&)> handler;
   std::function<void(const Message&)> message_handler;
-  std::vector<std::pair<sim::Vec2, Touch>> in_contact;  // world-frame normals of contacts in force
+  std::vector<sim::TurtleContact> in_contact;  // contacts in force (touching() makes their Touch)
   std::vector<sim::Vec2> trail;
 
   // Cold: set up once, or used rarely.
@@ -266,12 +266,15 @@ Result Agent::issue(sim::TurtleCommand c) {
   std::optional<Touch> cut;
   std::vector<Touch> delivered;
   delivered.swap(inbox);
-  if (s.touched && !delivered.empty()) cut = delivered.front();
   if (c.kind == sim::TurtleCommand::Kind::move) odometer += s.done;
   if (pen_down) trail.push_back(s.pos);
   if (lays_wall && s.pos != start) server->lay_wall(*this, start, s.pos);
   if (handler)
     for (const Touch& t : delivered) handler(t);
+  if (s.touched && !delivered.empty()) cut = std::move(delivered.front());
+  // Hand the buffer back for the next touches (unless a handler's own command refilled the inbox).
+  delivered.clear();
+  if (inbox.empty()) inbox.swap(delivered);
   std::vector<Message> letters;
   letters.swap(messages);
   if (message_handler)
@@ -319,11 +322,15 @@ std::vector<Touch> Turtle::touching() const {
   // Contacts in force, with their sensors worked out for the heading the turtle has now.
   std::vector<Touch> out;
   const double heading_deg = agent_->server->world.turtle(agent_->index).heading / kDeg;
-  for (const auto& [normal, touch] : agent_->in_contact) {
-    Touch t = touch;
-    const sim::Vec2 d = -normal;
+  for (const sim::TurtleContact& c : agent_->in_contact) {
+    Touch t;
+    const sim::Vec2 d = -c.normal;
     t.bearing = wrap_degrees(std::atan2(d.x, d.y) / kDeg - heading_deg);
     t.sensors = agent_->server->sensors_for(*agent_, t.bearing);
+    t.sensor_names = &agent_->sensor_names;
+    t.what = agent_->server->other_id(c.kind, c.other);
+    t.kind = kind_word(c.kind);
+    t.t = c.t;
     out.push_back(std::move(t));
   }
   return out;
@@ -519,7 +526,7 @@ void WorldServer::Impl::control_step() {
         if (t.fired(s)) e.sensors.push_back(a.program.sensors[s].name);
       emit(std::move(e));
     }
-    a.in_contact.emplace_back(c.normal, t);
+    a.in_contact.push_back(c);
     if (!a.finished) a.inbox.push_back(std::move(t));
   }
   // 1a. The game's referee, on the same contacts.
