@@ -211,6 +211,10 @@ class Engine final : public EngineBase {
   std::size_t turtle_count() const override { return run_.size(); }
   TurtleState turtle(std::size_t k) const override;
   double turtle_radius(std::size_t k) const override { return body_[nb_ + k].r; }
+  void idle_turtles(std::vector<std::uint32_t>& out) const override {
+    for (std::uint32_t k = 0; k < run_.size(); ++k)
+      if (!run_[k].busy) out.push_back(k);
+  }
   void command_turtle(std::size_t k, const TurtleCommand& command) override;
   std::size_t add_wall(const WallDef& wall) override;
   std::vector<TurtleContact> take_turtle_contacts() override {
@@ -353,7 +357,9 @@ class Engine final : public EngineBase {
   }
 
   // Apply.
-  void process(double limit);
+  /// Serves events up to internal time `limit`. Returns false when it stopped early to rebase the
+  /// clock (exact mode), so that the caller takes the limit afresh in the new internal time.
+  bool process(double limit);
   void collide(std::uint32_t i);
   void collide_balls(std::uint32_t i, std::uint32_t j);
   void collide_with_turtle(std::uint32_t i, std::uint32_t j);
@@ -879,7 +885,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::predict_crossing(std::uint32_t i
 // Apply
 
 template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::process(double limit) {
+bool Engine<Flight, kBallBall, kStep, kExtras>::process(double limit) {
   for (;;) {
     const double next_event = heap_.empty() ? kNever : heap_.top_key();
     if constexpr (kExtras) {
@@ -907,9 +913,13 @@ void Engine<Flight, kBallBall, kStep, kExtras>::process(double limit) {
     if (p.t_coll <= p.t_cross) collide(i);
     else cross(i);
     if constexpr (!kStep) {
-      if (++events_since_rebase_ >= rebase_every_) limit -= rebase();
+      if (++events_since_rebase_ >= rebase_every_) {
+        rebase();
+        return false;
+      }
     }
   }
+  return true;
 }
 
 template <class Flight, bool kBallBall, bool kStep, bool kExtras>
@@ -1608,7 +1618,11 @@ void Engine<Flight, kBallBall, kStep, kExtras>::advance_to(double t) {
       return;
     }
   } else {
-    process(t - t_base_);
+    // The limit is always t - t_base_, rounded once. Shifting it along with a rebase would round
+    // twice, and an event at the limit (a turtle's command that ends on a control step) would then
+    // fall before or after the programs run there depending on where the run was cut into calls.
+    while (!process(t - t_base_)) {
+    }
     now_ = t - t_base_;
   }
 }

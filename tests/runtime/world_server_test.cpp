@@ -255,3 +255,49 @@ TEST_CASE("runs are deterministic", "[runtime][determinism]") {
     CHECK(a[k].b == b[k].b);
   }
 }
+
+TEST_CASE("where a run is cut into run_until calls does not change it", "[runtime][determinism][regression]") {
+  // Many turtles, so that the engine rebases its clock often, and back-offs that last exactly one
+  // control step (5 units at 50 units/s, dt 0.1), so that commands end right at a boundary. Whether
+  // such a command has ended when the programs run there must not depend on the calls: the CLI cuts
+  // runs into chunks by wall time.
+  auto run = [](double cut) {
+    sim::WorldDef d = arena();
+    d.arena.width = d.arena.height = 1000;
+    Registry r = base_registry();
+    r.add("random_walk", [](Turtle& t, const Params&) {
+      for (;;) {
+        auto m = t.forward(20 + 100 * t.uniform());
+        if (m.touched()) t.back(5);
+        t.right(360 * t.uniform() - 180);
+      }
+    });
+    for (int k = 0; k < 400; ++k)
+      d.turtles.push_back(body("t" + std::to_string(k), {25.0 + 48 * (k % 20), 25.0 + 48 * (k / 20)}, 37.0 * k));
+    for (auto& t : d.turtles) t.radius = 8;
+    std::vector<TurtleProgram> programs(d.turtles.size(), program("random_walk"));
+    WorldServer s(d, programs, r);
+    std::vector<LogEvent> log;
+    s.set_event_log(&log);
+    if (cut <= 0.0) {
+      s.run_until(40.0);
+    } else {
+      for (double t = cut; t < 40.0; t += cut) s.run_until(t);
+      s.run_until(40.0);
+    }
+    return log;
+  };
+  const auto whole = run(0.0);
+  CHECK(whole.size() > 10000);
+  for (double cut : {0.0537, 0.25, 1.0 / 3.0}) {
+    INFO("cut every " << cut << " s");
+    const auto cut_run = run(cut);
+    REQUIRE(cut_run.size() == whole.size());
+    std::size_t first_difference = whole.size();
+    for (std::size_t k = 0; k < whole.size() && first_difference == whole.size(); ++k)
+      if (std::memcmp(&whole[k].t, &cut_run[k].t, sizeof(double)) != 0 || whole[k].kind != cut_run[k].kind ||
+          whole[k].a != cut_run[k].a || whole[k].b != cut_run[k].b)
+        first_difference = k;
+    CHECK(first_difference == whole.size());
+  }
+}

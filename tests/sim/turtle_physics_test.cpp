@@ -228,7 +228,15 @@ TEST_CASE("a hundred turtles driven at random stay apart and inside", "[turtle][
     std::mt19937_64 rng(7);
     auto uniform = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
     std::uint64_t touches = 0;
+    std::uint64_t idle_mismatches = 0;  // idle_turtles() against turtle(k).busy, turtle by turtle
+    std::vector<std::uint32_t> idle, expected;
     for (int step = 1; step <= 3000; ++step) {
+      idle.clear();
+      expected.clear();
+      w.idle_turtles(idle);
+      for (std::uint32_t k = 0; k < w.turtle_count(); ++k)
+        if (!w.turtle(k).busy) expected.push_back(k);
+      if (idle != expected) ++idle_mismatches;
       for (std::size_t k = 0; k < w.turtle_count(); ++k) {
         const TurtleState s = w.turtle(k);
         if (s.busy) continue;
@@ -239,6 +247,7 @@ TEST_CASE("a hundred turtles driven at random stay apart and inside", "[turtle][
       touches += w.take_turtle_contacts().size();
     }
     CHECK(touches > 500);
+    CHECK(idle_mismatches == 0);
     CHECK(w.measure_overlap().relative <= 1e-9);
     CHECK(w.stats().exits == 0);
     for (std::size_t k = 0; k < w.turtle_count(); ++k) {

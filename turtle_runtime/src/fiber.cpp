@@ -8,6 +8,7 @@
 #include <exception>
 #include <mutex>
 #include <stdexcept>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <pthread.h>
@@ -107,12 +108,13 @@ void install_handlers() {
 // Boost's protected stack, remembering where its guard page is.
 class GuardedStack {
  public:
-  GuardedStack(std::size_t size, char** guard_lo, std::size_t* reserved)
-      : inner_(size), guard_lo_(guard_lo), reserved_(reserved) {}
+  GuardedStack(std::size_t size, char** guard_lo, char** top, std::size_t* reserved)
+      : inner_(size), guard_lo_(guard_lo), top_(top), reserved_(reserved) {}
   ctx::stack_context allocate() {
     ctx::stack_context sc = inner_.allocate();
     // Boost maps size + one page and protects the lowest page: [sp - size, sp - size + page).
     *guard_lo_ = static_cast<char*>(sc.sp) - sc.size;
+    *top_ = static_cast<char*>(sc.sp);
     *reserved_ = sc.size;
     return sc;
   }
@@ -121,6 +123,7 @@ class GuardedStack {
  private:
   ctx::protected_fixedsize_stack inner_;
   char** guard_lo_;
+  char** top_;
   std::size_t* reserved_;
 };
 
@@ -173,6 +176,8 @@ class Fiber::Impl {
   ctx::fiber self;    // the suspended body, seen from outside
   ctx::fiber caller;  // whoever resumed it, seen from inside
   char* guard_lo = nullptr;
+  char* top = nullptr;          // the high end of the stack
+  char* suspended_at = nullptr;  // the frame of the last suspend(), for prefetch_stack()
   std::size_t reserved = 0;
   bool started = false;
   bool finished = false;
@@ -193,7 +198,7 @@ Fiber::Fiber(std::function<void()> body, std::size_t stack_bytes) : impl_(std::m
   install_handlers();
   impl_->body = std::move(body);
   Impl* impl = impl_.get();
-  impl_->self = ctx::fiber(std::allocator_arg, GuardedStack(stack_bytes, &impl_->guard_lo, &impl_->reserved),
+  impl_->self = ctx::fiber(std::allocator_arg, GuardedStack(stack_bytes, &impl_->guard_lo, &impl_->top, &impl_->reserved),
                            [impl](ctx::fiber&& caller) {
                              TURTLEGAS_ASAN_ARRIVE(nullptr, &impl->outer_bottom, &impl->outer_size);
                              impl->caller = std::move(caller);
@@ -264,6 +269,7 @@ Fiber::Outcome Fiber::resume(double budget_seconds) {
 }
 
 void Fiber::suspend() {
+  impl_->suspended_at = static_cast<char*>(__builtin_frame_address(0));
   TURTLEGAS_ASAN_SWITCH(&impl_->inner_fake, impl_->outer_bottom, impl_->outer_size);
   try {
     impl_->caller = std::move(impl_->caller).resume();
@@ -273,6 +279,19 @@ void Fiber::suspend() {
     throw;
   }
   TURTLEGAS_ASAN_ARRIVE(impl_->inner_fake, &impl_->outer_bottom, &impl_->outer_size);
+}
+
+void Fiber::prefetch_record() const { __builtin_prefetch(impl_.get()); }
+
+void Fiber::prefetch_stack() const {
+  // A resume first pops the saved context just below suspend()'s frame, then returns through the
+  // program's frames above it, up to the top of the stack.
+  const char* at = impl_->suspended_at;
+  if (at == nullptr || impl_->finished || impl_->abandoned) return;
+  constexpr std::ptrdiff_t kBelow = 256, kAbove = 2048, kLine = 64;
+  const char* from = at - kBelow;
+  const char* to = std::min<const char*>(impl_->top, at + kAbove);
+  for (const char* p = from; p < to; p += kLine) __builtin_prefetch(p);
 }
 
 bool Fiber::done() const { return impl_->finished || impl_->abandoned; }

@@ -125,6 +125,9 @@ class World {
   std::size_t turtle_count() const;
   TurtleState turtle(std::size_t i) const;
   double turtle_radius(std::size_t i) const;
+  /// Appends to *out, in increasing order, the turtles whose command is not running (those whose
+  /// TurtleState::busy is false): one pass over compact state, for schedulers with many turtles.
+  void idle_turtles(std::vector<std::uint32_t>& out) const;
   /// Starts a command for turtle i at the current time, replacing whatever it was doing.
   void command_turtle(std::size_t i, const TurtleCommand& command);
   /// Contacts involving turtles since the last call, in time order.
