@@ -136,7 +136,8 @@ static_assert(sizeof(Pending) == 32);
 
 /// Everything an event reads and writes about its own body, in two adjacent cache lines: serving a
 /// body costs one pair of lines instead of a miss in each of four arrays (bodies, predictions,
-/// queue nodes, masses) once they outgrow the cache. The same 128 bytes the four arrays took.
+/// queue nodes, masses) once they outgrow the cache. The four arrays took the same 128 bytes (and
+/// `last_` 4 more, now in the padding of `Pending`). A turtle's record leaves its mass unused.
 struct alignas(64) Record {
   Body body;
   Pending pending;

@@ -51,6 +51,7 @@ class EventQueue {
   }
   /// Subtracts dt from every key (time rebasing) and rebuilds the calendar around them.
   void shift_keys(double dt);
+  /// The queue's own arrays; the nodes are the caller's.
   std::size_t memory_bytes() const;
 
  private:
