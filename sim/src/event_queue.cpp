@@ -6,8 +6,10 @@
 
 namespace turtlegas::sim::detail {
 
-void EventQueue::reset(std::size_t ids) {
-  node_.assign(ids, Node{});
+void EventQueue::reset(Node* first, std::size_t stride, std::size_t ids) {
+  nodes_ = first;
+  stride_ = stride;
+  ids_ = ids;
   std::size_t buckets = 1024;
   while (buckets < ids) buckets *= 2;
   year_ = buckets;
@@ -22,16 +24,16 @@ void EventQueue::reset(std::size_t ids) {
 }
 
 void EventQueue::push_list(std::uint32_t& head, std::uint32_t id, std::uint32_t where) {
-  Node& n = node_[id];
+  Node& n = node(id);
   n.where = where;
   n.prev = kAbsent;
   n.next = head;
-  if (head != kAbsent) node_[head].prev = id;
+  if (head != kAbsent) node(head).prev = id;
   head = id;
 }
 
 void EventQueue::insert(std::uint32_t id) {
-  Node& n = node_[id];
+  Node& n = node(id);
   if (!(n.key < std::numeric_limits<double>::infinity())) {
     n.where = kInfinite;
     return;
@@ -49,7 +51,7 @@ void EventQueue::insert(std::uint32_t id) {
 }
 
 void EventQueue::unlink(std::uint32_t id) {
-  Node& n = node_[id];
+  Node& n = node(id);
   switch (n.where) {
     case kNowhere: return;
     case kInfinite: break;
@@ -59,9 +61,9 @@ void EventQueue::unlink(std::uint32_t id) {
       break;
     default: {
       std::uint32_t& head = n.where == kInOverflow ? overflow_head_ : bucket_head_[n.where];
-      if (n.prev != kAbsent) node_[n.prev].next = n.next;
+      if (n.prev != kAbsent) node(n.prev).next = n.next;
       else head = n.next;
-      if (n.next != kAbsent) node_[n.next].prev = n.prev;
+      if (n.next != kAbsent) node(n.next).prev = n.prev;
       --finite_;
     }
   }
@@ -69,7 +71,7 @@ void EventQueue::unlink(std::uint32_t id) {
 }
 
 void EventQueue::set(std::uint32_t id, double key) {
-  Node& n = node_[id];
+  Node& n = node(id);
   if (n.where == kInHeap && n.prev == 0) {
     // The id just served gets its next key: the common case. Moved down from the root in place
     // when the key stays in the bucket being served, else taken off the root and filed.
@@ -108,7 +110,7 @@ void EventQueue::refill() {
     std::uint32_t id = bucket_head_[current_];
     bucket_head_[current_] = kAbsent;
     while (id != kAbsent) {
-      const std::uint32_t next = node_[id].next;
+      const std::uint32_t next = node(id).next;
       heap_push(id);
       id = next;
     }
@@ -122,15 +124,16 @@ void EventQueue::rebuild() {
   // the engine's peak).
   std::size_t count = 0;
   double start = std::numeric_limits<double>::infinity();
-  for (Node& n : node_) {
+  for (std::uint32_t id = 0; id < ids_; ++id) {
+    Node& n = node(id);
     if (n.where == kNowhere || n.where == kInfinite) continue;
     n.where = kRebuilding;
     ++count;
     start = std::min(start, n.key);
   }
   double sum = 0.0;
-  for (const Node& n : node_)
-    if (n.where == kRebuilding) sum += n.key - start;
+  for (std::uint32_t id = 0; id < ids_; ++id)
+    if (node(id).where == kRebuilding) sum += node(id).key - start;
   std::fill(bucket_head_.begin(), bucket_head_.end(), kAbsent);
   heap_.clear();
   overflow_head_ = kAbsent;
@@ -146,21 +149,21 @@ void EventQueue::rebuild() {
   t0_ = start;
   current_ = 0;
   served_end_ = 1.0;
-  for (std::uint32_t id = 0; id < node_.size(); ++id) {
-    if (node_[id].where != kRebuilding) continue;
-    node_[id].where = kNowhere;
+  for (std::uint32_t id = 0; id < ids_; ++id) {
+    if (node(id).where != kRebuilding) continue;
+    node(id).where = kNowhere;
     insert(id);
   }
 }
 
 void EventQueue::shift_keys(double dt) {
-  for (auto& n : node_)
-    if (n.where != kNowhere) n.key -= dt;
+  for (std::uint32_t id = 0; id < ids_; ++id)
+    if (node(id).where != kNowhere) node(id).key -= dt;
   if (finite_ > 0) rebuild();
 }
 
 void EventQueue::heap_push(std::uint32_t id) {
-  node_[id].where = kInHeap;
+  node(id).where = kInHeap;
   heap_.push_back(id);
   heap_up(static_cast<std::uint32_t>(heap_.size() - 1));
 }
@@ -171,7 +174,7 @@ void EventQueue::heap_erase(std::uint32_t pos) {
   if (pos == heap_.size()) return;
   heap_place(pos, last);
   heap_up(pos);
-  heap_down(node_[last].prev);
+  heap_down(node(last).prev);
 }
 
 void EventQueue::heap_up(std::uint32_t pos) {
@@ -200,7 +203,7 @@ void EventQueue::heap_down(std::uint32_t pos) {
 }
 
 std::size_t EventQueue::memory_bytes() const {
-  return node_.capacity() * sizeof(Node) + bucket_head_.capacity() * sizeof(std::uint32_t) +
+  return bucket_head_.capacity() * sizeof(std::uint32_t) +
          heap_.capacity() * sizeof(std::uint32_t);
 }
 

@@ -21,14 +21,26 @@ class EventQueue {
  public:
   static constexpr std::uint32_t kAbsent = std::numeric_limits<std::uint32_t>::max();
 
-  void reset(std::size_t ids);
+  /// Where the queue keeps one id's key and links. The nodes live in the caller's per-body
+  /// records (next to the body's other hot state, so that serving an id touches one record
+  /// rather than several arrays); the queue reaches node `id` at `stride * id` bytes past the first.
+  struct Node {
+    double key = 0.0;
+    std::uint32_t where = 0xFFFFFFF3u;  ///< bucket slot, or one of the k* states (kNowhere)
+    std::uint32_t prev = kAbsent;       ///< list links, or the heap position when kInHeap
+    std::uint32_t next = kAbsent;
+  };
+
+  /// Starts empty over `ids` nodes (default-constructed by the caller) at `first`, `stride` bytes
+  /// apart; they must stay put while the queue is used.
+  void reset(Node* first, std::size_t stride, std::size_t ids);
   /// Inserts id or moves it to its new key (which may be infinite).
   void set(std::uint32_t id, double key);
   void remove(std::uint32_t id);
   /// True when no finite key is stored.
   bool empty() const { return finite_ == 0; }
   /// The earliest (key, id); only when !empty().
-  double top_key() { settle(); return node_[heap_[0]].key; }
+  double top_key() { settle(); return node(heap_[0]).key; }
   std::uint32_t top_id() { settle(); return heap_[0]; }
   /// An id likely to be served soon after the top, k = 0 or 1 (the top's children in the served
   /// bucket, or the first id filed in the next bucket), or kAbsent; for prefetching.
@@ -39,17 +51,17 @@ class EventQueue {
   }
   /// Subtracts dt from every key (time rebasing) and rebuilds the calendar around them.
   void shift_keys(double dt);
+  /// The queue's own arrays; the nodes are the caller's.
   std::size_t memory_bytes() const;
 
  private:
   /// Node::where beyond the bucket slots; kRebuilding marks the ids a rebuild re-inserts.
   enum : std::uint32_t { kInHeap = 0xFFFFFFF0u, kInOverflow, kInfinite, kNowhere, kRebuilding };
-  struct Node {
-    double key = 0.0;
-    std::uint32_t where = kNowhere;  ///< bucket slot, or one of the k* states
-    std::uint32_t prev = kAbsent;    ///< list links, or the heap position when kInHeap
-    std::uint32_t next = kAbsent;
-  };
+  static_assert(kNowhere == 0xFFFFFFF3u);
+
+  Node& node(std::uint32_t id) const {
+    return *reinterpret_cast<Node*>(reinterpret_cast<char*>(nodes_) + stride_ * id);
+  }
 
   void insert(std::uint32_t id);
   void unlink(std::uint32_t id);
@@ -70,7 +82,8 @@ class EventQueue {
 
   // The small heap of the bucket being served.
   bool heap_before(std::uint32_t a, std::uint32_t b) const {
-    return node_[a].key < node_[b].key || (node_[a].key == node_[b].key && a < b);
+    const double ka = node(a).key, kb = node(b).key;
+    return ka < kb || (ka == kb && a < b);
   }
   void heap_push(std::uint32_t id);
   void heap_erase(std::uint32_t pos);
@@ -78,10 +91,12 @@ class EventQueue {
   void heap_down(std::uint32_t pos);
   void heap_place(std::uint32_t pos, std::uint32_t id) {
     heap_[pos] = id;
-    node_[id].prev = pos;
+    node(id).prev = pos;
   }
 
-  std::vector<Node> node_;
+  Node* nodes_ = nullptr;
+  std::size_t stride_ = sizeof(Node);
+  std::size_t ids_ = 0;
   std::vector<std::uint32_t> bucket_head_;
   std::vector<std::uint32_t> heap_;
   std::uint32_t overflow_head_ = kAbsent;
