@@ -5,33 +5,16 @@
 
 #include <cmath>
 
+#include "fixtures.hpp"
 #include "turtlegas/turtle/turtle.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
 using namespace turtlegas;
 using namespace turtlegas::turtle;
+using turtlegas::test::arena;
+using turtlegas::test::body;
 
 namespace {
-
-sim::WorldDef arena() {
-  sim::WorldDef d;
-  d.arena.width = 400;
-  d.arena.height = 400;
-  d.arena.boundary = sim::Boundary::walls;
-  d.dt = 0.1;
-  return d;
-}
-
-sim::TurtleDef body(std::string id, sim::Vec2 pos, double heading_deg, double speed = 50) {
-  sim::TurtleDef t;
-  t.id = std::move(id);
-  t.pos = pos;
-  t.heading = heading_deg * M_PI / 180.0;
-  t.radius = 10;
-  t.speed = speed;
-  t.turn_rate = M_PI;
-  return t;
-}
 
 TurtleProgram script(std::string commands, bool builder = false) {
   TurtleProgram p;

@@ -5,11 +5,14 @@
 #include <cmath>
 #include <cstring>
 
+#include "fixtures.hpp"
 #include "turtlegas/turtle/turtle.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
 using namespace turtlegas;
 using namespace turtlegas::turtle;
+using turtlegas::test::arena;
+using turtlegas::test::body;
 
 namespace {
 
@@ -20,26 +23,6 @@ constexpr bool kSanitized = true;
 #else
 constexpr bool kSanitized = false;
 #endif
-
-sim::WorldDef arena() {
-  sim::WorldDef d;
-  d.arena.width = 400;
-  d.arena.height = 400;
-  d.arena.boundary = sim::Boundary::walls;
-  d.dt = 0.1;
-  return d;
-}
-
-sim::TurtleDef body(std::string id, sim::Vec2 pos, double heading_deg) {
-  sim::TurtleDef t;
-  t.id = std::move(id);
-  t.pos = pos;
-  t.heading = heading_deg * M_PI / 180.0;
-  t.radius = 10;
-  t.speed = 50;
-  t.turn_rate = M_PI;  // 180 degrees per second
-  return t;
-}
 
 TurtleProgram program(std::string controller, std::string params = "{}") {
   TurtleProgram p;
