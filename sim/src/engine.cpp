@@ -289,6 +289,15 @@ class Engine final : public EngineBase {
   void add_end_layers(Vec2 p, const Layers& l);
   Vec2 mover_p1(const Mover& m, double t) const { return m.p1_ref + (t - m.t_ref) * m.u; }
   Vec2 mover_d(const Mover& m, double t) const { return m.d_ref + (t - m.t_ref) * m.w; }
+  /// One end of mover m at internal time t (the second through the translation's fixed shape
+  /// when it does not turn or stretch), and that end's velocity.
+  Vec2 mover_end(const Mover& m, bool second, double t) const {
+    const Vec2 p1 = mover_p1(m, t);
+    if (!second) return p1;
+    const Segment& s = walls_[m.wall];
+    return m.rigid() ? p1 + s.len * s.u : p1 + mover_d(m, t);
+  }
+  static Vec2 mover_end_velocity(const Mover& m, bool second) { return second ? m.u + m.w : m.u; }
   /// The wall of mover m as a segment at internal time t.
   Segment mover_segment(const Mover& m, double t) const {
     if (m.rigid()) {
@@ -1368,28 +1377,24 @@ void Engine<Flight, kBallBall, kStep, kExtras>::consider_mover(std::uint32_t i, 
   const Vec2 p1 = mover_p1(m, now_);
   const Vec2 v = bi.v - m.u;
   const double horizon = std::min(p.t_coll, next_key_);
+  double t_wall = kNever;
   if (!m.rigid()) {
     // Turning or stretching: no straight-line argument rules out meeting the same wall again.
-    const double t = now_ + toi_disc_deforming_segment(bi.x - p1, v, accel(i), mover_d(m, now_), m.w, bi.r, horizon - now_);
-    if (t < p.t_coll && t <= horizon) {
-      p.t_coll = t;
-      p.kind = Partner::wall;
-      p.partner = w;
-    }
+    t_wall = now_ + toi_disc_deforming_segment(bi.x - p1, v, accel(i), mover_d(m, now_), m.w, bi.r, horizon - now_);
   } else if (!(straight(i) && last_[i] == last_code(Partner::wall, w))) {
-    const double t = now_ + toi_disc_segment(bi.x - p1, v, accel(i), s, bi.r);
-    if (t < p.t_coll && t <= horizon) {
-      p.t_coll = t;
-      p.kind = Partner::wall;
-      p.partner = w;
-    }
+    t_wall = now_ + toi_disc_segment(bi.x - p1, v, accel(i), s, bi.r);
+  }
+  if (t_wall < p.t_coll && t_wall <= horizon) {
+    p.t_coll = t_wall;
+    p.kind = Partner::wall;
+    p.partner = w;
   }
   for (std::uint32_t which = 0; which < 2; ++which) {
     const std::uint32_t code = 2 * mi + which;
     if (straight(i) && last_[i] == last_code(Partner::moving_end, code)) continue;
     // Each end moves in a straight line, so its contacts have the closed forms of a fixed point.
-    const Vec2 e = which == 0 ? p1 : (m.rigid() ? p1 + s.len * s.u : p1 + mover_d(m, now_));
-    const Vec2 ve = which == 0 ? v : v - m.w;
+    const Vec2 e = mover_end(m, which == 1, now_);
+    const Vec2 ve = which == 0 ? v : v - m.w;  // the body's velocity relative to that end
     double dt;
     if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(bi.x - e, ve, flight_.a, bi.r, horizon - now_);
     else dt = toi_disc_point(bi.x - e, ve, bi.r);
@@ -1407,11 +1412,9 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_moving_end(std::uint32_t
   sync(i);
   Body& a = body_[i];
   const Mover& m = movers_[code / 2];
-  const Segment& s = walls_[m.wall];
-  const Vec2 p1 = mover_p1(m, now_);
   const bool second = code % 2 == 1;
-  const Vec2 e = !second ? p1 : (m.rigid() ? p1 + s.len * s.u : p1 + mover_d(m, now_));
-  const Vec2 ue = second ? m.u + m.w : m.u;  // the end's velocity
+  const Vec2 e = mover_end(m, second, now_);
+  const Vec2 ue = mover_end_velocity(m, second);
   const Vec2 F = a.x - e;
   const double dist = norm(F);
   note_contact(a.r - dist, a.r);
