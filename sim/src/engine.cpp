@@ -831,6 +831,15 @@ void Engine<Flight, kBallBall, kStep, kExtras>::predict(std::uint32_t i, int ix,
     if (grid_.plain_neighbourhood(ix, iy)) {
       // Away from a periodic seam the 3x3 cells are three runs of three in the table.
       const int stride = grid_.stride();
+      if constexpr (kExtras) {
+        // Scenes with turtles: the first body listed in each of the nine cells is asked for
+        // before the scan walks the lists one by one (with many turtles each is a cache miss).
+        for (int row = static_cast<int>(bi.cell) - stride - 1, dy = -1; dy <= 1; ++dy, row += stride)
+          for (int dx = 0; dx <= 2; ++dx) {
+            if (const std::uint32_t j = turtle_head_[row + dx]; j != kNone) __builtin_prefetch(&body_[j]);
+            if (const std::uint32_t j = head_[row + dx]; j != kNone) __builtin_prefetch(&body_[j]);
+          }
+      }
       for (int row = static_cast<int>(bi.cell) - stride - 1, dy = -1; dy <= 1; ++dy, row += stride)
         for (int dx = 0; dx <= 2; ++dx) scan_cell(i, bi, row + dx, Vec2{}, p);
     } else {
