@@ -275,7 +275,9 @@ class Engine final : public EngineBase {
   bool is_turtle(std::uint32_t id) const { return kExtras && id >= nb_; }
   /// Collision layers: whether two bodies, or a body and a wall or wall end, can touch at all.
   bool meets(std::uint32_t i, std::uint32_t j) const {
-    if constexpr (kExtras) return layers_[i].collides_with(layers_[j]);
+    // Bodies' layers are fixed at construction; when all are the defaults (which meet), the pair
+    // test reads neither (with many turtles layers_[j] is a cache miss per candidate).
+    if constexpr (kExtras) return !bodies_layered_ || layers_[i].collides_with(layers_[j]);
     else return true;
   }
   bool meets_wall(std::uint32_t i, std::uint32_t w) const {
@@ -448,6 +450,7 @@ class Engine final : public EngineBase {
   std::vector<TurtleRun> run_;
   std::vector<TurtleContact> contacts_;
   std::vector<Layers> layers_;       ///< per body (kExtras only)
+  bool bodies_layered_ = false;      ///< whether any body's layers differ from the defaults
   std::vector<Layers> wall_layers_;  ///< per wall (kExtras only)
   std::vector<Layers> end_layers_;   ///< per end: its walls' categories and masks together
   std::vector<Mover> movers_;                 ///< moving walls (kExtras only), outside the grid
@@ -582,6 +585,7 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vect
     layers_.resize(n);
     for (std::uint32_t i = 0; i < nb_; ++i) layers_[i] = def.balls[i].layers;
     for (std::size_t k = 0; k < def.turtles.size(); ++k) layers_[nb_ + k] = def.turtles[k].layers;
+    bodies_layered_ = std::any_of(layers_.begin(), layers_.end(), [](const Layers& l) { return l != Layers{}; });
   }
   for (std::uint32_t i = 0; i < nb_; ++i) {
     const BallDef& d = def.balls[i];
@@ -806,7 +810,7 @@ inline void Engine<Flight, kBallBall, kStep, kExtras>::scan_cell(std::uint32_t i
   if (!is_turtle(i)) {
     if constexpr (kBallBall)
       for (std::uint32_t j = head_[cell]; j != kNone; j = body_[j].next) consider_ball(i, bi, j, shift, p);
-  } else {
+  } else if (nb_ > 0) {  // a scene of turtles alone never reads the (empty) ball lists
     for (std::uint32_t j = head_[cell]; j != kNone; j = body_[j].next) consider_ball_from_turtle(i, bi, j, shift, p);
   }
   if constexpr (kExtras)
@@ -837,6 +841,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::predict(std::uint32_t i, int ix,
         for (int row = static_cast<int>(bi.cell) - stride - 1, dy = -1; dy <= 1; ++dy, row += stride)
           for (int dx = 0; dx <= 2; ++dx) {
             if (const std::uint32_t j = turtle_head_[row + dx]; j != kNone) __builtin_prefetch(&body_[j]);
+            if (nb_ == 0) continue;
             if (const std::uint32_t j = head_[row + dx]; j != kNone) __builtin_prefetch(&body_[j]);
           }
       }
