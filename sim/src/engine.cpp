@@ -179,7 +179,6 @@ constexpr std::uint32_t last_code(Partner k, std::uint32_t index) {
 struct TurtleRun {
   TurtleCommand::Kind kind = TurtleCommand::Kind::stop;
   bool coasting = false;  ///< bouncing off after a contact, until the next control step
-  bool busy = false;
   bool touched = false;
   double amount = 0.0;
   double t_start = 0.0;
@@ -252,7 +251,7 @@ class Engine final : public EngineBase {
   double turtle_radius(std::size_t k) const override { return body_[nb_ + k].r; }
   void idle_turtles(std::vector<std::uint32_t>& out) const override {
     for (std::uint32_t k = 0; k < run_.size(); ++k)
-      if (!run_[k].busy) out.push_back(k);
+      if (busy_[k] == 0) out.push_back(k);
   }
   void command_turtle(std::size_t k, const TurtleCommand& command) override;
   std::size_t add_wall(const WallDef& wall) override;
@@ -448,6 +447,7 @@ class Engine final : public EngineBase {
   std::vector<std::uint32_t> head_;         ///< balls by cell
   std::vector<std::uint32_t> turtle_head_;  ///< turtles by cell (only when there are turtles)
   std::vector<TurtleRun> run_;
+  std::vector<std::uint8_t> busy_;  ///< per turtle: a command is running (apart, so the idle scan reads 1 byte a turtle)
   std::vector<TurtleContact> contacts_;
   std::vector<Layers> layers_;       ///< per body (kExtras only)
   bool bodies_layered_ = false;      ///< whether any body's layers differ from the defaults
@@ -606,6 +606,7 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vect
   last_ = {records_.get(), n};
   pending_ = {records_.get(), n};
   run_.resize(def.turtles.size());
+  busy_.assign(def.turtles.size(), 0);
   for (std::size_t k = 0; k < def.turtles.size(); ++k) {
     const TurtleDef& d = def.turtles[k];
     const auto id = static_cast<std::uint32_t>(nb_ + k);
@@ -1100,8 +1101,8 @@ void Engine<Flight, kBallBall, kStep, kExtras>::touch(std::uint32_t id, EventKin
   const std::size_t k = id - nb_;
   TurtleRun& r = run_[k];
   Body& b = body_[id];
-  if (r.busy) {
-    r.busy = false;
+  if (busy_[k] != 0) {
+    busy_[k] = 0;
     r.touched = true;
     if (r.kind == TurtleCommand::Kind::turn) r.heading0 = heading_at(k, now_);
     r.amount = r.kind == TurtleCommand::Kind::move ? r.speed * (now_ - r.t_start)
@@ -1226,11 +1227,12 @@ template <class Flight, bool kBallBall, bool kStep, bool kExtras>
 void Engine<Flight, kBallBall, kStep, kExtras>::end_command(std::uint32_t i) {
   // A turtle's command (or its coasting after a bounce) has run its course.
   sync(i);
-  TurtleRun& r = run_[i - nb_];
+  const std::size_t k = i - nb_;
+  TurtleRun& r = run_[k];
   // A completed turn ends exactly where it was told to, not where omega * time rounds to.
-  if (r.kind == TurtleCommand::Kind::turn && r.busy) r.heading0 += r.amount;
-  if (r.busy) r.amount = std::abs(r.amount);
-  r.busy = false;
+  if (r.kind == TurtleCommand::Kind::turn && busy_[k] != 0) r.heading0 += r.amount;
+  if (busy_[k] != 0) r.amount = std::abs(r.amount);
+  busy_[k] = 0;
   r.coasting = false;
   r.omega = 0.0;
   r.t_end = kNever;
@@ -1258,27 +1260,27 @@ void Engine<Flight, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, co
   b.v = {};
   switch (c.kind) {
     case TurtleCommand::Kind::stop:
-      r.busy = false;
+      busy_[k] = 0;
       r.t_end = kNever;
       break;
     case TurtleCommand::Kind::move: {
       const double sign = c.amount >= 0.0 ? 1.0 : -1.0;
-      r.busy = c.amount != 0.0 && r.speed > 0.0;
-      r.t_end = r.busy ? now_ + std::abs(c.amount) / r.speed : kNever;
-      if (r.busy) b.v = (sign * r.speed) * heading_vector(r.heading0);
+      busy_[k] = c.amount != 0.0 && r.speed > 0.0;
+      r.t_end = busy_[k] != 0 ? now_ + std::abs(c.amount) / r.speed : kNever;
+      if (busy_[k] != 0) b.v = (sign * r.speed) * heading_vector(r.heading0);
       r.amount = c.amount;
       break;
     }
     case TurtleCommand::Kind::turn:
-      r.busy = c.amount != 0.0 && r.turn_rate > 0.0;
+      busy_[k] = c.amount != 0.0 && r.turn_rate > 0.0;
       r.omega = c.amount >= 0.0 ? r.turn_rate : -r.turn_rate;
-      r.t_end = r.busy ? now_ + std::abs(c.amount) / r.turn_rate : kNever;
-      if (!r.busy) r.omega = 0.0;
+      r.t_end = busy_[k] != 0 ? now_ + std::abs(c.amount) / r.turn_rate : kNever;
+      if (busy_[k] == 0) r.omega = 0.0;
       r.amount = c.amount;
       break;
     case TurtleCommand::Kind::wait:
-      r.busy = c.amount > 0.0;
-      r.t_end = r.busy ? now_ + c.amount : kNever;
+      busy_[k] = c.amount > 0.0;
+      r.t_end = busy_[k] != 0 ? now_ + c.amount : kNever;
       r.amount = c.amount;
       break;
   }
@@ -1520,9 +1522,9 @@ TurtleState Engine<Flight, kBallBall, kStep, kExtras>::turtle(std::size_t k) con
   s.pos = b.x + (now_ - b.t) * b.v;
   s.vel = b.v;
   s.heading = heading_at(k, now_);
-  s.busy = r.busy;
+  s.busy = busy_[k] != 0;
   s.touched = r.touched;
-  if (r.busy) {
+  if (s.busy) {
     const double el = now_ - r.t_start;
     s.done = r.kind == TurtleCommand::Kind::move ? r.speed * el
              : r.kind == TurtleCommand::Kind::turn ? r.turn_rate * el
@@ -1571,9 +1573,8 @@ void Engine<Flight, kBallBall, kStep, kExtras>::remove(std::uint32_t i) {
   ++body_[i].count;  // predictions made against it are now stale
   heap_.remove(i);
   if (is_turtle(i)) {
-    TurtleRun& r = run_[i - nb_];
-    r.busy = false;
-    r.t_end = kNever;
+    busy_[i - nb_] = 0;
+    run_[i - nb_].t_end = kNever;
     body_[i].v = {};
   }
 }
@@ -1632,7 +1633,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::begin_step() {
       ++b.count;
       heap_.remove(i);
       if (turtle) {
-        run_[i - nb_].busy = false;
+        busy_[i - nb_] = 0;
         run_[i - nb_].t_end = kNever;
         b.v = {};
       }
