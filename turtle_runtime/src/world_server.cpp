@@ -261,7 +261,7 @@ Result Agent::issue(sim::TurtleCommand c) {
   command = c;
   // The wall pen lays the stroke this command drives, in the pen mode it was issued in.
   const bool lays_wall = pen_down && pen_mode == PenMode::wall && c.kind == sim::TurtleCommand::Kind::move;
-  const sim::Vec2 start = server->world.turtle(index).pos;
+  const sim::Vec2 start = lays_wall ? server->world.turtle(index).pos : sim::Vec2{};
   fiber->suspend();
   // Resumed by the scheduler: the command has ended. Interrupts first, then the answer.
   const sim::TurtleState s = server->world.turtle(index);
