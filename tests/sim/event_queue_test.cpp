@@ -134,6 +134,10 @@ TEST_CASE("EventQueue serves the same (key, id) order as a std::set", "[event_qu
   }
 }
 
+TEST_CASE("EventQueue over many ids serves the same (key, id) order", "[event_queue]") {
+  run(70000, 20261123, 3000);
+}
+
 TEST_CASE("EventQueue with every key equal serves by id", "[event_queue]") {
   Checked q(3000);
   for (std::uint32_t id = 0; id < 3000; ++id) q.set(id, 2.5);
