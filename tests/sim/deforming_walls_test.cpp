@@ -240,11 +240,7 @@ TEST_CASE("a turtle struck by a turning wall is touched and knocked away", "[def
   WorldDef d = box(200, 200, Boundary::none);
   // An arm from (100, 100) swinging from pointing +x to pointing +y in 2 s.
   d.walls.push_back(moving("arm", {100, 100}, {180, 100}, {{2.0, {100, 100}, {100, 180}}}));
-  TurtleDef t;
-  t.id = "t";
-  t.pos = {150, 120};
-  t.radius = 5;
-  d.turtles.push_back(t);
+  d.turtles.push_back(turtle("t", {150, 120}, 0, 5));
   World w(d, Mode::exact);
   w.advance_to(1.0);
   const auto contacts = w.take_turtle_contacts();

@@ -60,11 +60,7 @@ TEST_CASE("a turtle pushed by a moving wall is touched and carried along", "[mov
   WorldDef d = box(200, 100, Boundary::none);
   // x = 100 - 5 t until t = 10 (x = 50).
   d.walls.push_back(moving("pusher", {100, 0}, {100, 100}, {{10.0, {50, 0}, {50, 100}}}));
-  TurtleDef t;
-  t.id = "t";
-  t.pos = {50, 50};
-  t.radius = 10;
-  d.turtles.push_back(t);
+  d.turtles.push_back(turtle("t", {50, 50}, 0, 10));
   World w(d, Mode::exact);
   w.advance_to(12.0);
   // Contact when the wall reaches x = 60 (t = 8); pushed to x = 40 by t = 10, then left there.

@@ -38,6 +38,18 @@ inline BallDef ball(std::string id, Vec2 pos, Vec2 vel, double radius = 1.0, dou
   return BallDef{std::move(id), pos, vel, radius, mass, 0.0};
 }
 
+/// A turtle with the given heading (degrees, Logo convention), radius and speed; turn rate 90°/s.
+inline sim::TurtleDef turtle(std::string id, Vec2 pos, double heading_deg, double radius = 10, double speed = 30) {
+  sim::TurtleDef t;
+  t.id = std::move(id);
+  t.pos = pos;
+  t.heading = heading_deg * (M_PI / 180.0);
+  t.radius = radius;
+  t.speed = speed;
+  t.turn_rate = M_PI / 2;
+  return t;
+}
+
 /// A random gas on a jittered lattice (never overlapping), speeds `speed` in random directions.
 inline WorldDef random_gas(int n, double phi, double radius, double speed, std::uint64_t seed,
                            sim::Boundary boundary = sim::Boundary::walls) {

@@ -18,17 +18,6 @@ const Mode kModes[] = {Mode::exact, Mode::step};
 const char* name(Mode m) { return m == Mode::exact ? "exact" : "step"; }
 constexpr double kDeg = M_PI / 180.0;
 
-TurtleDef turtle(std::string id, Vec2 pos, double heading_deg, double radius = 10, double speed = 30) {
-  TurtleDef t;
-  t.id = std::move(id);
-  t.pos = pos;
-  t.heading = heading_deg * kDeg;
-  t.radius = radius;
-  t.speed = speed;
-  t.turn_rate = 90 * kDeg;
-  return t;
-}
-
 TurtleCommand move(double d) { return {TurtleCommand::Kind::move, d}; }
 TurtleCommand turn(double deg) { return {TurtleCommand::Kind::turn, deg * kDeg}; }
 
