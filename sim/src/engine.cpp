@@ -1230,8 +1230,10 @@ void Engine<Flight, kBallBall, kStep, kExtras>::end_command(std::uint32_t i) {
   const std::size_t k = i - nb_;
   TurtleRun& r = run_[k];
   // A completed turn ends exactly where it was told to, not where omega * time rounds to.
-  if (r.kind == TurtleCommand::Kind::turn && busy_[k] != 0) r.heading0 += r.amount;
-  if (busy_[k] != 0) r.amount = std::abs(r.amount);
+  if (busy_[k] != 0) {
+    if (r.kind == TurtleCommand::Kind::turn) r.heading0 += r.amount;
+    r.amount = std::abs(r.amount);
+  }
   busy_[k] = 0;
   r.coasting = false;
   r.omega = 0.0;
@@ -1258,32 +1260,32 @@ void Engine<Flight, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, co
   r.amount = 0.0;
   Body& b = body_[id];
   b.v = {};
+  bool busy = false;
   switch (c.kind) {
     case TurtleCommand::Kind::stop:
-      busy_[k] = 0;
       r.t_end = kNever;
       break;
     case TurtleCommand::Kind::move: {
       const double sign = c.amount >= 0.0 ? 1.0 : -1.0;
-      busy_[k] = c.amount != 0.0 && r.speed > 0.0;
-      r.t_end = busy_[k] != 0 ? now_ + std::abs(c.amount) / r.speed : kNever;
-      if (busy_[k] != 0) b.v = (sign * r.speed) * heading_vector(r.heading0);
+      busy = c.amount != 0.0 && r.speed > 0.0;
+      r.t_end = busy ? now_ + std::abs(c.amount) / r.speed : kNever;
+      if (busy) b.v = (sign * r.speed) * heading_vector(r.heading0);
       r.amount = c.amount;
       break;
     }
     case TurtleCommand::Kind::turn:
-      busy_[k] = c.amount != 0.0 && r.turn_rate > 0.0;
-      r.omega = c.amount >= 0.0 ? r.turn_rate : -r.turn_rate;
-      r.t_end = busy_[k] != 0 ? now_ + std::abs(c.amount) / r.turn_rate : kNever;
-      if (busy_[k] == 0) r.omega = 0.0;
+      busy = c.amount != 0.0 && r.turn_rate > 0.0;
+      r.omega = busy ? (c.amount >= 0.0 ? r.turn_rate : -r.turn_rate) : 0.0;
+      r.t_end = busy ? now_ + std::abs(c.amount) / r.turn_rate : kNever;
       r.amount = c.amount;
       break;
     case TurtleCommand::Kind::wait:
-      busy_[k] = c.amount > 0.0;
-      r.t_end = busy_[k] != 0 ? now_ + c.amount : kNever;
+      busy = c.amount > 0.0;
+      r.t_end = busy ? now_ + c.amount : kNever;
       r.amount = c.amount;
       break;
   }
+  busy_[k] = busy ? 1 : 0;
   // A new course: predictions made against the old one are stale, and "just collided, cannot
   // meet again" no longer holds.
   ++b.count;

@@ -105,7 +105,7 @@ void run(std::size_t ids, std::uint64_t seed, int steps) {
     } else if (u < 0.95) {
       q.remove(pick());
     } else if (u < 0.97) {
-      // A burst of equal keys: crowds one bucket past its line, into its list.
+      // A burst of equal keys, all in one bucket (ties served by id).
       const double key = now + uniform();
       for (int k = 0; k < 40; ++k) q.set(pick(), key);
     } else if (u < 0.99) {
