@@ -95,9 +95,9 @@ struct alignas(64) Body {
 };
 static_assert(sizeof(Body) == 64);
 
-/// What a prediction is about. `body` partners are balls or turtles (ids are shared); `command`
-/// is the end of a turtle's own command.
-enum class Partner : std::uint8_t { none, body, wall, end, command, moving_end };
+/// What a prediction is about. `body` partners are balls or turtles (ids are shared). (The end of a
+/// turtle's own command is kept apart: Engine::end_.)
+enum class Partner : std::uint8_t { none, body, wall, end, moving_end };
 
 /// A moving wall's pose at a keyframe: its first end and the vector to its second.
 struct MoverKey {
@@ -137,12 +137,15 @@ static_assert(sizeof(Pending) == 32);
 /// Everything an event reads and writes about its own body, in two adjacent cache lines: serving a
 /// body costs one pair of lines instead of a miss in each of four arrays (bodies, predictions,
 /// queue nodes, masses) once they outgrow the cache. The four arrays took the same 128 bytes (and
-/// `last_` 4 more, now in the padding of `Pending`). A turtle's record leaves its mass unused.
+/// `last_` 4 more, now in the padding of `Pending`).
 struct alignas(64) Record {
   Body body;
   Pending pending;
   EventQueue::Node node;
-  double mass = 0.0;
+  /// A ball's mass. A turtle has none (a ball meets it as a wall of infinite mass): its slot holds
+  /// the internal time its command ends (kNever: no command running), which each of its events
+  /// reads beside its prediction.
+  double mass_or_end = 0.0;
 };
 static_assert(sizeof(Record) == 128);
 
@@ -161,7 +164,8 @@ class Column {
 };
 inline Body& body_of(Record& r) { return r.body; }
 inline Pending& pending_of(Record& r) { return r.pending; }
-inline double& mass_of(Record& r) { return r.mass; }
+inline double& mass_of(Record& r) { return r.mass_or_end; }
+inline double& command_end_of(Record& r) { return r.mass_or_end; }
 inline std::uint32_t& last_of(Record& r) { return r.pending.last; }
 
 struct FreeRecords {
@@ -181,8 +185,7 @@ struct TurtleRun {
   bool coasting = false;  ///< bouncing off after a contact, until the next control step
   bool touched = false;
   double amount = 0.0;
-  double t_start = 0.0;
-  double t_end = kNever;
+  double t_start = 0.0;  ///< (its end is in the turtle's Record: Engine::end_)
   double heading0 = 0.0;  ///< heading at t_start
   double omega = 0.0;     ///< signed turn rate while turning
   double speed = 0.0;
@@ -318,6 +321,8 @@ class Engine final : public EngineBase {
   /// The acceleration a body flies under: the field for balls, none for turtles.
   Vec2 accel(std::uint32_t id) const { return is_turtle(id) ? Vec2{} : flight_.a; }
   bool straight(std::uint32_t id) const { return !Flight::kAccelerates || is_turtle(id); }
+  /// A turtle standing still (balls under a field are never taken for one: this is for turtles).
+  static bool at_rest(const Body& b) { return b.v.x == 0.0 && b.v.y == 0.0; }
   Vec2 pos_at(const Body& b, std::uint32_t id, double dt) const {
     return is_turtle(id) ? b.x + dt * b.v : flight_.pos(b.x, b.v, dt);
   }
@@ -326,7 +331,7 @@ class Engine final : public EngineBase {
   }
   double heading_at(std::size_t k, double t) const {
     const TurtleRun& r = run_[k];
-    return r.heading0 + r.omega * (std::min(t, r.t_end) - r.t_start);
+    return r.heading0 + r.omega * (std::min(t, end_[nb_ + k]) - r.t_start);
   }
   Vec2 min_image(Vec2 d) const {
     if (grid_.periodic()) {
@@ -397,9 +402,14 @@ class Engine final : public EngineBase {
     predict_crossing(i, c.ix, c.iy);
   }
   void predict_crossing(std::uint32_t i, int ix, int iy);
+  /// When a turtle's command ends (kNever for a ball, or a turtle with no command running).
+  double command_end(std::uint32_t i) const {
+    if constexpr (kExtras) return is_turtle(i) ? end_[i] : kNever;
+    else return kNever;
+  }
   void schedule(std::uint32_t i) {
     const Pending& p = pending_[i];
-    heap_.set(i, std::min(p.t_coll, p.t_cross));
+    heap_.set(i, std::min(std::min(p.t_coll, p.t_cross), command_end(i)));
   }
   int step_rings(double reach) const {
     return static_cast<int>(std::floor(reach / std::min(grid_.cell_w(), grid_.cell_h()))) + 1;
@@ -441,6 +451,7 @@ class Engine final : public EngineBase {
   std::unique_ptr<Record[], FreeRecords> records_;  ///< one per body; the columns below view them
   Column<Body, body_of> body_;
   Column<double, mass_of> mass_;      ///< balls only
+  Column<double, command_end_of> end_;  ///< turtles only: when the command running ends
   Column<std::uint32_t, last_of> last_;
   Column<Pending, pending_of> pending_;
   std::vector<double> last_time_;  ///< only when restitution < 1 (the TC rule)
@@ -599,10 +610,11 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vect
     rec->body.x = d.x;
     rec->body.v = d.v;
     rec->body.r = d.r;
-    rec->mass = d.mass;
+    rec->mass_or_end = d.mass;
   }
   body_ = {records_.get(), n};
   mass_ = {records_.get(), nb_};
+  end_ = {records_.get(), n};
   last_ = {records_.get(), n};
   pending_ = {records_.get(), n};
   run_.resize(def.turtles.size());
@@ -612,6 +624,7 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vect
     const auto id = static_cast<std::uint32_t>(nb_ + k);
     body_[id].x = d.pos;
     body_[id].r = d.radius;
+    end_[id] = kNever;
     TurtleRun& r = run_[k];
     r.heading0 = d.heading;
     r.speed = d.speed;
@@ -822,16 +835,10 @@ template <class Flight, bool kBallBall, bool kStep, bool kExtras>
 void Engine<Flight, kBallBall, kStep, kExtras>::predict(std::uint32_t i, int ix, int iy) {
   const Body& bi = body_[i];
   Pending& p = pending_[i];
+  // A turtle's command end is not a candidate here: it is kept apart (command_end()), so that a
+  // turtle whose command starts or ends without moving it keeps the collisions predicted for it.
   p.t_coll = kNever;
   p.kind = Partner::none;
-  if (is_turtle(i)) {
-    // The end of the turtle's own command is one more candidate.
-    const TurtleRun& r = run_[i - nb_];
-    if (r.t_end < kNever) {
-      p.t_coll = r.t_end;
-      p.kind = Partner::command;
-    }
-  }
   if constexpr (!kStep) {
     if (grid_.plain_neighbourhood(ix, iy)) {
       // Away from a periodic seam the 3x3 cells are three runs of three in the table.
@@ -990,7 +997,9 @@ bool Engine<Flight, kBallBall, kStep, kExtras>::process(double limit) {
       __builtin_prefetch(&pending_[k]);
     }
     const Pending& p = pending_[i];
-    if (p.t_coll <= p.t_cross) collide(i);
+    // A command's end goes first at a tie with a collision or a crossing.
+    if (const double t_end = command_end(i); t_end <= p.t_coll && t_end <= p.t_cross) end_command(i);
+    else if (p.t_coll <= p.t_cross) collide(i);
     else cross(i);
     if constexpr (!kStep) {
       if (++events_since_rebase_ >= rebase_every_) {
@@ -1028,7 +1037,6 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
     case Partner::wall: collide_wall(i, p.partner); return;
     case Partner::end: collide_end(i, p.partner); return;
     case Partner::moving_end: collide_moving_end(i, p.partner); return;
-    case Partner::command: end_command(i); return;
     case Partner::none: break;
   }
   // A body with nothing pending has an infinite key and is never popped.
@@ -1109,7 +1117,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::touch(std::uint32_t id, EventKin
                : r.kind == TurtleCommand::Kind::turn ? std::abs(r.omega) * (now_ - r.t_start)
                                                      : now_ - r.t_start;
     r.omega = 0.0;
-    r.t_end = kNever;
+    end_[id] = kNever;
   }
   const double vn = dot(b.v, normal);
   if (r.bounce >= 0.0 && vn < 0.0) {
@@ -1118,11 +1126,11 @@ void Engine<Flight, kBallBall, kStep, kExtras>::touch(std::uint32_t id, EventKin
     const double t_ext = t_base_ + now_;
     const double next_step = (std::floor(t_ext / dt_ + 1e-9) + 1.0) * dt_;
     r.coasting = true;
-    r.t_end = next_step - t_base_;
+    end_[id] = next_step - t_base_;
   } else {
     b.v = {};
     r.coasting = false;
-    r.t_end = kNever;
+    end_[id] = kNever;
   }
   contacts_.push_back({t_base_ + now_, static_cast<std::uint32_t>(k), kind, other, normal});
 }
@@ -1237,7 +1245,13 @@ void Engine<Flight, kBallBall, kStep, kExtras>::end_command(std::uint32_t i) {
   busy_[k] = 0;
   r.coasting = false;
   r.omega = 0.0;
-  r.t_end = kNever;
+  end_[i] = kNever;
+  if (at_rest(body_[i])) {
+    // A turn or a wait: the disc stood still and stays still, so every prediction made with it
+    // (its own and its neighbours') still holds. Only its key loses the command's end.
+    schedule(i);
+    return;
+  }
   body_[i].v = {};
   after_change(i);
   last_[i] = kNone;
@@ -1259,16 +1273,17 @@ void Engine<Flight, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, co
   r.omega = 0.0;
   r.amount = 0.0;
   Body& b = body_[id];
+  const bool was_at_rest = at_rest(b);
   b.v = {};
   bool busy = false;
   switch (c.kind) {
     case TurtleCommand::Kind::stop:
-      r.t_end = kNever;
+      end_[id] = kNever;
       break;
     case TurtleCommand::Kind::move: {
       const double sign = c.amount >= 0.0 ? 1.0 : -1.0;
       busy = c.amount != 0.0 && r.speed > 0.0;
-      r.t_end = busy ? now_ + std::abs(c.amount) / r.speed : kNever;
+      end_[id] = busy ? now_ + std::abs(c.amount) / r.speed : kNever;
       if (busy) b.v = (sign * r.speed) * heading_vector(r.heading0);
       r.amount = c.amount;
       break;
@@ -1276,16 +1291,23 @@ void Engine<Flight, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, co
     case TurtleCommand::Kind::turn:
       busy = c.amount != 0.0 && r.turn_rate > 0.0;
       r.omega = busy ? (c.amount >= 0.0 ? r.turn_rate : -r.turn_rate) : 0.0;
-      r.t_end = busy ? now_ + std::abs(c.amount) / r.turn_rate : kNever;
+      end_[id] = busy ? now_ + std::abs(c.amount) / r.turn_rate : kNever;
       r.amount = c.amount;
       break;
     case TurtleCommand::Kind::wait:
       busy = c.amount > 0.0;
-      r.t_end = busy ? now_ + c.amount : kNever;
+      end_[id] = busy ? now_ + c.amount : kNever;
       r.amount = c.amount;
       break;
   }
   busy_[k] = busy ? 1 : 0;
+  if (was_at_rest && at_rest(b)) {
+    // A turn, a wait or a stop from rest: the disc does not move, so the predictions made with it
+    // still hold (its own, kept apart from the command's end, and its neighbours'). Only its key
+    // takes the command's end.
+    schedule(id);
+    return;
+  }
   // A new course: predictions made against the old one are stale, and "just collided, cannot
   // meet again" no longer holds.
   ++b.count;
@@ -1576,7 +1598,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::remove(std::uint32_t i) {
   heap_.remove(i);
   if (is_turtle(i)) {
     busy_[i - nb_] = 0;
-    run_[i - nb_].t_end = kNever;
+    end_[i] = kNever;
     body_[i].v = {};
   }
 }
@@ -1599,9 +1621,9 @@ double Engine<Flight, kBallBall, kStep, kExtras>::rebase() {
     pending_[i].t_cross -= shift;
     if (inelastic_) last_time_[i] -= shift;
   }
-  for (TurtleRun& r : run_) {
-    r.t_start -= shift;
-    r.t_end -= shift;
+  for (std::size_t k = 0; k < run_.size(); ++k) {
+    run_[k].t_start -= shift;
+    end_[nb_ + k] -= shift;
   }
   for (Mover& m : movers_) m.t_ref -= shift;
   t_base_ += shift;
@@ -1636,7 +1658,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::begin_step() {
       heap_.remove(i);
       if (turtle) {
         busy_[i - nb_] = 0;
-        run_[i - nb_].t_end = kNever;
+        end_[i] = kNever;
         b.v = {};
       }
       continue;
@@ -1665,9 +1687,9 @@ void Engine<Flight, kBallBall, kStep, kExtras>::finish_step() {
   ++step_index_;
   ++stats_.steps;
   ++stats_.events;
-  for (TurtleRun& r : run_) {
-    r.t_start -= dt_;
-    r.t_end -= dt_;
+  for (std::size_t k = 0; k < run_.size(); ++k) {
+    run_[k].t_start -= dt_;
+    end_[nb_ + k] -= dt_;
   }
   for (Mover& m : movers_) m.t_ref -= dt_;
   if (inelastic_)

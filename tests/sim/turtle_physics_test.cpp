@@ -174,6 +174,82 @@ TEST_CASE("a ball bounces off a turtle, which stops dead at the touch", "[turtle
   }
 }
 
+TEST_CASE("a turtle turning or waiting at rest is still struck when its predictions say", "[turtle]") {
+  // Commands that leave a turtle standing still (turn, wait) keep the collisions already predicted
+  // with it rather than predicting again; these scenes fail if one is lost or left stale.
+  // A ball of radius 2 at x = 260 closes on the still turtle (radius 10, x = 200) at 30 units/s:
+  // contact after 48 units, at t = 1.6.
+  const Mode mode = GENERATE(Mode::exact, Mode::step);
+  INFO(name(mode));
+  {
+    WorldDef d = box(400, 400);
+    d.dt = 0.1;
+    d.turtles.push_back(turtle("t", {200, 200}, 0));  // turns at 90 degrees/s
+    d.balls.push_back(ball("b", {260, 200}, {-30, 0}, 2));
+    SECTION("struck after a turn and a wait from rest, when only the turtle foresaw it") {
+      // The ball falls along x = 185 at 10 units/s, missing the turtle where it starts (x = 200,
+      // 15 > 12 away) and while it drives to x = 185 (done at t = 0.5, the ball 55 above). So the
+      // ball foresees nothing; the turtle, stopping, predicts the contact itself: 43 units closed
+      // at 10, at t = 4.8. It then turns and waits; those commands must keep that prediction. (One
+      // cell spans the arena, so no cell crossing makes the ball look round again.)
+      d.arena.cell = 400;
+      d.turtles[0].heading = 270 * kDeg;  // towards -x
+      d.balls[0].pos = {185, 260};
+      d.balls[0].vel = {0, -10};
+      World w(d, mode);
+      w.command_turtle(0, move(15));  // 0.5 s at 30
+      w.advance_to(1.0);
+      CHECK_FALSE(w.turtle(0).busy);
+      CHECK(w.turtle(0).pos.x == Approx(185).epsilon(1e-14));
+      w.command_turtle(0, turn(45));  // 0.5 s
+      w.advance_to(2.0);
+      CHECK_FALSE(w.turtle(0).busy);
+      CHECK(w.turtle(0).heading == Approx(315 * kDeg).epsilon(1e-14));
+      w.command_turtle(0, {TurtleCommand::Kind::wait, 0.5});
+      w.advance_to(6.0);
+      CHECK(w.stats().turtle_ball == 1);
+      CHECK(w.ball(0).vel.y == Approx(10).epsilon(1e-12));
+      const auto c = w.take_turtle_contacts();
+      REQUIRE(c.size() == 1);
+      CHECK(c[0].t == Approx(4.8).epsilon(1e-12));
+      CHECK(w.turtle(0).pos.x == Approx(185).epsilon(1e-14));
+      CHECK_FALSE(w.turtle(0).touched);  // the wait had ended: nothing was cut short
+      CHECK(w.measure_overlap().relative <= 1e-9);
+    }
+    SECTION("struck in the middle of a turn, which the touch cuts short") {
+      World w(d, mode);
+      w.command_turtle(0, turn(90));
+      w.advance_to(1.3);
+      w.command_turtle(0, turn(-90));  // from 90 degrees back towards 0; struck 0.3 s in
+      w.advance_to(3.0);
+      const TurtleState s = w.turtle(0);
+      CHECK(s.touched);
+      CHECK_FALSE(s.busy);
+      CHECK(s.done == Approx(27 * kDeg).epsilon(1e-12));
+      CHECK(s.heading == Approx(63 * kDeg).epsilon(1e-12));
+      CHECK(w.stats().turtle_ball == 1);
+      CHECK(w.take_turtle_contacts().at(0).t == Approx(1.6).epsilon(1e-12));
+    }
+    SECTION("a turtle that set off towards the still one, then stopped, does not reach it") {
+      // The second turtle's stop changes its course after the still turtle's last prediction:
+      // that prediction is stale and must not fire.
+      WorldDef e = box(400, 400);
+      e.dt = 0.1;
+      e.turtles.push_back(turtle("still", {200, 200}, 0));
+      e.turtles.push_back(turtle("mover", {100, 200}, 90));  // towards +x at 30: contact at 80 units
+      World w(e, mode);
+      w.command_turtle(1, move(60));  // stops 20 short of contact, at t = 2
+      w.command_turtle(0, turn(45));
+      w.advance_to(0.5);
+      w.command_turtle(0, turn(45));
+      w.advance_to(4.0);
+      CHECK(w.stats().turtle_turtle == 0);
+      CHECK(w.turtle(1).pos.x == Approx(160).epsilon(1e-14));
+      CHECK(w.turtle(0).heading == Approx(M_PI / 2).epsilon(1e-14));
+    }
+  }
+}
+
 TEST_CASE("a turtle with bounce set rebounds and coasts to the next control step", "[turtle]") {
   WorldDef d = box(400, 200);
   d.dt = 0.1;
