@@ -147,10 +147,14 @@ class alignas(64) Agent {
   std::optional<sim::TurtleCommand> command;  // issued by the program, taken by the scheduler
   bool started = false;
   bool finished = false;
+  bool waiting = false;    // suspended in issue(), for finish_command() to answer
+  bool lays_wall = false;  // the command waited on lays a wall (the pen in wall mode, a move)
+  sim::TurtleCommand::Kind waiting_on = sim::TurtleCommand::Kind::stop;
   bool pen_down = false;
   bool it = false;                            // the game's role, as Turtle::it() reports it
   PenMode pen_mode = PenMode::line;
   double odometer = 0.0;
+  Result answer;                              // finish_command()'s, taken by issue() on resuming
   std::vector<Touch> inbox;                   // touches to deliver when the program resumes
   std::vector<Message> messages;              // messages to deliver when the program resumes
   std::function<void(const Touch&)> handler;
@@ -167,8 +171,12 @@ class alignas(64) Agent {
   std::vector<std::string> sensor_names;      // what Touch::sensor_names points to
   std::size_t walls_laid = 0;                 // k of the next `<id>-w<k>`
   std::string fault;
+  sim::Vec2 stroke_start;                     // where the wall pen's stroke began
 
   Result issue(sim::TurtleCommand c);
+  /// The touch and message handlers, on the program's stack (they may issue commands).
+  [[gnu::noinline]] void deliver();
+  [[noreturn, gnu::noinline, gnu::cold]] void not_own_program() const;
   Touch make_touch(const sim::TurtleContact& c) const;
   /// Cache hint: the hot lines above (everything up to and including the generator's index).
   void prefetch() const {
@@ -205,6 +213,7 @@ class WorldServer::Impl : public GameHost {
   double boundary_time(std::uint64_t k) const { return static_cast<double>(k) * def.dt; }
   void control_step();
   void run_program(Agent& a);
+  void finish_command(Agent& a);
   void drain_sim_events();
   void lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to);
   bool id_taken(const std::string& id) const;
@@ -255,25 +264,36 @@ Touch Agent::make_touch(const sim::TurtleContact& c) const {
   return t;
 }
 
+void Agent::not_own_program() const {
+  throw std::logic_error("turtle '" + id + "': commands must be issued from its own program");
+}
+
+// A command's whole round trip on the program's stack is kept shallow: every line of stack the
+// program touches between two commands is a cache miss at each resume once there are thousands of
+// turtles. So the scheduler does the bookkeeping of a finished command on its own (warm) stack
+// before resuming (WorldServer::Impl::finish_command), and this side only hands the answer back,
+// running the handlers out of line when there is something for them.
 Result Agent::issue(sim::TurtleCommand c) {
-  if (!fiber || detail::Fiber::current() != &*fiber)
-    throw std::logic_error("turtle '" + id + "': commands must be issued from its own program");
+  if (!fiber || detail::Fiber::current() != &*fiber) [[unlikely]] not_own_program();
   command = c;
+  waiting_on = c.kind;
+  waiting = true;
   // The wall pen lays the stroke this command drives, in the pen mode it was issued in.
-  const bool lays_wall = pen_down && pen_mode == PenMode::wall && c.kind == sim::TurtleCommand::Kind::move;
-  const sim::Vec2 start = lays_wall ? server->world.turtle(index).pos : sim::Vec2{};
+  lays_wall = pen_down && pen_mode == PenMode::wall && c.kind == sim::TurtleCommand::Kind::move;
+  if (lays_wall) stroke_start = server->world.turtle(index).pos;
   fiber->suspend();
-  // Resumed by the scheduler: the command has ended. Interrupts first, then the answer.
-  const sim::TurtleState s = server->world.turtle(index);
-  std::optional<Touch> cut;
+  // Resumed by the scheduler: the command has ended. The answer is taken first, since a handler's
+  // own command leaves the next one; then interrupts, then messages.
+  Result r = std::move(answer);
+  if (!inbox.empty() || !messages.empty()) [[unlikely]] deliver();
+  return r;
+}
+
+void Agent::deliver() {
   std::vector<Touch> delivered;
   delivered.swap(inbox);
-  if (c.kind == sim::TurtleCommand::Kind::move) odometer += s.done;
-  if (pen_down) trail.push_back(s.pos);
-  if (lays_wall && s.pos != start) server->lay_wall(*this, start, s.pos);
   if (handler)
     for (const Touch& t : delivered) handler(t);
-  if (s.touched && !delivered.empty()) cut = std::move(delivered.front());
   // Hand the buffer back for the next touches (unless a handler's own command refilled the inbox).
   delivered.clear();
   if (inbox.empty()) inbox.swap(delivered);
@@ -281,8 +301,18 @@ Result Agent::issue(sim::TurtleCommand c) {
   letters.swap(messages);
   if (message_handler)
     for (const Message& m : letters) message_handler(m);
-  const double done = c.kind == sim::TurtleCommand::Kind::turn ? s.done / kDeg : s.done;
-  return Result(done, std::move(cut));
+}
+
+void WorldServer::Impl::finish_command(Agent& a) {
+  // The end of the command the program waits on, worked out before it resumes (see issue()).
+  a.waiting = false;
+  const sim::TurtleState s = world.turtle(a.index);
+  if (a.waiting_on == sim::TurtleCommand::Kind::move) a.odometer += s.done;
+  if (a.pen_down) a.trail.push_back(s.pos);
+  if (a.lays_wall && s.pos != a.stroke_start) lay_wall(a, a.stroke_start, s.pos);
+  const double done = a.waiting_on == sim::TurtleCommand::Kind::turn ? s.done / kDeg : s.done;
+  // A touch that cut the command short is the first of those delivered on resuming.
+  a.answer = s.touched && !a.inbox.empty() ? Result(done, a.inbox.front()) : Result(done, std::nullopt);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -458,6 +488,7 @@ void WorldServer::Impl::run_program(Agent& a) {
         },
         options.stack_bytes);
   }
+  if (a.waiting) finish_command(a);
   const auto outcome = a.fiber->resume(options.program_budget);
   const double now = world.time();
   auto park = [&](const std::string& fault) {

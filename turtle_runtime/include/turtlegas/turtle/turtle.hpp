@@ -22,6 +22,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -78,17 +79,20 @@ struct Touch {
 class Result {
  public:
   Result() = default;
-  Result(double done, std::optional<Touch> touch) : done_(done), touch_(std::move(touch)) {}
+  Result(double done, std::optional<Touch> touch)
+      : done_(done), touch_(touch ? std::make_shared<const Touch>(std::move(*touch)) : nullptr) {}
   /// Distance driven (units), angle turned (degrees) or time waited (s), always >= 0.
   double done() const { return done_; }
   /// Whether a touch cut the command short.
-  bool touched() const { return touch_.has_value(); }
+  bool touched() const { return touch_ != nullptr; }
   /// The touch that cut it short; only when touched().
   const Touch& touch() const { return *touch_; }
 
  private:
   double done_ = 0.0;
-  std::optional<Touch> touch_;
+  // Shared and immutable: a Result is 24 bytes, small in the controller's frame (a program's
+  // frames are its stack's hot lines, fetched again at every resume), and copies cheaply.
+  std::shared_ptr<const Touch> touch_;
 };
 
 /// A message to a program from the world (a game's referee, say): delivered when the program
