@@ -119,6 +119,38 @@ TEST_CASE("a touch cuts a command short, fires the right sensor, arrives on the 
   CHECK(saw_touch);
 }
 
+TEST_CASE("a touch handler's own command does not change the answer of the command it interrupted", "[runtime]") {
+  // The handler backs off (a command of its own, suspending the program inside the handler);
+  // the forward it interrupted still answers with its own distance and touch.
+  sim::WorldDef d = arena();
+  d.walls.push_back({"w", {202, 0}, {202, 400}});
+  d.turtles.push_back(body("t1", {100, 100}, 90));  // facing the wall at x = 202
+  Registry r = base_registry();
+  struct Seen {
+    Result moved, backed;
+    int handled = 0;
+  };
+  static Seen seen;
+  seen = {};
+  r.add("recoil", [](Turtle& t, const Params&) {
+    t.on_touch([&](const Touch&) {
+      ++seen.handled;
+      seen.backed = t.back(10);
+    });
+    seen.moved = t.forward(500);
+  });
+  WorldServer s(d, {program("recoil")}, r);
+  s.run_until(5.0);
+  CHECK(seen.handled == 1);
+  CHECK(seen.backed.done() == Approx(10));
+  CHECK_FALSE(seen.backed.touched());
+  REQUIRE(seen.moved.touched());
+  CHECK(seen.moved.done() == Approx(92));
+  CHECK(seen.moved.touch().front());
+  CHECK(seen.moved.touch().what == "w");
+  CHECK(s.turtle(0).state.pos.x == Approx(182));
+}
+
 TEST_CASE("sensors follow the heading: a wall touched in front is on the left after a right turn", "[runtime]") {
   sim::WorldDef d = arena();
   d.walls.push_back({"w", {50, 0}, {50, 400}});
