@@ -256,6 +256,17 @@ class Engine final : public EngineBase {
     for (std::uint32_t k = 0; k < run_.size(); ++k)
       if (busy_[k] == 0) out.push_back(k);
   }
+  void prefetch_turtle(std::size_t k) const override {
+    // What turtle(k) and command_turtle(k) read first: the turtle's record (two lines) and its
+    // command state (which may straddle two).
+    if (k >= run_.size()) return;
+    const char* rec = reinterpret_cast<const char*>(&body_[nb_ + k]);
+    __builtin_prefetch(rec);
+    __builtin_prefetch(rec + 64);
+    const char* run = reinterpret_cast<const char*>(&run_[k]);
+    __builtin_prefetch(run);
+    __builtin_prefetch(run + sizeof(TurtleRun) - 1);
+  }
   void command_turtle(std::size_t k, const TurtleCommand& command) override;
   std::size_t add_wall(const WallDef& wall) override;
   std::vector<TurtleContact> take_turtle_contacts() override {

@@ -28,6 +28,7 @@ class EngineBase {
   virtual TurtleState turtle(std::size_t i) const = 0;
   virtual double turtle_radius(std::size_t i) const = 0;
   virtual void idle_turtles(std::vector<std::uint32_t>& out) const = 0;
+  virtual void prefetch_turtle(std::size_t i) const = 0;
   virtual void command_turtle(std::size_t i, const TurtleCommand& command) = 0;
   virtual std::vector<TurtleContact> take_turtle_contacts() = 0;
   virtual std::size_t add_wall(const WallDef& wall) = 0;

@@ -40,6 +40,7 @@ std::size_t World::turtle_count() const { return impl_->engine->turtle_count(); 
 TurtleState World::turtle(std::size_t i) const { return impl_->engine->turtle(i); }
 double World::turtle_radius(std::size_t i) const { return impl_->engine->turtle_radius(i); }
 void World::idle_turtles(std::vector<std::uint32_t>& out) const { impl_->engine->idle_turtles(out); }
+void World::prefetch_turtle(std::size_t i) const { impl_->engine->prefetch_turtle(i); }
 void World::command_turtle(std::size_t i, const TurtleCommand& command) { impl_->engine->command_turtle(i, command); }
 std::vector<TurtleContact> World::take_turtle_contacts() { return impl_->engine->take_turtle_contacts(); }
 double World::energy() const { return impl_->engine->energy(); }

@@ -20,6 +20,11 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 double wrap_degrees(double a) {
+  // Within two turns either way (bearings, arcs), one or two exact steps of 360 give fmod's
+  // answer bit for bit (the differences are exact by Sterbenz's lemma); fmod only beyond.
+  if (a >= 0.0 && a < 360.0) return a;
+  if (a >= 360.0 && a < 720.0) return a - 360.0;
+  if (a < 0.0 && a > -360.0) return a + 360.0;
   a = std::fmod(a, 360.0);
   return a < 0 ? a + 360.0 : a;
 }
@@ -577,6 +582,7 @@ void WorldServer::Impl::control_step() {
     if (k + 2 < n) {
       const Agent& b = *agents[idle[k + 2]];
       if (b.fiber) b.fiber->prefetch_record();
+      world.prefetch_turtle(idle[k + 2]);  // for finish_command() and the command that follows
     }
     if (k + 1 < n) {
       const Agent& b = *agents[idle[k + 1]];

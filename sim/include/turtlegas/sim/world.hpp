@@ -128,6 +128,9 @@ class World {
   /// Appends to *out, in increasing order, the turtles whose command is not running (those whose
   /// TurtleState::busy is false): one pass over compact state, for schedulers with many turtles.
   void idle_turtles(std::vector<std::uint32_t>& out) const;
+  /// A cache hint, no effect on the simulation: asks for the state turtle(i) and
+  /// command_turtle(i) read first. For schedulers resuming many turtles' programs in turn.
+  void prefetch_turtle(std::size_t i) const;
   /// Starts a command for turtle i at the current time, replacing whatever it was doing.
   void command_turtle(std::size_t i, const TurtleCommand& command);
   /// Contacts involving turtles since the last call, in time order.
