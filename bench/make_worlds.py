@@ -1,10 +1,15 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
-"""Writes the benchmark scenes worlds/bench/gas_N<n>_phi<f>.json.
+"""Writes the benchmark scenes worlds/bench/gas_N<n>_phi<f>.json, and effects_<name>.json.
 
 A random gas in a square box with four walls: N discs of radius 0.5, mass 1 and speed 3 in random
 directions, at area fraction phi, so the box side is sqrt(N * pi * r^2 / phi). The files are data
 shared with other engines' benchmarks; rerun this script only to change the scene set.
+
+The effects_*.json scenes are the N = 10^4, phi = 0.05 gas with one effect switched on at a
+strength that changes nothing measurable (gravity of 1e-12, one wall in a category of its own
+that every ball still collides with), so that the engine runs its general code for that effect:
+bench/run_effects.sh measures what the plain scene saves by not declaring it.
 
     python3 bench/make_worlds.py [OUT_DIR]
 """
@@ -49,21 +54,49 @@ def scene(count: int, phi: float) -> dict:
     }
 
 
+# One collision layer, declared by a short wall on the left edge that is in a category of its own.
+TAGGED_WALL = {"id": "tagged", "from": [0, 0], "to": [0, 1], "category": "tagged"}
+EFFECTS = [
+    ("plain", {}, []),
+    ("gravity", {"gravity": [0, -1e-12]}, []),
+    ("layers", {}, [TAGGED_WALL]),
+    ("gravity_layers", {"gravity": [0, -1e-12]}, [TAGGED_WALL]),
+]
+
+
+def effects_scene(name: str, effects: dict, walls: list) -> dict:
+    s = scene(10_000, 0.05)
+    s["name"] = f"effects benchmark: {name}"
+    s["x-about"] = (
+        "The N=10000 phi=0.05 gas benchmark with effects declared that change nothing measurable "
+        f"({name}). Written by bench/make_worlds.py; run by bench/run_effects.sh (docs/performance.md)."
+    )
+    if effects:
+        s["effects"] = effects
+    if walls:
+        s["walls"] = walls
+    return s
+
+
+def write(path: pathlib.Path, world: dict) -> None:
+    # repr-exact doubles: the side must give exactly this phi in every engine that reads it.
+    text = json.dumps(world, indent=2)
+    # Number pairs on one line: [[0, 0], [side, side]] reads better than eight lines.
+    text = re.sub(r"\[\s*([-\d.e+]+),\s*([-\d.e+]+)\s*\]", r"[\1, \2]", text)
+    text = re.sub(r"\[\s*(\[[^\[\]]*\]),\s*(\[[^\[\]]*\])\s*\]", r"[\1, \2]", text)
+    path.write_text(text + "\n")
+    print(path)
+
+
 def main() -> None:
     root = pathlib.Path(__file__).resolve().parent.parent
     out = pathlib.Path(sys.argv[1]) if len(sys.argv) > 1 else root / "worlds" / "bench"
     out.mkdir(parents=True, exist_ok=True)
     for count_name, count in COUNTS:
         for phi_name, phi in FRACTIONS:
-            path = out / f"gas_N{count_name}_phi{phi_name}.json"
-            # repr-exact doubles: the side must give exactly this phi in every engine that reads it.
-            text = json.dumps(scene(count, phi), indent=2)
-            # Number pairs on one line: [[0, 0], [side, side]] reads better than eight lines.
-            text = re.sub(r"\[\s*([-\d.e+]+),\s*([-\d.e+]+)\s*\]", r"[\1, \2]", text)
-            text = re.sub(r"\[\s*(\[[^\[\]]*\]),\s*(\[[^\[\]]*\])\s*\]", r"[\1, \2]", text)
-            path.write_text(text + "\n")
-            print(path)
-
+            write(out / f"gas_N{count_name}_phi{phi_name}.json", scene(count, phi))
+    for name, effects, walls in EFFECTS:
+        write(out / f"effects_{name}.json", effects_scene(name, effects, walls))
 
 if __name__ == "__main__":
     main()
