@@ -20,10 +20,11 @@
 // few milliseconds is not measured once against the clock's and the scheduler's granularity.
 // Progress goes to stderr.
 //
-// Every line has scene, world, N, mode, dt (null in exact mode), sim_seconds, cpu_seconds,
-// wall_seconds, repeats, cpu_per_sim_second (the cost), collisions, ball_ball, ball_wall, events,
-// steps, max_contact_overlap, energy_start, energy_end and energy_error = |E(T) - E(0)| / |E(0)|
-// (World::energy(): kinetic plus potential, zero at y = 0). Ballistic lines add
+// Every line has scene, world (its name), world_file, N, mode, dt (null in exact mode),
+// sim_seconds, cpu_seconds, wall_seconds, repeats, cpu_per_sim_second (the cost), collisions,
+// ball_ball, ball_wall, events, steps, max_contact_overlap, energy_start, energy_end and
+// energy_error = |E(T) - E(0)| / |E(0)| (World::energy(): kinetic plus potential, zero at y = 0).
+// Ballistic lines add
 // max_position_error and rms_position_error (units) and rms_ball_energy_error (each ball's own
 // relative energy error, RMS over the balls); gas lines add the signed energy_drift.
 #include <algorithm>
@@ -144,12 +145,14 @@ Run run(const sim::WorldDef& def, sim::Mode mode, double until, double min_cpu) 
 const char* mode_name(sim::Mode mode) { return mode == sim::Mode::exact ? "exact" : "step"; }
 
 /// The fields every line has: what ran and what it cost.
-nlohmann::ordered_json common(std::string_view scene, const sim::WorldDef& def, sim::Mode mode, const Run& r) {
+nlohmann::ordered_json common(std::string_view scene, const std::filesystem::path& file, const sim::WorldDef& def,
+                              sim::Mode mode, const Run& r) {
   const sim::World& w = *r.world;
   const sim::Stats& s = w.stats();
   nlohmann::ordered_json out;
   out["scene"] = scene;
   out["world"] = def.name;
+  out["world_file"] = file.generic_string();
   out["N"] = def.balls.size();
   out["mode"] = mode_name(mode);
   out["dt"] = mode == sim::Mode::step ? nlohmann::json(def.dt) : nlohmann::json(nullptr);
@@ -175,7 +178,8 @@ double ball_energy(double mass, sim::Vec2 g, sim::Vec2 pos, sim::Vec2 vel) {
 /// Ballistic scene: position and energy error against the closed form, at the world's end time.
 /// Besides the total energy, each ball's own energy error: the total sums errors of both signs
 /// over the balls (see docs/performance.md), each ball's is what its trajectory feels.
-nlohmann::ordered_json ballistic_line(const sim::WorldDef& def, sim::Mode mode, const Run& r, double energy0) {
+nlohmann::ordered_json ballistic_line(const std::filesystem::path& file, const sim::WorldDef& def, sim::Mode mode,
+                                      const Run& r, double energy0) {
   const sim::World& w = *r.world;
   const sim::Vec2 g = def.effects.gravity;
   const double t = w.time();
@@ -192,7 +196,7 @@ nlohmann::ordered_json ballistic_line(const sim::WorldDef& def, sim::Mode mode, 
     const double de = (ball_energy(b.mass, g, got.pos, got.vel) - e0) / e0;
     ball_energy2 += de * de;
   }
-  nlohmann::ordered_json out = common("ballistic", def, mode, r);
+  nlohmann::ordered_json out = common("ballistic", file, def, mode, r);
   out["max_position_error"] = max_err;
   out["rms_position_error"] = std::sqrt(sum2 / n);
   out["rms_ball_energy_error"] = std::sqrt(ball_energy2 / n);
@@ -203,9 +207,10 @@ nlohmann::ordered_json ballistic_line(const sim::WorldDef& def, sim::Mode mode, 
 }
 
 /// Gas scene: no trajectory reference (chaos); energy and collision counts only.
-nlohmann::ordered_json gas_line(const sim::WorldDef& def, sim::Mode mode, const Run& r, double energy0) {
+nlohmann::ordered_json gas_line(const std::filesystem::path& file, const sim::WorldDef& def, sim::Mode mode,
+                                const Run& r, double energy0) {
   const sim::World& w = *r.world;
-  nlohmann::ordered_json out = common("gas", def, mode, r);
+  nlohmann::ordered_json out = common("gas", file, def, mode, r);
   out["energy_start"] = energy0;
   out["energy_end"] = w.energy();
   out["energy_drift"] = (w.energy() - energy0) / std::abs(energy0);
@@ -228,8 +233,8 @@ void run_scene(std::string_view scene, const std::filesystem::path& file, const 
   }
   const double energy0 = sim::World(def, sim::Mode::exact).energy();
   auto emit = [&](sim::Mode mode, const Run& r) {
-    const nlohmann::ordered_json line = scene == "ballistic" ? ballistic_line(def, mode, r, energy0)
-                                                             : gas_line(def, mode, r, energy0);
+    const nlohmann::ordered_json line = scene == "ballistic" ? ballistic_line(file, def, mode, r, energy0)
+                                                             : gas_line(file, def, mode, r, energy0);
     std::cout << line.dump() << std::endl;
     std::cerr << scene << ' ' << mode_name(mode);
     if (mode == sim::Mode::step) std::cerr << " dt=1/" << std::lround(1.0 / def.dt);

@@ -17,6 +17,7 @@ import pathlib
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.dont_write_bytecode = True  # no __pycache__ in bench/: machine_json.sh counts files there as changes
 import make_tables  # noqa: E402  (the sibling script: table, machine and splice helpers)
 
 BEGIN = "<!-- BEGIN GENERATED: bench/make_accuracy.py -->"
