@@ -24,9 +24,9 @@
 // sim_seconds, cpu_seconds, wall_seconds, repeats, cpu_per_sim_second (the cost), collisions,
 // ball_ball, ball_wall, events, steps, max_contact_overlap, energy_start, energy_end and
 // energy_error = |E(T) - E(0)| / |E(0)| (World::energy(): kinetic plus potential, zero at y = 0).
-// Ballistic lines add
-// max_position_error and rms_position_error (units) and rms_ball_energy_error (each ball's own
-// relative energy error, RMS over the balls); gas lines add the signed energy_drift.
+// Ballistic lines add max_position_error and rms_position_error (units) and rms_ball_energy_error
+// (each ball's own relative energy error, RMS over the balls); gas lines add the signed
+// energy_drift.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
