@@ -16,8 +16,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <ctime>
-#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -34,6 +32,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_common.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/sim/world_def.hpp"
 #include "turtlegas/world/world_file.hpp"
@@ -41,18 +40,11 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using turtlegas::bench::thread_cpu_seconds;
 namespace sim = turtlegas::sim;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-/// CPU time of this thread, seconds. Next to the wall time it shows whether other processes took
-/// the core during a measurement (cpu / wall well below 1).
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 /// A field of /proc/self/status in bytes (VmRSS, VmHWM), or 0 where there is no /proc.
@@ -112,16 +104,9 @@ struct Options {
 }
 
 double positive_number(std::string_view option, const std::string& text) {
-  std::size_t used = 0;
-  double x = 0.0;
-  try {
-    x = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || !(x > 0.0) || !std::isfinite(x))
-    usage_error(std::string(option) + " needs a positive number, got '" + text + "'");
-  return x;
+  const std::optional<double> x = turtlegas::bench::positive_number(text);
+  if (!x) usage_error(std::string(option) + " needs a positive number, got '" + text + "'");
+  return *x;
 }
 
 Options parse_options(int argc, char** argv) {
@@ -347,17 +332,4 @@ int run_main(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run_main(argc, argv);
-  } catch (const turtlegas::world::WorldFileError& e) {
-    std::cerr << "gas_bench: " << e.what() << '\n';
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "gas_bench: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "gas_bench: " << e.what() << '\n';
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return turtlegas::bench::run_with_exit_codes("gas_bench", run_main, argc, argv); }

@@ -259,14 +259,19 @@ def main():
     if not args.doc:
         sys.stdout.write(text)
         return
-    doc = pathlib.Path(args.doc)
+    splice(args.doc, BEGIN, END, text)
+
+
+def splice(doc_path, begin, end, text):
+    """Replaces what lies between the begin and end markers of the doc with text."""
+    doc = pathlib.Path(doc_path)
     old = doc.read_text() if doc.exists() else ""
-    if BEGIN in old and END in old:
-        head, rest = old.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
-        doc.write_text(head + BEGIN + "\n" + text + END + tail)
+    if begin in old and end in old:
+        head, rest = old.split(begin, 1)
+        _, tail = rest.split(end, 1)
+        doc.write_text(head + begin + "\n" + text + end + tail)
     else:
-        sys.exit(f"{doc}: no '{BEGIN}' ... '{END}' markers; add them where the tables belong")
+        sys.exit(f"{doc}: no '{begin}' ... '{end}' markers; add them where the tables belong")
 
 
 if __name__ == "__main__":

@@ -38,19 +38,7 @@ machine=$out_dir/results-$stamp-$host-$commit.machine.json
 tmp=$(mktemp)
 trap 'rm -f "$tmp"' EXIT
 
-compiler=$(grep '^CMAKE_CXX_COMPILER:' "$build/CMakeCache.txt" | cut -d= -f2)
-flags=$(grep '^CMAKE_CXX_FLAGS_RELEASE:' "$build/CMakeCache.txt" | cut -d= -f2)
-dirty=$( (git -C "$root" status --porcelain -- sim turtle_runtime bench 2>/dev/null || true) | wc -l)
-CPU=$(lscpu | sed -n 's/^Model name: *//p' | head -1) \
-CORES=$(nproc) \
-COMPILER=$("$compiler" --version | head -1) \
-FLAGS="Release ($flags -ffp-contract=off)" \
-KERNEL=$(uname -sr) \
-COMMIT="$commit$( (( dirty )) && echo " + uncommitted changes in $dirty files of sim/, turtle_runtime/, bench/")" \
-DATE=$(date -u '+%Y-%m-%d %H:%M') \
-LOADAVG=$(cut -d' ' -f1-3 /proc/loadavg) \
-python3 -c 'import json, os; print(json.dumps({k.lower(): os.environ[k] for k in
-  ["CPU", "CORES", "COMPILER", "FLAGS", "KERNEL", "COMMIT", "DATE", "LOADAVG"]}, indent=2))' > "$machine"
+bash "$root/bench/machine_json.sh" "$build" > "$machine"
 
 # One line per run on stderr while the set runs.
 progress='import json, sys

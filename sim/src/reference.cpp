@@ -255,4 +255,36 @@ std::vector<Event> events(const WorldDef& def, double t_end, std::vector<BallSta
   return out;
 }
 
+BallState ballistic(const BallDef& ball, const ArenaDef& arena, double g, double t) {
+  const double r = ball.radius;
+  const Vec2 x0 = ball.pos;
+  const Vec2 v0 = ball.vel;
+  const double h = x0.y - r;  // height of the centre above its floor contact
+  if (!(g > 0.0)) throw std::invalid_argument("ballistic: g must be > 0");
+  if (!(x0.x >= r && x0.x <= arena.width - r && h >= 0.0 && x0.y <= arena.height - r))
+    throw std::invalid_argument("ballistic: the ball must start inside the arena, at least a radius from each edge");
+  // Speed at the floor, the same at every bounce (elastic).
+  const double impact = std::sqrt(v0.y * v0.y + 2.0 * g * h);
+  if (!(impact > 0.0)) throw std::invalid_argument("ballistic: a ball at rest on the floor has no bouncing trajectory");
+  if (!(r + impact * impact / (2.0 * g) < arena.height - r))
+    throw std::invalid_argument("ballistic: the ball's apex reaches the ceiling; lower it or slow it down");
+
+  // x: the free line unfolded into a circle of circumference 2L; the second half runs back.
+  const double span = arena.width - 2.0 * r;
+  double u = std::fmod((x0.x - r) + v0.x * t, 2.0 * span);
+  if (u < 0.0) u += 2.0 * span;
+  const bool back = u > span;
+  const double x = r + (back ? 2.0 * span - u : u);
+  const double vx = back ? -v0.x : v0.x;
+
+  // y: the first landing is the larger root of h + v0.y s - g s^2 / 2 = 0; for a ball thrown down
+  // it is written as 2h / (impact - v0.y), whose terms add, so a ball just above the floor keeps
+  // its digits. After it every flight is the same parabola, of period 2 impact / g.
+  const double land = v0.y > 0.0 ? (v0.y + impact) / g : 2.0 * h / (impact - v0.y);
+  if (t < land) return {{x, x0.y + t * (v0.y - 0.5 * g * t)}, {vx, v0.y - g * t}, true};
+  const double period = 2.0 * impact / g;
+  const double s = std::fmod(t - land, period);
+  return {{x, r + s * (impact - 0.5 * g * s)}, {vx, impact - g * s}, true};
+}
+
 }  // namespace turtlegas::sim::reference

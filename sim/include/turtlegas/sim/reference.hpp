@@ -42,4 +42,13 @@ Overlap overlap(const std::vector<Vec2>& pos, const std::vector<double>& radius,
 /// Boundaries `none` and `walls` only. Returns the events and leaves final states in *final.
 std::vector<Event> events(const WorldDef& def, double t_end, std::vector<BallState>* final = nullptr);
 
+/// Where a ball is at time t (seconds) when it flies alone (no other ball, no wall but the arena's)
+/// in an arena with `Boundary::walls`, elastic, under gravity (0, -g), g > 0 in units/s^2: x
+/// reflects between the side walls (the line x0 + vx t folded into [r, width - r]), y is a
+/// parabola bouncing on the floor y = r. The closed form that step mode's error is measured
+/// against. Throws std::invalid_argument unless g > 0, the ball starts inside [r, width - r] x
+/// [r, height - r], is not at rest on the floor (the engine models resting by hops of t_c, see
+/// docs/physics.md) and its apex stays below the ceiling's contact height - r.
+BallState ballistic(const BallDef& ball, const ArenaDef& arena, double g, double t);
+
 }  // namespace turtlegas::sim::reference

@@ -1,0 +1,263 @@
+// SPDX-License-Identifier: MIT
+//
+// accuracy_bench: what accuracy costs. Runs two scenes in exact mode and in step mode at a ladder
+// of dt, and prints one JSON line per run: the error against a reference beside the CPU time per
+// simulated second.
+//
+//   accuracy_bench [--ballistic WORLD.json] [--gas WORLD.json] [--until T] [--dts 10,30,...]
+//                  [--min-cpu SECONDS]
+//
+// - ballistic (default worlds/bench/accuracy_ballistic.json): balls that do not meet each other,
+//   under gravity, in a box with walls; each ball's trajectory is known in closed form
+//   (sim::reference::ballistic), so the errors are the position error against it (max and RMS
+//   over balls) and the relative energy error.
+// - gas (default worlds/gas_gravity.json): the memo's gas under gravity, interacting and chaotic,
+//   so no trajectory reference: the relative energy error and the number of collisions.
+// Each scene runs for T simulated seconds (default 20) in exact mode and in step mode with
+// dt = 1/n for each n of --dts (default 10,30,100,300,1000,3000). Only advance_to is timed, by
+// thread CPU time; a run is repeated (same bits: the engine is deterministic) until its CPU time
+// adds up to --min-cpu (default 1 s, at most 20 runs) and the fastest is kept, so that a run of a
+// few milliseconds is not measured once against the clock's and the scheduler's granularity.
+// Progress goes to stderr.
+//
+// Every line has scene, world (its name), world_file, N, mode, dt (null in exact mode),
+// sim_seconds, cpu_seconds, wall_seconds, repeats, cpu_per_sim_second (the cost), collisions,
+// ball_ball, ball_wall, events, steps, max_contact_overlap, energy_start, energy_end and
+// energy_error = |E(T) - E(0)| / |E(0)| (World::energy(): kinetic plus potential, zero at y = 0).
+// Ballistic lines add max_position_error and rms_position_error (units) and rms_ball_energy_error
+// (each ball's own relative energy error, RMS over the balls); gas lines add the signed
+// energy_drift.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench_common.hpp"
+#include "turtlegas/sim/reference.hpp"
+#include "turtlegas/sim/world.hpp"
+#include "turtlegas/sim/world_def.hpp"
+#include "turtlegas/world/world_file.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using turtlegas::bench::thread_cpu_seconds;
+namespace sim = turtlegas::sim;
+
+struct Options {
+  std::filesystem::path ballistic = "worlds/bench/accuracy_ballistic.json";
+  std::filesystem::path gas = "worlds/gas_gravity.json";
+  double until = 20.0;
+  std::vector<int> dts{10, 30, 100, 300, 1000, 3000};  ///< step mode runs dt = 1/n for each n
+  double min_cpu = 1.0;
+};
+
+[[noreturn]] void usage_error(const std::string& message) {
+  throw std::invalid_argument(message +
+                              "\nusage: accuracy_bench [--ballistic WORLD.json] [--gas WORLD.json] [--until T] "
+                              "[--dts 10,30,100,...] [--min-cpu SECONDS]");
+}
+
+double positive_number(std::string_view option, const std::string& text) {
+  const std::optional<double> x = turtlegas::bench::positive_number(text);
+  if (!x) usage_error(std::string(option) + " needs a positive number, got '" + text + "'");
+  return *x;
+}
+
+Options parse_options(int argc, char** argv) {
+  Options o;
+  for (int k = 1; k < argc; ++k) {
+    const std::string_view arg = argv[k];
+    auto value = [&]() -> std::string {
+      if (k + 1 >= argc) usage_error(std::string(arg) + " needs a value");
+      return argv[++k];
+    };
+    if (arg == "--ballistic") {
+      o.ballistic = value();
+    } else if (arg == "--gas") {
+      o.gas = value();
+    } else if (arg == "--until") {
+      o.until = positive_number(arg, value());
+    } else if (arg == "--min-cpu") {
+      o.min_cpu = positive_number(arg, value());
+    } else if (arg == "--dts") {
+      o.dts.clear();
+      std::stringstream list(value());
+      for (std::string item; std::getline(list, item, ',');) {
+        const double n = positive_number("--dts", item);
+        if (n != std::floor(n) || n > 1e7) usage_error("--dts takes whole numbers n up to 1e7 (dt = 1/n), got '" + item + "'");
+        o.dts.push_back(static_cast<int>(n));
+      }
+    } else if (arg == "-h" || arg == "--help") {
+      usage_error("accuracy_bench: accuracy against CPU time, exact and step mode");
+    } else {
+      usage_error("unknown argument '" + std::string(arg) + "'");
+    }
+  }
+  return o;
+}
+
+/// What one configuration did: the fastest of its repeats, and the world it left.
+struct Run {
+  double cpu = 0.0;   ///< thread CPU seconds inside advance_to, fastest repeat
+  double wall = 0.0;  ///< wall seconds of that repeat
+  int repeats = 0;
+  std::optional<sim::World> world;
+};
+
+/// Builds the scene in `mode` and runs it to `until`. Step mode stops a millionth of a step past the
+/// last boundary, so that the last step's kick has been applied however k dt rounds: the state is
+/// then the memo's x_k, v_k (both at t_k), not x_k with v_{k-1}.
+Run run(const sim::WorldDef& def, sim::Mode mode, double until, double min_cpu) {
+  Run best;
+  double total = 0.0;
+  const double end = mode == sim::Mode::exact ? until : (std::round(until / def.dt) + 1e-6) * def.dt;
+  while (best.repeats < 20 && (best.repeats == 0 || total < min_cpu)) {
+    sim::WorldDef copy = def;
+    sim::World world(std::move(copy), mode);
+    const double cpu_start = thread_cpu_seconds();
+    const auto start = Clock::now();
+    world.advance_to(end);
+    const double cpu = thread_cpu_seconds() - cpu_start;
+    const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+    total += cpu;
+    if (best.repeats == 0 || cpu < best.cpu) {
+      best.cpu = cpu;
+      best.wall = wall;
+      best.world.emplace(std::move(world));
+    }
+    ++best.repeats;
+  }
+  return best;
+}
+
+const char* mode_name(sim::Mode mode) { return mode == sim::Mode::exact ? "exact" : "step"; }
+
+/// The fields every line has: what ran and what it cost.
+nlohmann::ordered_json common(std::string_view scene, const std::filesystem::path& file, const sim::WorldDef& def,
+                              sim::Mode mode, const Run& r) {
+  const sim::World& w = *r.world;
+  const sim::Stats& s = w.stats();
+  nlohmann::ordered_json out;
+  out["scene"] = scene;
+  out["world"] = def.name;
+  out["world_file"] = file.generic_string();
+  out["N"] = def.balls.size();
+  out["mode"] = mode_name(mode);
+  out["dt"] = mode == sim::Mode::step ? nlohmann::json(def.dt) : nlohmann::json(nullptr);
+  out["sim_seconds"] = w.time();
+  out["cpu_seconds"] = r.cpu;
+  out["wall_seconds"] = r.wall;
+  out["repeats"] = r.repeats;
+  out["cpu_per_sim_second"] = r.cpu / w.time();
+  out["collisions"] = s.collisions();
+  out["ball_ball"] = s.ball_ball;
+  out["ball_wall"] = s.ball_wall + s.ball_wall_end;
+  out["events"] = s.events;
+  out["steps"] = s.steps;
+  out["max_contact_overlap"] = w.max_contact_overlap().relative;
+  return out;
+}
+
+/// A ball's kinetic plus potential energy, with the potential World::energy() uses (-m g.x).
+double ball_energy(double mass, sim::Vec2 g, sim::Vec2 pos, sim::Vec2 vel) {
+  return 0.5 * mass * sim::norm2(vel) - mass * sim::dot(g, pos);
+}
+
+/// Ballistic scene: position and energy error against the closed form, at the world's end time.
+/// Besides the total energy, each ball's own energy error: the total sums errors of both signs
+/// over the balls (see docs/performance.md), each ball's is what its trajectory feels.
+nlohmann::ordered_json ballistic_line(const std::filesystem::path& file, const sim::WorldDef& def, sim::Mode mode,
+                                      const Run& r, double energy0) {
+  const sim::World& w = *r.world;
+  const sim::Vec2 g = def.effects.gravity;
+  const double t = w.time();
+  const auto n = static_cast<double>(def.balls.size());
+  double max_err = 0.0, sum2 = 0.0, ball_energy2 = 0.0;
+  for (std::size_t i = 0; i < def.balls.size(); ++i) {
+    const sim::BallDef& b = def.balls[i];
+    const sim::BallState ref = sim::reference::ballistic(b, def.arena, -g.y, t);
+    const sim::BallState got = w.ball(i);
+    const double e = sim::norm(got.pos - ref.pos);
+    max_err = std::max(max_err, e);
+    sum2 += e * e;
+    const double e0 = ball_energy(b.mass, g, b.pos, b.vel);
+    const double de = (ball_energy(b.mass, g, got.pos, got.vel) - e0) / e0;
+    ball_energy2 += de * de;
+  }
+  nlohmann::ordered_json out = common("ballistic", file, def, mode, r);
+  out["max_position_error"] = max_err;
+  out["rms_position_error"] = std::sqrt(sum2 / n);
+  out["rms_ball_energy_error"] = std::sqrt(ball_energy2 / n);
+  out["energy_start"] = energy0;
+  out["energy_end"] = w.energy();
+  out["energy_error"] = std::abs(w.energy() - energy0) / std::abs(energy0);
+  return out;
+}
+
+/// Gas scene: no trajectory reference (chaos); energy and collision counts only.
+nlohmann::ordered_json gas_line(const std::filesystem::path& file, const sim::WorldDef& def, sim::Mode mode,
+                                const Run& r, double energy0) {
+  const sim::World& w = *r.world;
+  nlohmann::ordered_json out = common("gas", file, def, mode, r);
+  out["energy_start"] = energy0;
+  out["energy_end"] = w.energy();
+  out["energy_drift"] = (w.energy() - energy0) / std::abs(energy0);
+  out["energy_error"] = std::abs(w.energy() - energy0) / std::abs(energy0);
+  return out;
+}
+
+/// Every configuration of one scene: exact mode, then step mode from the largest dt down.
+void run_scene(std::string_view scene, const std::filesystem::path& file, const Options& opt) {
+  sim::WorldDef def = turtlegas::world::load_world_file(file);
+  if (def.name.empty()) def.name = file.stem().string();
+  if (scene == "ballistic") {
+    if (def.effects.ball_ball || def.effects.gravity.x != 0.0 || !(def.effects.gravity.y < 0.0) ||
+        def.effects.restitution != 1.0 || def.arena.boundary != sim::Boundary::walls || !def.walls.empty() ||
+        !def.turtles.empty())
+      throw std::invalid_argument(file.string() +
+                                  ": the ballistic scene needs ball_ball false, gravity [0, -g] with g > 0, "
+                                  "restitution 1, boundary walls and no walls or turtles of its own (its reference "
+                                  "is a ball alone in a box)");
+  }
+  const double energy0 = sim::World(def, sim::Mode::exact).energy();
+  auto emit = [&](sim::Mode mode, const Run& r) {
+    const nlohmann::ordered_json line = scene == "ballistic" ? ballistic_line(file, def, mode, r, energy0)
+                                                             : gas_line(file, def, mode, r, energy0);
+    std::cout << line.dump() << std::endl;
+    std::cerr << scene << ' ' << mode_name(mode);
+    if (mode == sim::Mode::step) std::cerr << " dt=1/" << std::lround(1.0 / def.dt);
+    std::cerr << ": " << r.cpu << " cpu s (" << r.repeats << " runs), energy error " << line["energy_error"].get<double>();
+    if (line.contains("max_position_error")) std::cerr << ", max position error " << line["max_position_error"].get<double>();
+    std::cerr << '\n';
+  };
+  emit(sim::Mode::exact, run(def, sim::Mode::exact, opt.until, opt.min_cpu));
+  for (int n : opt.dts) {
+    def.dt = 1.0 / n;
+    emit(sim::Mode::step, run(def, sim::Mode::step, opt.until, opt.min_cpu));
+  }
+}
+
+int run_main(int argc, char** argv) {
+  const Options opt = parse_options(argc, argv);
+  run_scene("ballistic", opt.ballistic, opt);
+  run_scene("gas", opt.gas, opt);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return turtlegas::bench::run_with_exit_codes("accuracy_bench", run_main, argc, argv);
+}

@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: MIT
+// What the world-file benchmark programs (gas_bench, accuracy_bench) share: the thread's CPU
+// clock, number options, and the project's exit codes.
+#pragma once
+
+#include <cmath>
+#include <ctime>
+#include <exception>
+#include <iostream>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "turtlegas/world/world_file.hpp"
+
+namespace turtlegas::bench {
+
+/// CPU time of this thread, seconds. Next to the wall time it shows whether other processes took
+/// the core during a measurement (cpu / wall well below 1).
+inline double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+/// The whole of `text` as a finite number > 0, or nothing (for the caller's usage message).
+inline std::optional<double> positive_number(const std::string& text) {
+  std::size_t used = 0;
+  double x = 0.0;
+  try {
+    x = std::stod(text, &used);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used != text.size() || !(x > 0.0) || !std::isfinite(x)) return std::nullopt;
+  return x;
+}
+
+/// Runs body(argc, argv) with the project's exit codes: its own result, 2 for a bad world file or
+/// bad arguments (WorldFileError, std::invalid_argument), 1 for anything else; the message goes to
+/// stderr after "PROGRAM: ".
+inline int run_with_exit_codes(std::string_view program, int (*body)(int, char**), int argc, char** argv) {
+  try {
+    return body(argc, argv);
+  } catch (const world::WorldFileError& e) {
+    std::cerr << program << ": " << e.what() << '\n';
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << program << ": " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << program << ": " << e.what() << '\n';
+    return 1;
+  }
+}
+
+}  // namespace turtlegas::bench
