@@ -255,6 +255,42 @@ TEST_CASE("without ball_ball, balls pass through each other", "[world][effects]"
   CHECK(w.ball(1).pos.x == Approx(30));
 }
 
+TEST_CASE("without ball_ball, exact mode sizes its cells by the walls, not by the number of balls", "[world][effects][grid]") {
+  // Balls that meet only walls gain nothing from a fine table: each crossing is an event that
+  // finds no partner. A box of side 400 has 1600 units of wall: cells of 400^2 / 1600 = 100.
+  auto scene = [](int n) {
+    WorldDef d = box(400, 400);
+    d.effects.ball_ball = false;
+    for (int k = 0; k < n; ++k)
+      d.balls.push_back(ball("b" + std::to_string(k), {6.0 + 12.0 * (k % 32), 6.0 + 12.0 * (k / 32)}, {7, 3}));
+    return d;
+  };
+  for (int n : {10, 1000}) {
+    World w(scene(n), Mode::exact);
+    CHECK(w.cell_size() == Approx(100));
+    CHECK(w.cells_x() == 4);
+  }
+  // Interior walls: 1600 of box plus 3 x 400 across it, so 400^2 / 2800.
+  WorldDef d = scene(100);
+  for (int k = 1; k <= 3; ++k) d.walls.push_back(WallDef{"w" + std::to_string(k), {100.0 * k, 0}, {100.0 * k, 400}});
+  d.balls.clear();
+  for (int k = 0; k < 100; ++k) d.balls.push_back(ball("b" + std::to_string(k), {50, 2.0 + 3.9 * k}, {7, 3}));
+  CHECK(World(d, Mode::exact).cell_size() == Approx(400.0 * 400.0 / 2800.0));
+  // Step mode keeps the finer table (it has no crossing events; fine cells keep walls away), and
+  // so does a scene whose balls meet each other.
+  CHECK(World(scene(1000), Mode::step).cell_size() < 20);
+  WorldDef gas = scene(1000);
+  gas.effects.ball_ball = true;
+  CHECK(World(gas, Mode::exact).cell_size() < 20);
+  // In 20 s each ball runs 140 along x and 60 along y: about 2 crossings of cells 100 wide, where
+  // the table sized for 0.3 balls a cell (6.9 wide) gave about 29.
+  World w(scene(1000), Mode::exact);
+  w.advance_to(20.0);
+  CHECK(w.stats().ball_wall > 200);
+  CHECK(w.stats().cell_crossings > 1000);
+  CHECK(w.stats().cell_crossings < 3000);
+}
+
 TEST_CASE("an open arena removes balls with an exit event at the crossing time", "[world][boundary]") {
   WorldDef d = box(100, 100, Boundary::none);
   d.balls.push_back(ball("a", {50, 50}, {10, 0}));
