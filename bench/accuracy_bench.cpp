@@ -63,24 +63,15 @@ struct Options {
   double min_cpu = 1.0;
 };
 
-[[noreturn]] void usage_error(const std::string& message) {
-  throw std::invalid_argument(message +
-                              "\nusage: accuracy_bench [--ballistic WORLD.json] [--gas WORLD.json] [--until T] "
-                              "[--dts 10,30,100,...] [--min-cpu SECONDS]");
-}
-
-double positive_number(std::string_view option, const std::string& text) {
-  const std::optional<double> x = turtlegas::bench::positive_number(text);
-  if (!x) usage_error(std::string(option) + " needs a positive number, got '" + text + "'");
-  return *x;
-}
+const turtlegas::bench::Usage usage("accuracy_bench [--ballistic WORLD.json] [--gas WORLD.json] [--until T]"
+                                    " [--dts 10,30,100,...] [--min-cpu SECONDS]");
 
 Options parse_options(int argc, char** argv) {
   Options o;
   for (int k = 1; k < argc; ++k) {
     const std::string_view arg = argv[k];
     auto value = [&]() -> std::string {
-      if (k + 1 >= argc) usage_error(std::string(arg) + " needs a value");
+      if (k + 1 >= argc) usage.error(std::string(arg) + " needs a value");
       return argv[++k];
     };
     if (arg == "--ballistic") {
@@ -88,21 +79,21 @@ Options parse_options(int argc, char** argv) {
     } else if (arg == "--gas") {
       o.gas = value();
     } else if (arg == "--until") {
-      o.until = positive_number(arg, value());
+      o.until = usage.positive(arg, value());
     } else if (arg == "--min-cpu") {
-      o.min_cpu = positive_number(arg, value());
+      o.min_cpu = usage.positive(arg, value());
     } else if (arg == "--dts") {
       o.dts.clear();
       std::stringstream list(value());
       for (std::string item; std::getline(list, item, ',');) {
-        const double n = positive_number("--dts", item);
-        if (n != std::floor(n) || n > 1e7) usage_error("--dts takes whole numbers n up to 1e7 (dt = 1/n), got '" + item + "'");
+        const double n = usage.positive("--dts", item);
+        if (n != std::floor(n) || n > 1e7) usage.error("--dts takes whole numbers n up to 1e7 (dt = 1/n), got '" + item + "'");
         o.dts.push_back(static_cast<int>(n));
       }
     } else if (arg == "-h" || arg == "--help") {
-      usage_error("accuracy_bench: accuracy against CPU time, exact and step mode");
+      usage.error("accuracy_bench: accuracy against CPU time, exact and step mode");
     } else {
-      usage_error("unknown argument '" + std::string(arg) + "'");
+      usage.error("unknown argument '" + std::string(arg) + "'");
     }
   }
   return o;

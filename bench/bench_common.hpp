@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "turtlegas/world/world_file.hpp"
 
@@ -36,6 +37,25 @@ inline std::optional<double> positive_number(const std::string& text) {
   if (used != text.size() || !(x > 0.0) || !std::isfinite(x)) return std::nullopt;
   return x;
 }
+
+/// A program's usage line, for argument errors: each throws std::invalid_argument (exit code 2
+/// under run_with_exit_codes) with the message and then the usage line.
+class Usage {
+ public:
+  explicit Usage(std::string line) : line_(std::move(line)) {}
+  [[noreturn]] void error(const std::string& message) const {
+    throw std::invalid_argument(message + "\nusage: " + line_);
+  }
+  /// The value of `option` as a finite number > 0, or an error naming the option.
+  double positive(std::string_view option, const std::string& text) const {
+    const std::optional<double> x = positive_number(text);
+    if (!x) error(std::string(option) + " needs a positive number, got '" + text + "'");
+    return *x;
+  }
+
+ private:
+  std::string line_;
+};
 
 /// Runs body(argc, argv) with the project's exit codes: its own result, 2 for a bad world file or
 /// bad arguments (WorldFileError, std::invalid_argument), 1 for anything else; the message goes to

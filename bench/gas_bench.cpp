@@ -97,17 +97,8 @@ struct Options {
   double max_wall = 300.0;
 };
 
-[[noreturn]] void usage_error(const std::string& message) {
-  throw std::invalid_argument(message +
-                              "\nusage: gas_bench WORLD.json [--mode exact|step] [--collisions K | --sim-seconds T] "
-                              "[--steps S | --ball-steps B] [--max-wall SECONDS]");
-}
-
-double positive_number(std::string_view option, const std::string& text) {
-  const std::optional<double> x = turtlegas::bench::positive_number(text);
-  if (!x) usage_error(std::string(option) + " needs a positive number, got '" + text + "'");
-  return *x;
-}
+const turtlegas::bench::Usage usage("gas_bench WORLD.json [--mode exact|step] [--collisions K | --sim-seconds T]"
+                                    " [--steps S | --ball-steps B] [--max-wall SECONDS]");
 
 Options parse_options(int argc, char** argv) {
   Options o;
@@ -115,41 +106,41 @@ Options parse_options(int argc, char** argv) {
   for (int k = 1; k < argc; ++k) {
     const std::string_view arg = argv[k];
     auto value = [&]() -> std::string {
-      if (k + 1 >= argc) usage_error(std::string(arg) + " needs a value");
+      if (k + 1 >= argc) usage.error(std::string(arg) + " needs a value");
       return argv[++k];
     };
     if (arg == "--mode") {
       const std::string m = value();
       if (m == "exact") o.mode = sim::Mode::exact;
       else if (m == "step") o.mode = sim::Mode::step;
-      else usage_error("--mode must be exact or step, got '" + m + "'");
+      else usage.error("--mode must be exact or step, got '" + m + "'");
     } else if (arg == "--collisions") {
-      o.collisions = static_cast<std::uint64_t>(positive_number(arg, value()));
+      o.collisions = static_cast<std::uint64_t>(usage.positive(arg, value()));
     } else if (arg == "--sim-seconds") {
-      o.sim_seconds = positive_number(arg, value());
+      o.sim_seconds = usage.positive(arg, value());
     } else if (arg == "--steps") {
-      o.steps = static_cast<std::uint64_t>(positive_number(arg, value()));
+      o.steps = static_cast<std::uint64_t>(usage.positive(arg, value()));
     } else if (arg == "--ball-steps") {
-      o.ball_steps = positive_number(arg, value());
+      o.ball_steps = usage.positive(arg, value());
     } else if (arg == "--max-wall") {
-      o.max_wall = positive_number(arg, value());
+      o.max_wall = usage.positive(arg, value());
     } else if (arg == "-h" || arg == "--help") {
-      usage_error("gas_bench: throughput and memory of one world file");
+      usage.error("gas_bench: throughput and memory of one world file");
     } else if (!arg.empty() && arg[0] == '-') {
-      usage_error("unknown option '" + std::string(arg) + "'");
+      usage.error("unknown option '" + std::string(arg) + "'");
     } else if (have_world) {
-      usage_error("only one world file per run (each scene gets its own process), got a second: '" + std::string(arg) + "'");
+      usage.error("only one world file per run (each scene gets its own process), got a second: '" + std::string(arg) + "'");
     } else {
       o.world = argv[k];
       have_world = true;
     }
   }
-  if (!have_world) usage_error("no world file given");
-  if (o.collisions && o.sim_seconds) usage_error("give --collisions or --sim-seconds, not both");
-  if (o.steps && o.ball_steps) usage_error("give --steps or --ball-steps, not both");
-  if (o.mode == sim::Mode::exact && (o.steps || o.ball_steps)) usage_error("--steps and --ball-steps are for --mode step");
+  if (!have_world) usage.error("no world file given");
+  if (o.collisions && o.sim_seconds) usage.error("give --collisions or --sim-seconds, not both");
+  if (o.steps && o.ball_steps) usage.error("give --steps or --ball-steps, not both");
+  if (o.mode == sim::Mode::exact && (o.steps || o.ball_steps)) usage.error("--steps and --ball-steps are for --mode step");
   if (o.mode == sim::Mode::step && (o.collisions || o.sim_seconds))
-    usage_error("--collisions and --sim-seconds are for --mode exact; step mode runs --steps or --ball-steps");
+    usage.error("--collisions and --sim-seconds are for --mode exact; step mode runs --steps or --ball-steps");
   return o;
 }
 

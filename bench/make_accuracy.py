@@ -9,8 +9,6 @@ The tables replace whatever lies between this script's GENERATED markers in the 
 they go to standard output. Plain python, SVG by hand, as make_tables.py (whose helpers it uses).
 """
 
-import argparse
-import json
 import math
 import os
 import pathlib
@@ -50,13 +48,17 @@ def g3(x):
     return "–" if x is None else f"{x:.3g}"
 
 
+def cost_cells(r, exact):
+    """The columns every table starts with: mode, dt, cost, cost against exact mode's."""
+    return [r["mode"], dt_label(r) if r["mode"] == "step" else "–", g3(r["cpu_per_sim_second"]),
+            g3(r['cpu_per_sim_second'] / exact['cpu_per_sim_second']) if exact else "–"]
+
+
 def ballistic_table(rows):
     exact = next((r for r in rows if r["mode"] == "exact"), None)
     out = []
     for r in rows:
-        out.append([
-            r["mode"], dt_label(r) if r["mode"] == "step" else "–", g3(r["cpu_per_sim_second"]),
-            g3(r['cpu_per_sim_second'] / exact['cpu_per_sim_second']) if exact else "–",
+        out.append(cost_cells(r, exact) + [
             g3(r["max_position_error"]), g3(r["rms_position_error"]), g3(r["rms_ball_energy_error"]),
             g3(r["energy_error"]), f"{r['collisions']:,}", make_tables.flag(r) or "",
         ])
@@ -69,9 +71,7 @@ def gas_table(rows):
     exact = next((r for r in rows if r["mode"] == "exact"), None)
     out = []
     for r in rows:
-        out.append([
-            r["mode"], dt_label(r) if r["mode"] == "step" else "–", g3(r["cpu_per_sim_second"]),
-            g3(r['cpu_per_sim_second'] / exact['cpu_per_sim_second']) if exact else "–",
+        out.append(cost_cells(r, exact) + [
             f"{r['energy_drift']:+.1e}", f"{r['collisions']:,}",
             f"{100 * (r['collisions'] / exact['collisions'] - 1):+.1f} %" if exact and exact["collisions"] else "–",
             make_tables.flag(r) or "",
@@ -186,24 +186,9 @@ def svg_plot(rows, path):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("results")
-    ap.add_argument("--machine")
-    ap.add_argument("--doc")
-    ap.add_argument("--svg")
-    args = ap.parse_args()
-
-    rows = make_tables.load(args.results)
-    machine = json.loads(pathlib.Path(args.machine).read_text()) if args.machine else {}
-    doc_dir = pathlib.Path(args.doc).parent if args.doc else pathlib.Path(".")
-
-    def rel(p):
-        return os.path.relpath(p, doc_dir)
-
-    parts = [f"Results: [`{rel(args.results)}`]({rel(args.results)})"
-             + (f", machine: [`{rel(args.machine)}`]({rel(args.machine)})" if args.machine else "") + ".", ""]
-    if machine:
-        parts += [make_tables.machine_text(machine), ""]
+    report = make_tables.Report(__doc__.splitlines()[0])
+    rows = report.rows
+    parts = report.header()
     ballistic, gas = scene_rows(rows, "ballistic"), scene_rows(rows, "gas")
     if ballistic:
         b = ballistic[0]
@@ -214,15 +199,10 @@ def main():
         parts += [f"### The memo's gas under gravity (`{g['world_file']}`: N = {g['N']}, "
                   f"T = {g['sim_seconds']:.3g} s)",
                   "", gas_table(gas), ""]
-    if args.svg:
-        svg_plot(rows, args.svg)
-        parts += [f"![error against CPU seconds per simulated second]({rel(args.svg)})", ""]
-    text = "\n".join(parts)
-    if args.doc:
-        make_tables.splice(args.doc, BEGIN, END, text)
-    else:
-        sys.stdout.write(text)
-
+    if report.args.svg:
+        svg_plot(rows, report.args.svg)
+        parts += [f"![error against CPU seconds per simulated second]({report.rel(report.args.svg)})", ""]
+    report.publish(BEGIN, END, parts)
 
 if __name__ == "__main__":
     main()

@@ -224,42 +224,59 @@ def svg_plot(rows, path):
     pathlib.Path(path).write_text("\n".join(svg) + "\n")
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("results")
-    ap.add_argument("--machine")
-    ap.add_argument("--doc")
-    ap.add_argument("--svg")
-    args = ap.parse_args()
+class Report:
+    """The command line the report scripts share (RESULTS [--machine M] [--doc D] [--svg S]), the
+    results and machine files read, and the header and placement of the generated text."""
 
-    rows = load(args.results)
-    machine = json.loads(pathlib.Path(args.machine).read_text()) if args.machine else {}
+    def __init__(self, description):
+        ap = argparse.ArgumentParser(description=description)
+        ap.add_argument("results")
+        ap.add_argument("--machine")
+        ap.add_argument("--doc")
+        ap.add_argument("--svg")
+        self.args = ap.parse_args()
+        self.rows = load(self.args.results)
+        self.machine = json.loads(pathlib.Path(self.args.machine).read_text()) if self.args.machine else {}
+        self.doc_dir = pathlib.Path(self.args.doc).parent if self.args.doc else pathlib.Path(".")
+
+    def rel(self, path):
+        """A path as the doc links it."""
+        return os.path.relpath(path, self.doc_dir)
+
+    def header(self):
+        """Lines naming the results and machine files, then the machine's description."""
+        a = self.args
+        parts = [f"Results: [`{self.rel(a.results)}`]({self.rel(a.results)})"
+                 + (f", machine: [`{self.rel(a.machine)}`]({self.rel(a.machine)})" if a.machine else "") + ".", ""]
+        if self.machine:
+            parts += [machine_text(self.machine), ""]
+        return parts
+
+    def publish(self, begin, end, parts):
+        """Writes the text between the doc's markers, or to stdout without --doc."""
+        text = "\n".join(parts)
+        if self.args.doc:
+            splice(self.args.doc, begin, end, text)
+        else:
+            sys.stdout.write(text)
+
+
+def main():
+    report = Report(__doc__.splitlines()[0])
+    rows = report.rows
     exact, step = by_mode(rows, "exact"), by_mode(rows, "step")
     exact_main, exact_detail = exact_tables(exact)
-
-    doc_dir = pathlib.Path(args.doc).parent if args.doc else pathlib.Path(".")
-    def rel(p):
-        return os.path.relpath(p, doc_dir)
-
-    parts = [f"Results: [`{rel(args.results)}`]({rel(args.results)})"
-             + (f", machine: [`{rel(args.machine)}`]({rel(args.machine)})" if args.machine else "") + ".", ""]
-    if machine:
-        parts += [machine_text(machine), ""]
+    parts = report.header()
     if exact:
         parts += ["### Exact mode", "", exact_main, "", "Run details:", "", exact_detail, ""]
     if step:
         parts += ["### Step mode (dt = 1/30 s)", "", step_table(step), ""]
     if exact:
         parts += ["### Targets", "", targets(exact), ""]
-    if args.svg:
-        svg_plot(rows, args.svg)
-        parts += [f"![ns per collision against N]({rel(args.svg)})", ""]
-    text = "\n".join(parts)
-
-    if not args.doc:
-        sys.stdout.write(text)
-        return
-    splice(args.doc, BEGIN, END, text)
+    if report.args.svg:
+        svg_plot(rows, report.args.svg)
+        parts += [f"![ns per collision against N]({report.rel(report.args.svg)})", ""]
+    report.publish(BEGIN, END, parts)
 
 
 def splice(doc_path, begin, end, text):
