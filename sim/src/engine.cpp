@@ -581,26 +581,27 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vect
                 "); set arena.cell >= that";
       throw std::invalid_argument("arena.cell " + std::to_string(cell) + " is too small: " + why);
     }
-  } else if (!kStep && !kBallBall && def.turtles.empty()) {
-    // Exact mode, balls meeting walls only: their number says nothing about how fine the table
-    // must be, and every cell crossing is an event that finds no partner. (Step mode has no
-    // crossing events; there finer cells keep the walls out of most balls' neighbourhoods, so it
-    // keeps the rule below.) So size the cells by the walls instead, at
-    // about one wall passing through a cell: with total wall length L, L / cell cells are crossed
-    // by walls out of area / cell^2, which is one each at cell = area / L. At most a quarter of the
-    // arena (a plain box gets a 4 x 4 table); no walls at all (exits only) gives that too.
-    double length = 0.0;
-    for (std::uint32_t w = 0; w < walls_.size(); ++w)
-      if (mover_of_[w] == kNone) length += walls_[w].len;
-    const double quarter = std::max(width_, height_) / 4.0;
-    cell = std::max(rule * (1.0 + 1e-9), length > 0.0 ? std::min(area / length, quarter) : quarter);
-    cell = std::max(cell, std::sqrt(area / 4.0e7));  // keep the table under ~4e7 cells
-    if (boundary_ == Boundary::periodic) cell = std::max(rule * (1.0 + 1e-9), std::min(cell, std::min(width_, height_) / 3.0));
   } else {
-    // About 0.3 balls per cell: measured fastest in exact mode from area fraction 0.05 to 0.3
-    // (fewer balls per cell means fewer candidates per prediction but more cell crossings).
-    const double density_cell = n > 0 ? std::sqrt(0.3 * area / static_cast<double>(n)) : std::max(width_, height_) / 16.0;
-    cell = std::max(rule * (1.0 + 1e-9), density_cell);
+    double preferred = 0.0;
+    if (!kStep && !kBallBall && def.turtles.empty()) {
+      // Exact mode, balls meeting walls only: their number says nothing about how fine the table
+      // must be, and every cell crossing is an event that finds no partner. (Step mode has no
+      // crossing events; there finer cells keep the walls out of most balls' neighbourhoods, so it
+      // keeps the rule below.) So size the cells by the walls instead, at about one wall passing
+      // through a cell: with total wall length L, L / cell cells are crossed by walls out of
+      // area / cell^2, which is one each at cell = area / L. At most a quarter of the arena (a
+      // plain box gets a 4 x 4 table); no walls at all (exits only) gives that too.
+      double length = 0.0;
+      for (std::uint32_t w = 0; w < walls_.size(); ++w)
+        if (mover_of_[w] == kNone) length += walls_[w].len;
+      const double quarter = std::max(width_, height_) / 4.0;
+      preferred = length > 0.0 ? std::min(area / length, quarter) : quarter;
+    } else {
+      // About 0.3 balls per cell: measured fastest in exact mode from area fraction 0.05 to 0.3
+      // (fewer balls per cell means fewer candidates per prediction but more cell crossings).
+      preferred = n > 0 ? std::sqrt(0.3 * area / static_cast<double>(n)) : std::max(width_, height_) / 16.0;
+    }
+    cell = std::max(rule * (1.0 + 1e-9), preferred);
     cell = std::max(cell, std::sqrt(area / 4.0e7));  // keep the table under ~4e7 cells
     // A periodic arena needs three cells across, so that no pair is seen through two images.
     if (boundary_ == Boundary::periodic) cell = std::max(rule * (1.0 + 1e-9), std::min(cell, std::min(width_, height_) / 3.0));
