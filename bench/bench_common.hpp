@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// What the world-file benchmark programs (gas_bench, accuracy_bench) share: the thread's CPU
-// clock, number options, and the project's exit codes.
+// What the benchmark programs share: the thread's CPU clock (all of them), number options and the
+// project's exit codes (the world-file programs, gas_bench and accuracy_bench).
 #pragma once
 
 #include <cmath>

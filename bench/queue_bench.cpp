@@ -16,14 +16,15 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <iostream>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "bench_common.hpp"
 #include "event_queue.hpp"
 
+using turtlegas::bench::thread_cpu_seconds;
 using turtlegas::sim::detail::EventQueue;
 
 namespace {
@@ -34,12 +35,6 @@ struct alignas(64) Record {
   double mass = 0.0;
 };
 static_assert(sizeof(Record) == 128);
-
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 }  // namespace
 

@@ -8,18 +8,19 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <fstream>
 #include <iostream>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "bench_common.hpp"
 #include "fiber.hpp"
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
 using namespace turtlegas;
+using turtlegas::bench::thread_cpu_seconds;
 
 namespace {
 
@@ -30,13 +31,6 @@ long status_kib(const std::string& key) {
   while (std::getline(f, line))
     if (line.rfind(key + ":", 0) == 0) return std::strtol(line.c_str() + key.size() + 1, nullptr, 10);
   return -1;
-}
-
-// CPU time of the calling thread, seconds: on a shared machine it counts only our own work.
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
