@@ -22,16 +22,19 @@ bench=$build/bench/gas_bench
 
 commit=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
 out=$root/docs/bench/effects-$(date -u +%Y-%m-%d)-$(hostname -s 2>/dev/null || echo host)-$commit.jsonl
-: > "$out"
+tmp=$(mktemp)
+trap 'rm -f "$tmp"' EXIT
 for ((r = 1; r <= rounds; ++r)); do
   for v in plain gravity layers gravity_layers; do
     line=$("$bench" "$root/worlds/bench/effects_$v.json" --collisions 2e6)
     printf '%s\n' "$line" | VARIANT=$v ROUND=$r python3 -c 'import json, os, sys
 d = json.loads(sys.stdin.read()); d["variant"] = os.environ["VARIANT"]; d["round"] = int(os.environ["ROUND"])
-print(json.dumps(d))' >> "$out"
+print(json.dumps(d))' >> "$tmp"
     echo "round $r/$rounds  $v" >&2
   done
 done
+mv "$tmp" "$out"
+trap - EXIT
 echo "results in $out" >&2
 
 python3 - "$out" <<'PY'
