@@ -370,10 +370,14 @@ std::optional<DefProblem> validate(const WorldDef& def) {
   if (auto p = check_walls(def)) return p;
   if (auto p = check_balls(def)) return p;
   if (auto p = check_turtles(def)) return p;
-  const std::size_t objects = def.walls.size() + def.balls.size() + def.turtles.size();
-  if (objects >= std::numeric_limits<std::uint32_t>::max() / 4)
-    return problem(Where::world, 0, "balls",
-                   "too many objects (" + std::to_string(objects) + "); the engine indexes them with 32 bits");
+  // Bodies, and wall ends (two per wall, the arena's four included), are indexed with 29 bits.
+  const std::size_t bodies = def.balls.size() + def.turtles.size();
+  const std::size_t wall_ends = 2 * (def.walls.size() + arena_ids.size());
+  if (bodies > kMaxObjects || wall_ends > kMaxObjects)
+    return problem(Where::world, 0, bodies > kMaxObjects ? "balls" : "walls",
+                   "too many objects (" + std::to_string(bodies) + " balls and turtles, " + std::to_string(def.walls.size()) +
+                       " walls); the engine indexes them with 29 bits: at most " + std::to_string(kMaxObjects) +
+                       " balls and turtles, and " + std::to_string(kMaxObjects / 2 - arena_ids.size()) + " walls");
   if (auto p = check_ids(def)) return p;
   if (auto p = check_overlaps(def)) return p;
   return std::nullopt;

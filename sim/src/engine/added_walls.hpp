@@ -28,6 +28,9 @@ std::size_t Engine<Flight, kBallBall, kStep, kExtras>::add_wall(const WallDef& w
     for (Vec2 p : {wall.from, wall.to})
       if (p.x < 0.0 || p.x > width_ || p.y < 0.0 || p.y > height_)
         throw std::invalid_argument("wall '" + wall.id + "' reaches outside a periodic arena; keep walls inside it");
+  if (2 * (walls_.size() + 1) > kMaxObjects)
+    throw std::invalid_argument("wall '" + wall.id + "': too many walls (" + std::to_string(walls_.size()) +
+                                "); the engine indexes wall ends with 29 bits");
   const Segment seg = make_segment(wall.from, wall.to);
   for (std::uint32_t i = 0; i < body_.size(); ++i) {
     const Body& b = body_[i];

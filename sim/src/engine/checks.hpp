@@ -3,7 +3,7 @@
 // Part of engine.hpp (members of Engine), included at its end.
 #pragma once
 
-#include "turtlegas/sim/reference.hpp"
+#include "../overlap.hpp"
 
 namespace turtlegas::sim::detail {
 namespace {
@@ -27,14 +27,14 @@ Overlap Engine<Flight, kBallBall, kStep, kExtras>::measure_overlap() const {
   auto pos = [&](std::size_t i) { return pos_at(body_[i], static_cast<std::uint32_t>(i), now_ - body_[i].t); };
   auto rad = [&](std::size_t i) { return body_[i].r; };
   auto alive = [&](std::size_t i) { return body_[i].cell != kNone; };
-  const reference::DiscView discs{n, pos, rad, alive};
+  const DiscView discs{n, pos, rad, alive};
   const bool periodic = boundary_ == Boundary::periodic;
   std::vector<Segment> walls_now = walls_;
   for (const Mover& m : movers_) walls_now[m.wall] = mover_segment(m, now_);
   if (!kBallBall && nb_ > 0) {
     // Balls pass through each other by request: measure walls for everyone, and pairs among the
     // turtles and between turtles and balls.
-    Overlap worst = reference::overlap(discs, walls_now, periodic ? width_ : 0.0, periodic ? height_ : 0.0, false,
+    Overlap worst = deepest_overlap(discs, walls_now, periodic ? width_ : 0.0, periodic ? height_ : 0.0, false,
                                        kExtras ? &layers_ : nullptr, kExtras ? &wall_layers_ : nullptr);
     for (std::uint32_t t = nb_; t < n; ++t) {
       if (!alive(t)) continue;
@@ -47,7 +47,7 @@ Overlap Engine<Flight, kBallBall, kStep, kExtras>::measure_overlap() const {
     }
     return worst;
   }
-  return reference::overlap(discs, walls_now, periodic ? width_ : 0.0, periodic ? height_ : 0.0, true,
+  return deepest_overlap(discs, walls_now, periodic ? width_ : 0.0, periodic ? height_ : 0.0, true,
                             kExtras ? &layers_ : nullptr, kExtras ? &wall_layers_ : nullptr);
 }
 

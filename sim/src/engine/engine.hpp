@@ -48,6 +48,7 @@
 
 #include "../cell_grid.hpp"
 #include "../event_queue.hpp"
+#include "cell_size.hpp"
 #include "engine_base.hpp"
 #include "flights.hpp"
 #include "moving_walls.hpp"
@@ -295,7 +296,7 @@ class Engine final : public EngineBase {
   Column<Body, body_of> body_;
   Column<double, mass_of> mass_;      ///< balls only
   Column<double, command_end_of> end_;  ///< turtles only: when the command running ends
-  Column<std::uint32_t, last_of> last_;
+  Column<LastPartner, last_of> last_;
   Column<Pending, pending_of> pending_;
   std::vector<double> last_time_;  ///< only when restitution < 1 (the TC rule)
   std::vector<std::uint32_t> head_;         ///< balls by cell
@@ -388,56 +389,9 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vect
 
   nb_ = static_cast<std::uint32_t>(def.balls.size());
   const std::size_t n = def.balls.size() + def.turtles.size();
-  double vmax = 0.0;
-  for (const auto& b : def.balls) {
-    rmax_ = std::max(rmax_, b.radius);
-    vmax = std::max(vmax, norm(b.vel));
-  }
-  for (const auto& t : def.turtles) {
-    rmax_ = std::max(rmax_, t.radius);
-    vmax = std::max(vmax, t.speed);
-  }
-  // Cell size. Exact mode needs cells at least a diameter wide so that touching bodies are always
-  // in neighbouring cells; step mode needs the memo's rule: a cell wider than any two bodies' radii
-  // plus their paths in one step.
-  const double area = width_ * height_;
-  const double rule = kStep ? 2.0 * (rmax_ + vmax * dt_) : 2.0 * rmax_;
-  double cell = 0.0;
-  if (def.arena.cell) {
-    cell = *def.arena.cell;
-    if (cell < rule) {
-      const std::string why = kStep
-          ? "the memo's rule in step mode needs cells wider than twice (largest radius + largest speed x dt) = " +
-                std::to_string(rule) + "; set arena.cell >= that, use a smaller dt, or use --mode exact"
-          : "exact mode needs cells at least as wide as the largest ball or turtle (diameter " + std::to_string(rule) +
-                "); set arena.cell >= that";
-      throw std::invalid_argument("arena.cell " + std::to_string(cell) + " is too small: " + why);
-    }
-  } else {
-    double preferred = 0.0;
-    if (!kStep && !kBallBall && def.turtles.empty()) {
-      // Exact mode, balls meeting walls only: their number says nothing about how fine the table
-      // must be, and every cell crossing is an event that finds no partner. (Step mode has no
-      // crossing events; there finer cells keep the walls out of most balls' neighbourhoods, so it
-      // keeps the rule below.) So size the cells by the walls instead, at about one wall passing
-      // through a cell: with total wall length L, L / cell cells are crossed by walls out of
-      // area / cell^2, which is one each at cell = area / L. At most a quarter of the arena (a
-      // plain box gets a 4 x 4 table); no walls at all (exits only) gives that too.
-      double length = 0.0;
-      for (std::uint32_t w = 0; w < walls_.size(); ++w)
-        if (mover_of_[w] == kNone) length += walls_[w].len;
-      const double quarter = std::max(width_, height_) / 4.0;
-      preferred = length > 0.0 ? std::min(area / length, quarter) : quarter;
-    } else {
-      // About 0.3 balls per cell: measured fastest in exact mode from area fraction 0.05 to 0.3
-      // (fewer balls per cell means fewer candidates per prediction but more cell crossings).
-      preferred = n > 0 ? std::sqrt(0.3 * area / static_cast<double>(n)) : std::max(width_, height_) / 16.0;
-    }
-    cell = std::max(rule * (1.0 + 1e-9), preferred);
-    cell = std::max(cell, std::sqrt(area / 4.0e7));  // keep the table under ~4e7 cells
-    // A periodic arena needs three cells across, so that no pair is seen through two images.
-    if (boundary_ == Boundary::periodic) cell = std::max(rule * (1.0 + 1e-9), std::min(cell, std::min(width_, height_) / 3.0));
-  }
+  for (const auto& b : def.balls) rmax_ = std::max(rmax_, b.radius);
+  for (const auto& t : def.turtles) rmax_ = std::max(rmax_, t.radius);
+  const double cell = choose_cell_size(def, kStep ? Mode::step : Mode::exact);
   // The records first, then (for a consumed scene) free the ball list before anything else per
   // ball or per cell is allocated. While the scene is alive only what the records need from it
   // (48 bytes a ball) is written, packed at the records' far end, whose pages alone are touched;

@@ -19,11 +19,8 @@ inline void Engine<Flight, kBallBall, kStep, kExtras>::consider_ball(std::uint32
   const double t = now_ + toi_disc_disc(r, v, bi.r + bj.r);
   if (t < p.t_coll) {
     // Checked only for a winner: most candidates miss, and last_[j] is a cache miss.
-    if (last_[i] == last_code(Partner::body, j) && last_[j] == last_code(Partner::body, i)) return;
-    p.t_coll = t;
-    p.kind = Partner::body;
-    p.partner = j;
-    p.partner_count = bj.count;
+    if (last_[i] == LastPartner::of(Partner::body, j) && last_[j] == LastPartner::of(Partner::body, i)) return;
+    p.take(t, Partner::body, j, bj.count);
   }
 }
 
@@ -40,41 +37,34 @@ void Engine<Flight, kBallBall, kStep, kExtras>::consider_turtle(std::uint32_t i,
   else dt = toi_disc_disc(rel, v, bi.r + bj.r);
   const double t = now_ + dt;
   if (t < p.t_coll) {
-    if (straight(i) && last_[i] == last_code(Partner::body, j) && last_[j] == last_code(Partner::body, i)) return;
-    p.t_coll = t;
-    p.kind = Partner::body;
-    p.partner = j;
-    p.partner_count = bj.count;
+    if (straight(i) && last_[i] == LastPartner::of(Partner::body, j) && last_[j] == LastPartner::of(Partner::body, i)) return;
+    p.take(t, Partner::body, j, bj.count);
   }
 }
 
 template <class Flight, bool kBallBall, bool kStep, bool kExtras>
 void Engine<Flight, kBallBall, kStep, kExtras>::consider_wall(std::uint32_t i, const Body& bi, std::uint32_t w,
                                                                Vec2 shift, Pending& p) const {
-  if (!meets_wall(i, w) || (straight(i) && last_[i] == last_code(Partner::wall, w))) return;
+  if (!meets_wall(i, w) || (straight(i) && last_[i] == LastPartner::of(Partner::wall, w))) return;
   const Segment& s = walls_[w];
   // Relative to the wall's first end, so walls far from the origin lose nothing.
   const double t = now_ + toi_disc_segment(bi.x - (s.p1 + shift), bi.v, accel(i), s, bi.r);
   if (t < p.t_coll) {
-    p.t_coll = t;
-    p.kind = Partner::wall;
-    p.partner = w;
+    p.take(t, Partner::wall, w);
   }
 }
 
 template <class Flight, bool kBallBall, bool kStep, bool kExtras>
 void Engine<Flight, kBallBall, kStep, kExtras>::consider_end(std::uint32_t i, const Body& bi, std::uint32_t e,
                                                               Vec2 shift, Pending& p) const {
-  if (!meets_end(i, e) || (straight(i) && last_[i] == last_code(Partner::end, e))) return;
+  if (!meets_end(i, e) || (straight(i) && last_[i] == LastPartner::of(Partner::end, e))) return;
   const Vec2 rel = bi.x - (ends_[e].p + shift);
   double dt;
   if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(rel, bi.v, flight_.a, bi.r, p.t_coll - now_);
   else dt = toi_disc_point(rel, bi.v, bi.r);
   const double t = now_ + dt;
   if (t < p.t_coll) {
-    p.t_coll = t;
-    p.kind = Partner::end;
-    p.partner = e;
+    p.take(t, Partner::end, e);
   }
 }
 
@@ -93,11 +83,8 @@ void Engine<Flight, kBallBall, kStep, kExtras>::consider_ball_from_turtle(std::u
   else dt = toi_disc_disc(rel, v, bi.r + bj.r);
   const double t = now_ + dt;
   if (t < p.t_coll) {
-    if (!Flight::kAccelerates && last_[i] == last_code(Partner::body, j) && last_[j] == last_code(Partner::body, i)) return;
-    p.t_coll = t;
-    p.kind = Partner::body;
-    p.partner = j;
-    p.partner_count = bj.count;
+    if (!Flight::kAccelerates && last_[i] == LastPartner::of(Partner::body, j) && last_[j] == LastPartner::of(Partner::body, i)) return;
+    p.take(t, Partner::body, j, bj.count);
   }
 }
 
@@ -167,8 +154,8 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_balls(std::uint32_t i, s
   log(EventKind::ball_ball, i, j);
   after_change(i);
   after_change(j);
-  last_[i] = last_code(Partner::body, j);
-  last_[j] = last_code(Partner::body, i);
+  last_[i] = LastPartner::of(Partner::body, j);
+  last_[j] = LastPartner::of(Partner::body, i);
   repredict(i);
   repredict(j);
 }
@@ -203,8 +190,8 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_with_turtle(std::uint32_
   }
   after_change(t);
   after_change(o);
-  last_[t] = last_code(Partner::body, o);
-  last_[o] = last_code(Partner::body, t);
+  last_[t] = LastPartner::of(Partner::body, o);
+  last_[o] = LastPartner::of(Partner::body, t);
   repredict(t);
   repredict(o);
 }
@@ -244,7 +231,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_wall(std::uint32_t i, st
     log(EventKind::ball_wall, i, w);
   }
   after_change(i);
-  last_[i] = last_code(Partner::wall, w);
+  last_[i] = LastPartner::of(Partner::wall, w);
   repredict(i);
 }
 
@@ -265,7 +252,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_end(std::uint32_t i, std
     log(EventKind::ball_wall_end, i, ends_[e].wall);
   }
   after_change(i);
-  last_[i] = last_code(Partner::end, e);
+  last_[i] = LastPartner::of(Partner::end, e);
   repredict(i);
 }
 
@@ -285,17 +272,15 @@ void Engine<Flight, kBallBall, kStep, kExtras>::consider_mover(std::uint32_t i, 
   if (!m.rigid()) {
     // Turning or stretching: no straight-line argument rules out meeting the same wall again.
     t_wall = now_ + toi_disc_deforming_segment(bi.x - p1, v, accel(i), mover_d(m, now_), m.w, bi.r, horizon - now_);
-  } else if (!(straight(i) && last_[i] == last_code(Partner::wall, w))) {
+  } else if (!(straight(i) && last_[i] == LastPartner::of(Partner::wall, w))) {
     t_wall = now_ + toi_disc_segment(bi.x - p1, v, accel(i), s, bi.r);
   }
   if (t_wall < p.t_coll && t_wall <= horizon) {
-    p.t_coll = t_wall;
-    p.kind = Partner::wall;
-    p.partner = w;
+    p.take(t_wall, Partner::wall, w);
   }
   for (std::uint32_t which = 0; which < 2; ++which) {
     const std::uint32_t code = 2 * mi + which;
-    if (straight(i) && last_[i] == last_code(Partner::moving_end, code)) continue;
+    if (straight(i) && last_[i] == LastPartner::of(Partner::moving_end, code)) continue;
     // Each end moves in a straight line, so its contacts have the closed forms of a fixed point.
     const Vec2 e = mover_end(m, which == 1, now_);
     const Vec2 ve = which == 0 ? v : v - m.w;  // the body's velocity relative to that end
@@ -304,9 +289,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::consider_mover(std::uint32_t i, 
     else dt = toi_disc_point(bi.x - e, ve, bi.r);
     const double t = now_ + dt;
     if (t < p.t_coll && t <= horizon) {
-      p.t_coll = t;
-      p.kind = Partner::moving_end;
-      p.partner = code;
+      p.take(t, Partner::moving_end, code);
     }
   }
 }
@@ -332,7 +315,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::collide_moving_end(std::uint32_t
     log(EventKind::ball_wall_end, i, m.wall);
   }
   after_change(i);
-  last_[i] = last_code(Partner::moving_end, code);
+  last_[i] = LastPartner::of(Partner::moving_end, code);
   repredict(i);
 }
 

@@ -56,7 +56,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::finish_step() {
     if (!is_turtle(i)) body_[i].v += dt_ * kick_;
   }
   // A kick changes every course, so "just collided, cannot meet again" no longer holds.
-  if (kick_.x != 0.0 || kick_.y != 0.0) for (std::uint32_t i = 0; i < last_.size(); ++i) last_[i] = kNone;
+  if (kick_.x != 0.0 || kick_.y != 0.0) for (std::uint32_t i = 0; i < last_.size(); ++i) last_[i] = LastPartner::none();
   ++step_index_;
   ++stats_.steps;
   ++stats_.events;

@@ -63,7 +63,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::end_command(std::uint32_t i) {
   }
   body_[i].v = {};
   after_change(i);
-  last_[i] = kNone;
+  last_[i] = LastPartner::none();
   repredict(i);
 }
 
@@ -120,7 +120,7 @@ void Engine<Flight, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, co
   // A new course: predictions made against the old one are stale, and "just collided, cannot
   // meet again" no longer holds.
   ++b.count;
-  last_[id] = kNone;
+  last_[id] = LastPartner::none();
   if constexpr (kStep) dmax_ = std::max(dmax_, travel_[id] + path_length(b.v, dt_ - now_));
   repredict(id);
 }

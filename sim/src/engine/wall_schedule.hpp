@@ -87,10 +87,10 @@ void Engine<Flight, kBallBall, kStep, kExtras>::keyframe() {
       ++body_[i].count;
     }
     // "Just collided, cannot meet again" does not survive a change of the wall's velocity.
-    const std::uint32_t kind = last_[i] == kNone ? 0 : last_[i] >> 29;
-    if (kind == static_cast<std::uint32_t>(Partner::moving_end) ||
-        (kind == static_cast<std::uint32_t>(Partner::wall) && mover_of_[last_[i] & ((1u << 29) - 1)] != kNone))
-      last_[i] = kNone;
+    const LastPartner last = last_[i];
+    if (!last.is_none() && (last.kind() == Partner::moving_end ||
+                            (last.kind() == Partner::wall && mover_of_[last.index()] != kNone)))
+      last_[i] = LastPartner::none();
     repredict(i);
   }
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -134,6 +135,10 @@ struct DefProblem {
   std::string field;      ///< the offending field ("radius", "pos", ...), may be empty
   std::string message;    ///< one line, says what is wrong and how to fix it
 };
+
+/// The most bodies (balls and turtles together) a scene may have, and the most wall ends (two per
+/// wall, the arena's four included): the engine packs an object's index in 29 bits.
+inline constexpr std::size_t kMaxObjects = std::size_t{1} << 29;
 
 /// Checks a scene for everything the engine relies on: finite numbers, positive radii and masses,
 /// non-zero-length walls, unique ids, balls inside the arena and not overlapping each other or a
