@@ -405,6 +405,10 @@ WallKey wall_pose(const WallDef& wall, double t) {
   return {t, prev.from, prev.to};
 }
 
+bool inside_arena(const ArenaDef& arena, Vec2 p) {
+  return !(p.x < 0.0 || p.x > arena.width || p.y < 0.0 || p.y > arena.height);
+}
+
 bool wall_visible(const WallDef& wall, double t) {
   bool visible = true;
   for (const VisibilityKey& k : wall.visibility)

@@ -1,9 +1,20 @@
 // SPDX-License-Identifier: MIT
 //
-// The GAS engine. One class template, instantiated once per combination of the physics a scene
-// can ask for (straight flights or parabolas under gravity; ball-ball collisions on or off; exact
-// or step mode; extras or not), chosen when the World is built, so nothing is decided per
-// collision.
+// The GAS engine. One class template, instantiated once per row of the table of variants
+// (factory.cpp): the flight (straight, or parabolas under gravity), ball-ball collisions on or
+// off, exact or step mode, extras or not. It is chosen when the World is built, so nothing is
+// decided per collision. The engine owns the loop and the two clocks; the rooms it holds do the
+// rest, each receiving what it touches (parts.hpp):
+//   records.hpp, body_store.*  the bodies: one 128-byte record each, columns, cell lists
+//   flights.hpp                how balls fly, and the time-of-impact choice that follows
+//   kick.hpp                   step mode's field, a velocity kick between steps
+//   neighbourhood.hpp          who a body looks at (the memo's table, CellGrid)
+//   interactions.hpp           predict / apply / validate per pair kind
+//   turtle_motion.*            turtles' commands, contacts and state
+//   walls.*, moving_walls.*    walls and their ends; keyframes and visibility
+//   cell_size.*, checks.hpp    the cell-size policy; energy and overlap
+//   exact_clock.hpp            cell crossings, exits, the rebase of internal time
+//   step_clock.hpp             the start and the end of one of the memo's steps
 //
 // Order of work, exact mode (event-driven):
 //   1. Every ball holds one pending prediction: its earliest collision among the objects in its
@@ -24,8 +35,8 @@
 //      cells its path can reach (the memo's rule makes that the 3x3 neighbourhood).
 //   2. Take the earliest collision in the step, make it happen, re-predict the balls it changed;
 //      repeat until no collision is left in the step (steps 2 and 3 of exact mode, without cells).
-//   3. Move every ball to the end of the step and apply the field kick v += a dt. Balls outside an
-//      open arena exit; a periodic arena wraps them.
+//   3. Move every ball to the end of the step and apply the field kick (kick.hpp: v += a dt).
+//      Balls outside an open arena exit; a periodic arena wraps them.
 //
 // kExtras: the scene has turtles, collision layers or moving walls; without them none of these
 // costs a thing. Layers are checked on each candidate pair before any time of impact. Moving walls
@@ -39,31 +50,39 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <limits>
+#include <concepts>
+#include <cstdint>
 #include <memory>
-#include <new>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "../cell_grid.hpp"
 #include "../event_queue.hpp"
+#include "arena.hpp"
+#include "body_store.hpp"
 #include "cell_size.hpp"
+#include "checks.hpp"
 #include "engine_base.hpp"
 #include "flights.hpp"
+#include "interactions.hpp"
+#include "kick.hpp"
 #include "moving_walls.hpp"
+#include "neighbourhood.hpp"
+#include "parts.hpp"
 #include "records.hpp"
 #include "turtle_motion.hpp"
-#include "turtlegas/sim/toi.hpp"
 #include "variant.hpp"
+#include "walls.hpp"
 
 namespace turtlegas::sim::detail {
 namespace {
 
-double path_length(Vec2 v, double dt) { return norm(v) * dt; }
-
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
 class Engine final : public EngineBase {
+  // Step mode flies straight and kicks between steps: its field is a run-time Kick, never a flight.
+  static_assert(!kStep || std::same_as<F, FreeFlight>, "step mode flies straight (FreeFlight)");
+
  public:
   /// Builds the engine for `def`. `release`, when given, is def's own ball list: it is emptied and
   /// its memory freed as soon as the balls have been copied, before the rest of the engine is
@@ -71,46 +90,46 @@ class Engine final : public EngineBase {
   Engine(const WorldDef& def, std::vector<BallDef>* release);
 
   void advance_to(double t) override;
-  void set_event_log(std::vector<Event>* log) override { log_ = log; }
+  void set_event_log(std::vector<Event>* log) override { record_.log = log; }
   double time() const override { return t_base_ + now_; }
-  std::size_t ball_count() const override { return nb_; }
+  std::size_t ball_count() const override { return bodies_.balls(); }
   BallState ball(std::size_t i) const override {
-    const Body& b = body_[i];
+    const Body& b = bodies_.body[i];
     const double dt = now_ - b.t;
-    return {flight_.pos(b.x, b.v, dt), flight_.vel(b.v, dt), b.cell != kNone};
+    const auto id = static_cast<std::uint32_t>(i);
+    return {motion_.flight().pos(id, b.x, b.v, dt), motion_.flight().vel(id, b.v, dt), b.cell != kNone};
   }
-  double radius(std::size_t i) const override { return body_[i].r; }
-  double mass(std::size_t i) const override { return mass_[i]; }
-  const std::vector<WallDef>& walls() const override { return wall_defs_; }
-  std::size_t turtle_count() const override { return run_.size(); }
-  TurtleState turtle(std::size_t k) const override;
-  double turtle_radius(std::size_t k) const override { return body_[nb_ + k].r; }
-  void idle_turtles(std::vector<std::uint32_t>& out) const override {
-    for (std::uint32_t k = 0; k < run_.size(); ++k)
-      if (busy_[k] == 0) out.push_back(k);
+  double radius(std::size_t i) const override { return bodies_.body[i].r; }
+  double mass(std::size_t i) const override { return bodies_.mass[i]; }
+  const std::vector<WallDef>& walls() const override { return walls_.defs; }
+  std::size_t turtle_count() const override { return turtles_.size(); }
+  TurtleState turtle(std::size_t k) const override {
+    const std::size_t id = bodies_.balls() + k;
+    return turtles_.state(k, bodies_.body[id], bodies_.end[id], now_);
   }
+  double turtle_radius(std::size_t k) const override { return bodies_.body[bodies_.balls() + k].r; }
+  void idle_turtles(std::vector<std::uint32_t>& out) const override { turtles_.idle(out); }
   void prefetch_turtle(std::size_t k) const override {
     // What turtle(k) and command_turtle(k) read first: the turtle's record (two lines) and its
     // command state (which may straddle two).
-    if (k >= run_.size()) return;
-    const char* rec = reinterpret_cast<const char*>(&body_[nb_ + k]);
+    if (k >= turtles_.size()) return;
+    const char* rec = reinterpret_cast<const char*>(&bodies_.body[bodies_.balls() + k]);
     __builtin_prefetch(rec);
     __builtin_prefetch(rec + 64);
-    const char* run = reinterpret_cast<const char*>(&run_[k]);
+    const char* run = reinterpret_cast<const char*>(&turtles_.run(k));
     __builtin_prefetch(run);
     __builtin_prefetch(run + sizeof(TurtleRun) - 1);
   }
   void command_turtle(std::size_t k, const TurtleCommand& command) override;
   std::size_t add_wall(const WallDef& wall) override;
-  std::vector<TurtleContact> take_turtle_contacts() override {
-    std::vector<TurtleContact> out;
-    out.swap(contacts_);
-    return out;
+  std::vector<TurtleContact> take_turtle_contacts() override { return turtles_.take_contacts(); }
+  double energy() const override {
+    if constexpr (kStep) return detail::energy(look(), kick_);
+    else return detail::energy(look(), motion_.flight());
   }
-  double energy() const override;
-  const Stats& stats() const override { return stats_; }
-  Overlap measure_overlap() const override;
-  Overlap max_contact_overlap() const override { return max_contact_; }
+  const Stats& stats() const override { return record_.stats; }
+  Overlap measure_overlap() const override { return detail::measure_overlap<kBallBall>(look(), arena_); }
+  Overlap max_contact_overlap() const override { return record_.max_contact; }
   double cell_size() const override { return std::min(grid_.cell_w(), grid_.cell_h()); }
   int cells_x() const override { return grid_.nx(); }
   int cells_y() const override { return grid_.ny(); }
@@ -118,106 +137,15 @@ class Engine final : public EngineBase {
   double dt() const override { return dt_; }
 
  private:
-  bool is_turtle(std::uint32_t id) const { return kExtras && id >= nb_; }
-  /// Collision layers: whether two bodies, or a body and a wall or wall end, can touch at all.
-  bool meets(std::uint32_t i, std::uint32_t j) const {
-    // Bodies' layers are fixed at construction; when all are the defaults (which meet), the pair
-    // test reads neither (with many turtles layers_[j] is a cache miss per candidate).
-    if constexpr (kExtras) return !bodies_layered_ || layers_[i].collides_with(layers_[j]);
-    else return true;
+  bool is_turtle(std::uint32_t id) const { return motion_.is_turtle(id); }
+  Look<F, kExtras> look() const { return {bodies_, walls_, schedule_, motion_, now_}; }
+  Parts<F, kStep, kExtras> parts() {
+    return {bodies_, motion_, walls_, schedule_, turtles_, arena_, restitution_, step_, record_, now_, t_base_, dt_};
   }
-  bool meets_wall(std::uint32_t i, std::uint32_t w) const {
-    if constexpr (kExtras) return layers_[i].collides_with(wall_layers_[w]);
-    else return true;
-  }
-  bool meets_end(std::uint32_t i, std::uint32_t e) const {
-    if constexpr (kExtras) return layers_[i].collides_with(end_layers_[e]);
-    else return true;
-  }
-  void add_end_layers(Vec2 p, const Layers& l);
-  Vec2 mover_p1(const Mover& m, double t) const { return m.p1_ref + (t - m.t_ref) * m.u; }
-  Vec2 mover_d(const Mover& m, double t) const { return m.d_ref + (t - m.t_ref) * m.w; }
-  /// One end of mover m at internal time t (the second through the translation's fixed shape
-  /// when it does not turn or stretch), and that end's velocity.
-  Vec2 mover_end(const Mover& m, bool second, double t) const {
-    const Vec2 p1 = mover_p1(m, t);
-    if (!second) return p1;
-    const Segment& s = walls_[m.wall];
-    return m.rigid() ? p1 + s.len * s.u : p1 + mover_d(m, t);
-  }
-  static Vec2 mover_end_velocity(const Mover& m, bool second) { return second ? m.u + m.w : m.u; }
-  /// The wall of mover m as a segment at internal time t.
-  Segment mover_segment(const Mover& m, double t) const {
-    if (m.rigid()) {
-      Segment s = walls_[m.wall];
-      s.p1 = mover_p1(m, t);
-      return s;
-    }
-    const Vec2 p1 = mover_p1(m, t);
-    return make_segment(p1, p1 + mover_d(m, t));
-  }
-  void aim_mover(Mover& m);
-  void refresh_next_key();
-  void apply_visibility();
-  void keyframe();
-  void consider_mover(std::uint32_t i, const Body& bi, std::uint32_t mi, Pending& p) const;
-  void collide_moving_end(std::uint32_t i, std::uint32_t code);
-  /// The acceleration a body flies under: the field for balls, none for turtles.
-  Vec2 accel(std::uint32_t id) const { return is_turtle(id) ? Vec2{} : flight_.a; }
-  bool straight(std::uint32_t id) const { return !Flight::kAccelerates || is_turtle(id); }
-  /// A turtle standing still (balls under a field are never taken for one: this is for turtles).
-  static bool at_rest(const Body& b) { return b.v.x == 0.0 && b.v.y == 0.0; }
-  Vec2 pos_at(const Body& b, std::uint32_t id, double dt) const {
-    return is_turtle(id) ? b.x + dt * b.v : flight_.pos(b.x, b.v, dt);
-  }
-  Vec2 vel_at(const Body& b, std::uint32_t id, double dt) const {
-    return is_turtle(id) ? b.v : flight_.vel(b.v, dt);
-  }
-  double heading_at(std::size_t k, double t) const {
-    const TurtleRun& r = run_[k];
-    return r.heading0 + r.omega * (std::min(t, end_[nb_ + k]) - r.t_start);
-  }
-  Vec2 min_image(Vec2 d) const {
-    if (grid_.periodic()) {
-      // The arena is at least 3 cells (so 3 diameters) across: the nearest image is the one.
-      d.x -= width_ * std::round(d.x / width_);
-      d.y -= height_ * std::round(d.y / height_);
-    }
-    return d;
-  }
-  /// x - s.p1 for the image of x nearest to the segment. In a periodic arena the minimum image
-  /// relative to p1 is the wrong one near the far part of a wall longer than half the arena.
-  Vec2 rel_to_segment(Vec2 x, const Segment& s) const {
-    Vec2 best = min_image(x - s.p1);
-    if (!grid_.periodic()) return best;
-    auto distance = [&](Vec2 rel) { return norm(rel - std::clamp(dot(rel, s.u), 0.0, s.len) * s.u); };
-    double best_distance = distance(best);
-    const Vec2 base = best;
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const Vec2 rel = base + Vec2{dx * width_, dy * height_};
-        const double d = distance(rel);
-        if (d < best_distance) {
-          best = rel;
-          best_distance = d;
-        }
-      }
-    return best;
-  }
+  void sync(std::uint32_t i) { sync_body<F, kStep, kExtras>(bodies_, motion_, step_, i, now_); }
+  void link(std::uint32_t i, std::uint32_t cell) { bodies_.link(i, cell, is_turtle(i)); }
+  void unlink(std::uint32_t i) { bodies_.unlink(i, is_turtle(i)); }
 
-  // Bookkeeping.
-  void link(std::uint32_t i, std::uint32_t cell);
-  void unlink(std::uint32_t i);
-  void sync(std::uint32_t i);
-  void log(EventKind kind, std::uint32_t a, std::uint32_t b) {
-    if (log_) log_->push_back({t_base_ + now_, kind, a, b});
-  }
-  void note_contact(double depth, double radius) {
-    if (depth > max_contact_.depth) max_contact_.depth = depth;
-    if (depth / radius > max_contact_.relative) max_contact_.relative = depth / radius;
-  }
-
-  // Predict.
   struct CellXY {
     int ix, iy;
   };
@@ -227,268 +155,144 @@ class Engine final : public EngineBase {
     const int iy = c / stride;
     return {c - iy * stride, iy};
   }
+
+  // Predict: body i's earliest collision (neighbourhood.hpp chooses the candidates), and in exact
+  // mode the time it leaves its cell. (ix, iy): the body's cell, where the caller has it.
   void predict(std::uint32_t i) {
-    const CellXY c = cell_xy(body_[i].cell);
+    const CellXY c = cell_xy(bodies_.body[i].cell);
     predict(i, c.ix, c.iy);
   }
-  /// (ix, iy): the body's cell, passed in where the caller has it.
   void predict(std::uint32_t i, int ix, int iy);
-  void predict_strip(std::uint32_t i, int dir, int ix, int iy);
-  // Forced inline: these are the innermost loops of every prediction.
-  [[gnu::always_inline]] void scan_cell(std::uint32_t i, const Body& bi, int cell, Vec2 shift, Pending& p) const;
-  [[gnu::always_inline]] void consider_ball(std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift, Pending& p) const;
-  void consider_turtle(std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift, Pending& p) const;
-  void consider_ball_from_turtle(std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift, Pending& p) const;
-  void consider_wall(std::uint32_t i, const Body& bi, std::uint32_t w, Vec2 shift, Pending& p) const;
-  void consider_end(std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift, Pending& p) const;
   void predict_crossing(std::uint32_t i) {
-    const CellXY c = cell_xy(body_[i].cell);
+    const CellXY c = cell_xy(bodies_.body[i].cell);
     predict_crossing(i, c.ix, c.iy);
   }
   void predict_crossing(std::uint32_t i, int ix, int iy);
   /// When a turtle's command ends (kNever for a ball, or a turtle with no command running).
   double command_end(std::uint32_t i) const {
-    if constexpr (kExtras) return is_turtle(i) ? end_[i] : kNever;
+    if constexpr (kExtras) return is_turtle(i) ? bodies_.end[i] : kNever;
     else return kNever;
   }
   void schedule(std::uint32_t i) {
-    const Pending& p = pending_[i];
+    const Pending& p = bodies_.pending[i];
     heap_.set(i, std::min(std::min(p.t_coll, p.t_cross), command_end(i)));
   }
-  int step_rings(double reach) const {
-    return static_cast<int>(std::floor(reach / std::min(grid_.cell_w(), grid_.cell_h()))) + 1;
+  void repredict(std::uint32_t i) {
+    const CellXY c = cell_xy(bodies_.body[i].cell);
+    predict(i, c.ix, c.iy);
+    if constexpr (!kStep) predict_crossing(i, c.ix, c.iy);  // crossing times depend on the velocity just changed
+    schedule(i);
+  }
+  /// Body i's course changed outside a collision (a command, a push): predictions made with it
+  /// are stale, and "just collided, cannot meet again" no longer holds.
+  void new_course(std::uint32_t i) {
+    ++bodies_.body[i].count;
+    bodies_.last[i] = LastPartner::none();
+    if constexpr (kStep)
+      step_.dmax = std::max(step_.dmax, step_.travel[i] + path_length(bodies_.body[i].v, dt_ - now_));
+    repredict(i);
   }
 
-  // Apply.
+  // Serve: the loop and what it dispatches to.
   /// Serves events up to internal time `limit`. Returns false when it stopped early to rebase the
   /// clock (exact mode), so that the caller takes the limit afresh in the new internal time.
   bool process(double limit);
   void collide(std::uint32_t i);
-  void collide_balls(std::uint32_t i, std::uint32_t j);
-  void collide_with_turtle(std::uint32_t i, std::uint32_t j);
-  void collide_wall(std::uint32_t i, std::uint32_t w);
-  void collide_end(std::uint32_t i, std::uint32_t e);
+  void served(Changed c) {
+    repredict(c.first);
+    if (c.second != kNone) repredict(c.second);
+  }
   void end_command(std::uint32_t i);
-  void touch(std::uint32_t id, EventKind kind, std::uint32_t other, Vec2 normal);
-  void cross(std::uint32_t i);
-  void remove(std::uint32_t i);
-  void repredict(std::uint32_t i);
-  double restitution_for(std::uint32_t i) const;
-  Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n) const;
-  void after_change(std::uint32_t i);
+  void keyframe();
 
-  // Time.
+  // The exact clock (exact_clock.hpp).
+  void cross(std::uint32_t i);
+  /// Body i's centre has left an open arena: it is removed, with an `exit` event.
+  void exit(std::uint32_t i);
   double rebase();
+
+  // The step clock (step_clock.hpp).
   void begin_step();
   void finish_step();
 
-  Flight flight_;
-  double e_ = 1.0;
-  double tc_ = 0.0;
-  bool inelastic_ = false;
-  Boundary boundary_ = Boundary::none;
-  double width_ = 0.0, height_ = 0.0;
+  Motion<F, kExtras> motion_;
+  Kick kick_;  ///< step mode's field
+  Restitution restitution_;
+  Arena arena_;
   double dt_ = 0.0;
-  Vec2 kick_{};
 
-  std::uint32_t nb_ = 0;     ///< balls are ids [0, nb_), turtles [nb_, body_.size())
-  std::unique_ptr<Record[], FreeRecords> records_;  ///< one per body; the columns below view them
-  Column<Body, body_of> body_;
-  Column<double, mass_of> mass_;      ///< balls only
-  Column<double, command_end_of> end_;  ///< turtles only: when the command running ends
-  Column<LastPartner, last_of> last_;
-  Column<Pending, pending_of> pending_;
-  std::vector<double> last_time_;  ///< only when restitution < 1 (the TC rule)
-  std::vector<std::uint32_t> head_;         ///< balls by cell
-  std::vector<std::uint32_t> turtle_head_;  ///< turtles by cell (only when there are turtles)
-  std::vector<TurtleRun> run_;
-  std::vector<std::uint8_t> busy_;  ///< per turtle: a command is running (apart, so the idle scan reads 1 byte a turtle)
-  std::vector<TurtleContact> contacts_;
-  std::vector<Layers> layers_;       ///< per body (kExtras only)
-  bool bodies_layered_ = false;      ///< whether any body's layers differ from the defaults
-  std::vector<Layers> wall_layers_;  ///< per wall (kExtras only)
-  std::vector<Layers> end_layers_;   ///< per end: its walls' categories and masks together
-  std::vector<Mover> movers_;                 ///< moving walls (kExtras only), outside the grid
-  std::vector<std::vector<MoverKey>> keys_;   ///< their keyframes, by mover
-  std::vector<std::uint32_t> mover_of_;       ///< per wall: its mover, or kNone
-  std::vector<std::uint32_t> pushed_by_;      ///< per turtle: the mover pushing it, or kNone
-  std::vector<std::uint32_t> blinkers_;       ///< walls whose visibility changes in time
-  std::vector<std::size_t> blink_next_;       ///< per blinker: its next visibility key
-  std::vector<std::uint32_t> base_mask_;      ///< per wall: its mask while it is there
-  double next_key_ = kNever;                  ///< internal time of the next keyframe of any mover
-  EventQueue heap_;
-
-  std::vector<WallDef> wall_defs_;
-  std::vector<Segment> walls_;
-  std::vector<WallEnd> ends_;
+  BodyStore bodies_;
+  Walls walls_;
+  WallSchedule schedule_;
+  Turtles turtles_;
   CellGrid grid_;
   double cell_ = 0.0;  ///< the cell side the grid was built for (rebuilt with it when walls are added)
+  EventQueue heap_;
 
   double now_ = 0.0;     ///< internal time, relative to t_base_
   double t_base_ = 0.0;  ///< external time of internal time zero
   std::uint64_t events_since_rebase_ = 0;
   std::uint64_t rebase_every_ = 0;
+  StepState step_;  ///< step mode only
 
-  // Step mode.
-  std::uint64_t step_index_ = 0;
-  double rmax_ = 0.0;
-  double dmax_ = 0.0;              ///< largest path length of any body in this step
-  std::vector<double> travel_;     ///< path length so far in this step
-  mutable std::vector<std::uint32_t> stamp_;  ///< de-duplicates walls and ends in ring scans
-  mutable std::uint32_t scan_ = 0;
-
-  Stats stats_;
-  Overlap max_contact_;
-  std::vector<Event>* log_ = nullptr;
+  EventRecord record_;
 };
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<BallDef>* release) {
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+Engine<F, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<BallDef>* release) {
   if (auto problem = validate(def)) throw std::invalid_argument(problem->message);
   const EffectsDef& fx = def.effects;
-  if constexpr (kStep) kick_ = fx.gravity;
-  else flight_.a = fx.gravity;
-  e_ = fx.restitution;
-  tc_ = fx.tc;
-  inelastic_ = e_ < 1.0;
-  boundary_ = def.arena.boundary;
-  width_ = def.arena.width;
-  height_ = def.arena.height;
+  motion_ = Motion<F, kExtras>(def);
+  if constexpr (kStep) kick_ = Kick(fx);
+  restitution_.e = fx.restitution;
+  restitution_.tc = fx.tc;
+  restitution_.inelastic = fx.restitution < 1.0;
+  arena_ = {def.arena.width, def.arena.height, def.arena.boundary};
   dt_ = def.dt;
 
-  wall_defs_ = def.walls;
-  if (boundary_ == Boundary::walls)
-    for (auto& w : arena_walls(def.arena)) wall_defs_.push_back(w);
-  for (const auto& w : wall_defs_) {
-    walls_.push_back(make_segment(w.from, w.to));
-    if (boundary_ == Boundary::periodic) {
-      for (Vec2 p : {w.from, w.to})
-        if (p.x < 0.0 || p.x > width_ || p.y < 0.0 || p.y > height_)
-          throw std::invalid_argument("wall '" + w.id + "' reaches outside a periodic arena; keep walls inside it");
-    }
+  walls_ = Walls(def, kExtras);
+  for (const WallDef& w : walls_.defs) {
+    if (arena_.periodic() && (!inside_arena(def.arena, w.from) || !inside_arena(def.arena, w.to)))
+      throw std::invalid_argument("wall '" + w.id + "' reaches outside a periodic arena; keep walls inside it");
   }
-  // Moving walls are checked by every prediction rather than listed in the table.
-  mover_of_.assign(wall_defs_.size(), kNone);
-  for (std::uint32_t w = 0; w < wall_defs_.size(); ++w) {
-    const WallDef& wd = wall_defs_[w];
-    if (wd.keys.empty()) continue;
-    if (boundary_ == Boundary::periodic) throw std::invalid_argument("wall '" + wd.id + "' moves: moving walls are not supported in a periodic arena yet");
-    mover_of_[w] = static_cast<std::uint32_t>(movers_.size());
-    movers_.push_back(Mover{w, 0, wd.from, wd.to - wd.from, 0.0, {}, {}});
-    keys_.push_back(mover_keys(wd));
-  }
-  // Wall ends, one per distinct point: a corner shared by two walls is one collision object.
-  for (std::uint32_t w = 0; w < wall_defs_.size(); ++w)
-    if (mover_of_[w] == kNone)
-      for (Vec2 p : {wall_defs_[w].from, wall_defs_[w].to}) ends_.push_back({p, w});
-  std::stable_sort(ends_.begin(), ends_.end(), [](const WallEnd& a, const WallEnd& b) {
-    return a.p.x != b.p.x ? a.p.x < b.p.x : a.p.y < b.p.y;
-  });
-  ends_.erase(std::unique(ends_.begin(), ends_.end(), [](const WallEnd& a, const WallEnd& b) { return a.p == b.p; }),
-              ends_.end());
+  for (const WallDef& w : walls_.defs)
+    if (!w.keys.empty() && arena_.periodic())
+      throw std::invalid_argument("wall '" + w.id + "' moves: moving walls are not supported in a periodic arena yet");
+  schedule_ = WallSchedule(walls_);
+  for (const auto& b : def.balls) step_.rmax = std::max(step_.rmax, b.radius);
+  for (const auto& t : def.turtles) step_.rmax = std::max(step_.rmax, t.radius);
+  cell_ = choose_cell_size(def, kStep ? Mode::step : Mode::exact);
+  bodies_ = BodyStore(def, release, kExtras);
+  turtles_ = Turtles(def.turtles);
+  const std::size_t n = bodies_.size();
 
-  nb_ = static_cast<std::uint32_t>(def.balls.size());
-  const std::size_t n = def.balls.size() + def.turtles.size();
-  for (const auto& b : def.balls) rmax_ = std::max(rmax_, b.radius);
-  for (const auto& t : def.turtles) rmax_ = std::max(rmax_, t.radius);
-  const double cell = choose_cell_size(def, kStep ? Mode::step : Mode::exact);
-  // The records first, then (for a consumed scene) free the ball list before anything else per
-  // ball or per cell is allocated. While the scene is alive only what the records need from it
-  // (48 bytes a ball) is written, packed at the records' far end, whose pages alone are touched;
-  // once the scene is gone the records are laid out front to back over it (record i ends before
-  // ball i + 1's packed data begins). So the peak is the scene plus 48 bytes a ball, not plus 128.
-  struct Packed {
-    Vec2 x, v;
-    double r, mass;
-  };
-  static_assert(sizeof(Record) >= sizeof(Packed) && sizeof(Record) % alignof(Packed) == 0);
-  records_.reset(static_cast<Record*>(::operator new(n * sizeof(Record), std::align_val_t{alignof(Record)})));
-  char* const raw = reinterpret_cast<char*>(records_.get());
-  char* const packed = raw + n * (sizeof(Record) - sizeof(Packed));
-  if constexpr (kExtras) {
-    layers_.resize(n);
-    for (std::uint32_t i = 0; i < nb_; ++i) layers_[i] = def.balls[i].layers;
-    for (std::size_t k = 0; k < def.turtles.size(); ++k) layers_[nb_ + k] = def.turtles[k].layers;
-    bodies_layered_ = std::any_of(layers_.begin(), layers_.end(), [](const Layers& l) { return l != Layers{}; });
-  }
-  for (std::uint32_t i = 0; i < nb_; ++i) {
-    const BallDef& d = def.balls[i];
-    new (packed + i * sizeof(Packed)) Packed{d.pos, d.vel, d.radius, d.mass};
-  }
-  if (release) std::vector<BallDef>().swap(*release);
-  for (std::uint32_t i = 0; i < n; ++i) {
-    Packed d{};
-    if (i < nb_) std::memcpy(&d, packed + i * sizeof(Packed), sizeof(Packed));
-    Record* rec = new (raw + i * sizeof(Record)) Record{};
-    rec->body.x = d.x;
-    rec->body.v = d.v;
-    rec->body.r = d.r;
-    rec->mass_or_end = d.mass;
-  }
-  body_ = {records_.get(), n};
-  mass_ = {records_.get(), nb_};
-  end_ = {records_.get(), n};
-  last_ = {records_.get(), n};
-  pending_ = {records_.get(), n};
-  run_.resize(def.turtles.size());
-  busy_.assign(def.turtles.size(), 0);
-  for (std::size_t k = 0; k < def.turtles.size(); ++k) {
-    const TurtleDef& d = def.turtles[k];
-    const auto id = static_cast<std::uint32_t>(nb_ + k);
-    body_[id].x = d.pos;
-    body_[id].r = d.radius;
-    end_[id] = kNever;
-    TurtleRun& r = run_[k];
-    r.heading0 = d.heading;
-    r.speed = d.speed;
-    r.turn_rate = d.turn_rate;
-    r.bounce = d.bounce;
-  }
-
-  const bool periodic = boundary_ == Boundary::periodic;
-  cell_ = cell;
-  std::vector<bool> moving(wall_defs_.size());
-  for (std::uint32_t w = 0; w < wall_defs_.size(); ++w) moving[w] = mover_of_[w] != kNone;
-  grid_ = CellGrid(width_, height_, cell, periodic, walls_, ends_, moving);
-  if (periodic && (grid_.nx() < 3 || grid_.ny() < 3))
-    throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell) +
+  grid_ = CellGrid(arena_.width, arena_.height, cell_, arena_.periodic(), walls_.segments, walls_.ends, walls_.moving());
+  if (arena_.periodic() && (grid_.nx() < 3 || grid_.ny() < 3))
+    throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell_) +
                                 "); enlarge the arena or use smaller balls");
 
-  if (inelastic_) last_time_.assign(n, -kNever);
-  head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
-  if constexpr (kExtras) turtle_head_.assign(static_cast<std::size_t>(grid_.cell_count()), kNone);
-  heap_.reset(n > 0 ? &records_[0].node : nullptr, sizeof(Record), n);
-  if constexpr (kStep) {
-    travel_.assign(n, 0.0);
-    stamp_.assign(walls_.size() * 9 + ends_.size() * 9, 0);
-  }
-  if constexpr (kExtras) {
-    for (const auto& w : wall_defs_) wall_layers_.push_back(w.layers);
-    end_layers_.assign(ends_.size(), Layers{0u, 0u});
-    for (const auto& w : wall_defs_)
-      for (Vec2 p : {w.from, w.to}) add_end_layers(p, w.layers);
-  }
-  // Balls, then turtles, each in list order, as the cell lists have always been built.
-  for (std::uint32_t i = 0; i < n; ++i) link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(body_[i].x)));
-  if constexpr (kExtras) {
-    base_mask_.resize(wall_defs_.size());
-    for (std::uint32_t w = 0; w < wall_defs_.size(); ++w) {
-      base_mask_[w] = wall_layers_[w].mask;
-      const auto& vis = wall_defs_[w].visibility;
-      if (vis.empty()) continue;
+  if constexpr (kExtras)
+    for (const WallDef& w : walls_.defs) {
       double prev = -1.0;
-      for (const VisibilityKey& k : vis) {
+      for (const VisibilityKey& k : w.visibility) {
         if (!(k.t > prev) || k.t < 0.0)
-          throw std::invalid_argument("wall '" + wall_defs_[w].id + "': visibility times must increase and be >= 0");
+          throw std::invalid_argument("wall '" + w.id + "': visibility times must increase and be >= 0");
         prev = k.t;
       }
-      blinkers_.push_back(w);
-      blink_next_.push_back(0);
     }
-    apply_visibility();
-    pushed_by_.assign(def.turtles.size(), kNone);
-    for (Mover& m : movers_) aim_mover(m);
-    refresh_next_key();
+  if (restitution_.inelastic) restitution_.last_time.assign(n, -kNever);
+  bodies_.make_lists(static_cast<std::size_t>(grid_.cell_count()), kExtras);
+  heap_.reset(bodies_.nodes(), sizeof(Record), n);
+  if constexpr (kStep) {
+    step_.travel.assign(n, 0.0);
+    step_.stamp.assign(walls_.segments.size() * 9 + walls_.ends.size() * 9, 0);
+  }
+  // Balls, then turtles, each in list order, as the cell lists have always been built.
+  for (std::uint32_t i = 0; i < n; ++i) link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(bodies_.body[i].x)));
+  if constexpr (kExtras) {
+    schedule_.apply_visibility(walls_, now_, t_base_);
+    turtles_.pushed_by.assign(turtles_.size(), kNone);
+    schedule_.aim_all(walls_, t_base_);
   }
   rebase_every_ = std::max<std::uint64_t>(4 * n, 4096);
   if constexpr (kStep) {
@@ -502,43 +306,34 @@ Engine<Flight, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vect
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::link(std::uint32_t i, std::uint32_t cell) {
-  Body& b = body_[i];
-  std::uint32_t& head = is_turtle(i) ? turtle_head_[cell] : head_[cell];
-  b.cell = cell;
-  b.prev = kNone;
-  b.next = head;
-  if (b.next != kNone) body_[b.next].prev = i;
-  head = i;
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::predict(std::uint32_t i, int ix, int iy) {
+  const Body& bi = bodies_.body[i];
+  Pending& p = bodies_.pending[i];
+  // A turtle's command end is not a candidate here: it is kept apart (command_end()), so that a
+  // turtle whose command starts or ends without moving it keeps the collisions predicted for it.
+  p.t_coll = kNever;
+  p.kind = Partner::none;
+  if constexpr (!kStep) look_around<kBallBall>(look(), grid_, i, bi, ix, iy, p);
+  else look_along_step<kBallBall>(look(), grid_, step_, dt_, i, bi, ix, iy, p);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::unlink(std::uint32_t i) {
-  Body& b = body_[i];
-  if (b.prev != kNone) body_[b.prev].next = b.next;
-  else (is_turtle(i) ? turtle_head_[b.cell] : head_[b.cell]) = b.next;
-  if (b.next != kNone) body_[b.next].prev = b.prev;
-  b.next = b.prev = kNone;
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::predict_crossing(std::uint32_t i, int ix, int iy) {
+  const Body& b = bodies_.body[i];
+  Pending& p = bodies_.pending[i];
+  const CellExit e = motion_.cell_exit(i, b.x, b.v, cell_box(grid_, ix, iy));
+  p.t_cross = now_ + e.t;
+  p.cross_dir = e.dir;
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::sync(std::uint32_t i) {
-  Body& b = body_[i];
-  const double dt = now_ - b.t;
-  if constexpr (kStep) travel_[i] += path_length(b.v, dt);
-  b.x = pos_at(b, i, dt);
-  b.v = vel_at(b, i, dt);
-  b.t = now_;
-}
-
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-bool Engine<Flight, kBallBall, kStep, kExtras>::process(double limit) {
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+bool Engine<F, kBallBall, kStep, kExtras>::process(double limit) {
   for (;;) {
     const double next_event = heap_.empty() ? kNever : heap_.top_key();
     if constexpr (kExtras) {
       // A moving wall reaching a keyframe changes course: everything predicts again.
-      if (next_key_ <= limit && next_key_ <= next_event) {
+      if (schedule_.next_key <= limit && schedule_.next_key <= next_event) {
         keyframe();
         continue;
       }
@@ -546,7 +341,7 @@ bool Engine<Flight, kBallBall, kStep, kExtras>::process(double limit) {
     if (next_event > limit) break;
     const std::uint32_t i = heap_.top_id();
     now_ = heap_.top_key();
-    ++stats_.events;
+    ++record_.stats.events;
     // The next events most likely belong to the top's children in the served bucket (or to the
     // next bucket): start loading their state now, which hides a cache miss or two per event once
     // the bodies outgrow the cache. (Written out rather than through a callback: GCC 12 drops the
@@ -554,10 +349,10 @@ bool Engine<Flight, kBallBall, kStep, kExtras>::process(double limit) {
     for (std::size_t n = 0; n < 2; ++n) {
       const std::uint32_t k = heap_.next_id(n);
       if (k == EventQueue::kAbsent) continue;
-      __builtin_prefetch(&body_[k]);
-      __builtin_prefetch(&pending_[k]);
+      __builtin_prefetch(&bodies_.body[k]);
+      __builtin_prefetch(&bodies_.pending[k]);
     }
-    const Pending& p = pending_[i];
+    const Pending& p = bodies_.pending[i];
     // A command's end goes first at a tie with a collision or a crossing.
     if (const double t_end = command_end(i); t_end <= p.t_coll && t_end <= p.t_cross) end_command(i);
     else if (p.t_coll <= p.t_cross) collide(i);
@@ -572,26 +367,116 @@ bool Engine<Flight, kBallBall, kStep, kExtras>::process(double limit) {
   return true;
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::repredict(std::uint32_t i) {
-  const CellXY c = cell_xy(body_[i].cell);
-  predict(i, c.ix, c.iy);
-  if constexpr (!kStep) predict_crossing(i, c.ix, c.iy);  // crossing times depend on the velocity just changed
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
+  const Pending p = bodies_.pending[i];
+  switch (p.kind) {
+    case Partner::body:
+      if (bodies_.body[p.partner].count != p.partner_count) {
+        ++record_.stats.stale;
+        sync(i);
+        predict(i);
+        schedule(i);
+        return;
+      }
+      if (is_turtle(i) || is_turtle(p.partner)) served(apply_turtle_body(parts(), i, p.partner));
+      else served(apply_ball_ball(parts(), i, p.partner));
+      return;
+    case Partner::wall: served(apply_wall(parts(), i, p.partner)); return;
+    case Partner::end: served(apply_end(parts(), i, p.partner)); return;
+    case Partner::moving_end: served(apply_moving_end(parts(), i, p.partner)); return;
+    case Partner::none: break;
+  }
+  // A body with nothing pending has an infinite key and is never popped.
+  sync(i);
+  predict(i);
   schedule(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::after_change(std::uint32_t i) {
-  ++body_[i].count;
-  if (inelastic_) last_time_[i] = now_;
-  if constexpr (kStep) {
-    // The rest of the step is walked at the new speed.
-    dmax_ = std::max(dmax_, travel_[i] + path_length(body_[i].v, dt_ - now_));
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::end_command(std::uint32_t i) {
+  // A turtle's command (or its coasting after a bounce) has run its course.
+  sync(i);
+  if (!turtles_.finish(i - bodies_.balls(), bodies_.body[i], bodies_.end[i])) {
+    // The disc stood still and stays still: only its key loses the command's end.
+    schedule(i);
+    return;
+  }
+  parts().changed(i);
+  bodies_.last[i] = LastPartner::none();
+  repredict(i);
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, const TurtleCommand& c) {
+  if (k >= turtles_.size()) throw std::out_of_range("command_turtle: no turtle " + std::to_string(k));
+  const auto id = static_cast<std::uint32_t>(bodies_.balls() + k);
+  if (bodies_.body[id].cell == kNone) return;  // it has left the arena
+  sync(id);
+  if (!turtles_.command(k, c, bodies_.body[id], bodies_.end[id], now_)) {
+    // The predictions made with it still hold; only its key takes the command's end.
+    schedule(id);
+    return;
+  }
+  new_course(id);
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::keyframe() {
+  now_ = schedule_.next_key;
+  ++record_.stats.events;
+  schedule_.take_keyframe(walls_, now_, t_base_);
+  const std::uint32_t nb = bodies_.balls();
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    Body& b = bodies_.body[i];
+    if (b.cell == kNone) continue;
+    sync(i);
+    if (is_turtle(i) && turtles_.pushed_by[i - nb] != kNone) {
+      // The push ends with the segment of motion that made it; the turtle stands where it is.
+      b.v = {};
+      turtles_.pushed_by[i - nb] = kNone;
+      ++b.count;
+    }
+    // "Just collided, cannot meet again" does not survive a change of the wall's velocity.
+    const LastPartner last = bodies_.last[i];
+    if (!last.is_none() && (last.kind() == Partner::moving_end ||
+                            (last.kind() == Partner::wall && walls_.mover_of[last.index()] != kNone)))
+      bodies_.last[i] = LastPartner::none();
+    repredict(i);
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::advance_to(double t) {
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+std::size_t Engine<F, kBallBall, kStep, kExtras>::add_wall(const WallDef& wall) {
+  walls_.check_new(wall, arena_.def());
+  const Segment seg = make_segment(wall.from, wall.to);
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    const Body& b = bodies_.body[i];
+    if (b.cell == kNone) continue;
+    if constexpr (kExtras)
+      if (!bodies_.layers[i].collides_with(wall.layers)) continue;  // it passes through this wall
+    const Vec2 rel = arena_.rel_to_segment(motion_.pos(b, i, now_ - b.t), seg);
+    const double foot = std::clamp(dot(rel, seg.u), 0.0, seg.len);
+    const double gap = norm(rel - foot * seg.u) - b.r;
+    if (gap < 0.0)
+      throw std::invalid_argument("wall '" + wall.id + "' would overlap " + (is_turtle(i) ? "a turtle" : "a ball") +
+                                  " (by " + std::to_string(-gap) + "); lay it clear of bodies");
+  }
+  const std::uint32_t w = walls_.add(wall, kExtras);
+  grid_ = CellGrid(arena_.width, arena_.height, cell_, grid_.periodic(), walls_.segments, walls_.ends,
+                   walls_.moving());  // same cells, new lists
+  if constexpr (kStep) step_.stamp.assign(walls_.segments.size() * 9 + walls_.ends.size() * 9, 0);
+  // Every prediction may now meet the new wall first.
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_.body[i].cell == kNone) continue;
+    sync(i);
+    repredict(i);
+  }
+  return w;
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
   if (!(t >= time())) throw std::invalid_argument("advance_to: time " + std::to_string(t) + " is before the world's time");
   if constexpr (kStep) {
     for (;;) {
@@ -615,18 +500,11 @@ void Engine<Flight, kBallBall, kStep, kExtras>::advance_to(double t) {
   }
 }
 
-
 }  // namespace
 }  // namespace turtlegas::sim::detail
 
-#include "added_walls.hpp"
-#include "checks.hpp"
 #include "exact_clock.hpp"
-#include "interactions.hpp"
-#include "neighbourhood.hpp"
 #include "step_clock.hpp"
-#include "turtle_commands.hpp"
-#include "wall_schedule.hpp"
 
 namespace turtlegas::sim::detail {
 

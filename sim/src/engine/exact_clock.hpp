@@ -1,77 +1,76 @@
 // SPDX-License-Identifier: MIT
-// The exact clock: cell crossings, exits, and the rebase of internal time.
-// Part of engine.hpp (members of Engine), included at its end.
+// The exact clock: cell crossings, exits from an open arena, and the rebase that keeps internal
+// times small. (Part of the Engine, whose loop serves these events: included at engine.hpp's end.)
 #pragma once
+
+#include "engine.hpp"
 
 namespace turtlegas::sim::detail {
 namespace {
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::cross(std::uint32_t i) {
-  ++stats_.cell_crossings;
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::cross(std::uint32_t i) {
+  ++record_.stats.cell_crossings;
   sync(i);
-  Body& b = body_[i];
-  const int dir = pending_[i].cross_dir;
+  Body& b = bodies_.body[i];
+  const int dir = bodies_.pending[i].cross_dir;
   auto [ix, iy] = cell_xy(b.cell);
   ix += dir == 0 ? -1 : (dir == 1 ? 1 : 0);
   iy += dir == 2 ? -1 : (dir == 3 ? 1 : 0);
   if (ix < 1 || ix > grid_.nx() || iy < 1 || iy > grid_.ny()) {
-    if (boundary_ != Boundary::periodic) {
+    if (!arena_.periodic()) {
       // The centre has left the arena. (With boundary walls this happens only if the walls were
       // missed; the body is removed rather than left to fly through the table.)
-      const bool turtle = is_turtle(i);
-      log(EventKind::exit, turtle ? i - nb_ : i, turtle ? 1 : 0);
-      ++stats_.exits;
-      remove(i);
+      unlink(i);
+      exit(i);
       return;
     }
-    if (ix < 1) { ix = grid_.nx(); b.x.x += width_; }
-    else if (ix > grid_.nx()) { ix = 1; b.x.x -= width_; }
-    if (iy < 1) { iy = grid_.ny(); b.x.y += height_; }
-    else if (iy > grid_.ny()) { iy = 1; b.x.y -= height_; }
+    if (ix < 1) { ix = grid_.nx(); b.x.x += arena_.width; }
+    else if (ix > grid_.nx()) { ix = 1; b.x.x -= arena_.width; }
+    if (iy < 1) { iy = grid_.ny(); b.x.y += arena_.height; }
+    else if (iy > grid_.ny()) { iy = 1; b.x.y -= arena_.height; }
   }
   unlink(i);
   link(i, static_cast<std::uint32_t>(grid_.index(ix, iy)));
-  predict_strip(i, dir, ix, iy);
+  look_at_strip<kBallBall>(look(), grid_, i, b, dir, ix, iy, bodies_.pending[i]);
   predict_crossing(i, ix, iy);
   schedule(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::remove(std::uint32_t i) {
-  unlink(i);
-  body_[i].cell = kNone;
-  ++body_[i].count;  // predictions made against it are now stale
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::exit(std::uint32_t i) {
+  // (Unlinked already.) The log names a turtle by its own index, with b = 1 (events.hpp).
+  const bool turtle = is_turtle(i);
+  const std::uint32_t nb = bodies_.balls();
+  record_.note(t_base_ + now_, EventKind::exit, turtle ? i - nb : i, turtle ? 1 : 0);
+  ++record_.stats.exits;
+  Body& b = bodies_.body[i];
+  b.cell = kNone;
+  ++b.count;  // predictions made against it are now stale
   heap_.remove(i);
-  if (is_turtle(i)) {
-    busy_[i - nb_] = 0;
-    end_[i] = kNever;
-    body_[i].v = {};
-  }
+  if (turtle) turtles_.exit(i - nb, b, bodies_.end[i]);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-double Engine<Flight, kBallBall, kStep, kExtras>::rebase() {
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+double Engine<F, kBallBall, kStep, kExtras>::rebase() {
   // Keep internal times small: absolute times would lose a bit of position per doubling of t.
   // All bodies are brought to now, which becomes internal zero. Amortised O(1) per event.
   events_since_rebase_ = 0;
   const double shift = now_;
   if (shift == 0.0) return 0.0;
-  for (std::uint32_t i = 0; i < body_.size(); ++i) {
-    if (body_[i].cell == kNone) continue;
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_.body[i].cell == kNone) continue;
     sync(i);
-    body_[i].t = 0.0;
-    pending_[i].t_coll -= shift;
-    pending_[i].t_cross -= shift;
-    if (inelastic_) last_time_[i] -= shift;
+    bodies_.body[i].t = 0.0;
+    bodies_.pending[i].t_coll -= shift;
+    bodies_.pending[i].t_cross -= shift;
+    if (restitution_.inelastic) restitution_.last_time[i] -= shift;
   }
-  for (std::size_t k = 0; k < run_.size(); ++k) {
-    run_[k].t_start -= shift;
-    end_[nb_ + k] -= shift;
-  }
-  for (Mover& m : movers_) m.t_ref -= shift;
+  turtles_.shift_times(shift);
+  for (std::size_t k = 0; k < turtles_.size(); ++k) bodies_.end[bodies_.balls() + k] -= shift;
+  schedule_.shift_times(shift);
   t_base_ += shift;
-  refresh_next_key();
+  schedule_.refresh_next_key(walls_, t_base_);
   now_ = 0.0;
   heap_.shift_keys(shift);
   return shift;

@@ -13,8 +13,9 @@
 #include "flights.hpp"
 #include "variant.hpp"
 
-// flight, balls, mode, extras. Step mode flies straight and kicks between steps, so its rows all
-// use FreeFlight.
+// flight, balls, mode, extras; within a mode the flights in order of cost (the factory takes the
+// first row that serves the scene). Step mode flies straight and kicks between steps, so its rows
+// all use FreeFlight (the engine refuses anything else).
 #define TURTLEGAS_ENGINE_VARIANTS(ROW)         \
   ROW(FreeFlight, balls_meet, exact, plain)    \
   ROW(FreeFlight, balls_meet, exact, extras)   \
@@ -49,14 +50,12 @@ bool needs_extras(const WorldDef& def) {
   return !def.turtles.empty() || layered;
 }
 
-template <class Flight>
-bool is_flight(const WorldDef& def, Mode mode) {
-  // Step mode flies straight (its field is a kick between steps); exact mode flies parabolas
-  // under gravity.
-  const bool gravity = def.effects.gravity.x != 0.0 || def.effects.gravity.y != 0.0;
-  const bool parabolas = mode == Mode::exact && gravity;
-  if constexpr (Flight::kAccelerates) return parabolas;
-  else return !parabolas;
+/// Whether a row's flight serves the scene: in exact mode when the flight fits its effects (the
+/// rows are in order of cost, so the first that fits is the cheapest); in step mode always (it
+/// flies straight and kicks between steps).
+template <Flight F>
+bool flight_serves(const WorldDef& def, bool step) {
+  return step || F::fits(def.effects);
 }
 
 std::unique_ptr<EngineBase> make(const WorldDef& def, Mode mode, std::vector<BallDef>* release) {
@@ -64,8 +63,8 @@ std::unique_ptr<EngineBase> make(const WorldDef& def, Mode mode, std::vector<Bal
   const bool step = mode == Mode::step;
   const bool extras = needs_extras(def);
 #define TURTLEGAS_TRY_ROW(flight, balls, mode_, extras_)                                                \
-  if (is_flight<flight>(def, mode) && ball_ball == variant::balls && step == variant::mode_ &&          \
-      extras == variant::extras_)                                                                       \
+  if (step == variant::mode_ && ball_ball == variant::balls && extras == variant::extras_ &&            \
+      flight_serves<flight>(def, step))                                                                 \
     return make_variant<flight, variant::balls, variant::mode_, variant::extras_>(def, release);
   TURTLEGAS_ENGINE_VARIANTS(TURTLEGAS_TRY_ROW)
 #undef TURTLEGAS_TRY_ROW

@@ -1,322 +1,296 @@
 // SPDX-License-Identifier: MIT
-// Interactions, per pair kind: predict (consider_*), apply (collide_*), and the contact depth each records.
-// Part of engine.hpp (members of Engine), included at its end.
+// Interactions, one section per pair kind: ball-ball, turtle-body (a turtle with a ball or
+// another turtle), body-wall, body-wall end, and moving walls (their interior and their two
+// ends). Each has
+//   - predict: the time of impact of one candidate pair, offered to the body's Pending (it reads
+//     a Look; the flight chooses the time-of-impact function and whether the pair's last
+//     collision rules it out);
+//   - apply: the response at the contact, with its record (it receives Parts; it returns the
+//     bodies whose course changed, which the engine then predicts afresh);
+//   - validate: how deep the contact was when it happened (EventRecord::note_contact), the
+//     engine's running check on its own times of impact.
+// The neighbourhood scans (neighbourhood.hpp) decide which candidates each body looks at.
 #pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "parts.hpp"
+#include "turtlegas/sim/toi.hpp"
 
 namespace turtlegas::sim::detail {
 namespace {
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-inline void Engine<Flight, kBallBall, kStep, kExtras>::consider_ball(std::uint32_t i, const Body& bi, std::uint32_t j,
-                                                               Vec2 shift, Pending& p) const {
-  // i is a ball here, j a ball.
-  if (j == i || !meets(i, j)) return;
-  const Body& bj = body_[j];
-  const double dtj = now_ - bj.t;
-  // Under uniform gravity both balls fall alike, so their relative motion is a straight line.
-  const Vec2 r = flight_.pos(bj.x, bj.v, dtj) + shift - bi.x;
-  const Vec2 v = flight_.vel(bj.v, dtj) - bi.v;
-  const double t = now_ + toi_disc_disc(r, v, bi.r + bj.r);
-  if (t < p.t_coll) {
-    // Checked only for a winner: most candidates miss, and last_[j] is a cache miss.
-    if (last_[i] == LastPartner::of(Partner::body, j) && last_[j] == LastPartner::of(Partner::body, i)) return;
-    p.take(t, Partner::body, j, bj.count);
-  }
-}
+/// The bodies an event changed, to be predicted afresh in this order.
+struct Changed {
+  std::uint32_t first;
+  std::uint32_t second = kNone;
+};
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::consider_turtle(std::uint32_t i, const Body& bi, std::uint32_t j,
-                                                                 Vec2 shift, Pending& p) const {
-  // j is a turtle (straight flight); i a ball or a turtle.
-  if (j == i || !meets(i, j)) return;
-  const Body& bj = body_[j];
-  const Vec2 rel = bi.x - (bj.x + (now_ - bj.t) * bj.v + shift);
-  const Vec2 v = bi.v - bj.v;
-  double dt;
-  if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(rel, v, flight_.a, bi.r + bj.r, p.t_coll - now_);
-  else dt = toi_disc_disc(rel, v, bi.r + bj.r);
-  const double t = now_ + dt;
-  if (t < p.t_coll) {
-    if (straight(i) && last_[i] == LastPartner::of(Partner::body, j) && last_[j] == LastPartner::of(Partner::body, i)) return;
-    p.take(t, Partner::body, j, bj.count);
-  }
-}
+// ---------------------------------------------------------------------------------------------
+// Ball-ball
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::consider_wall(std::uint32_t i, const Body& bi, std::uint32_t w,
-                                                               Vec2 shift, Pending& p) const {
-  if (!meets_wall(i, w) || (straight(i) && last_[i] == LastPartner::of(Partner::wall, w))) return;
-  const Segment& s = walls_[w];
-  // Relative to the wall's first end, so walls far from the origin lose nothing.
-  const double t = now_ + toi_disc_segment(bi.x - (s.p1 + shift), bi.v, accel(i), s, bi.r);
+/// Ball i (at its own time, now) and ball j seen through `shift` (a periodic image).
+template <Flight F, bool kExtras>
+[[gnu::always_inline]] inline void predict_ball_ball(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi,
+                                                     std::uint32_t j, Vec2 shift, Pending& p) {
+  if (j == i || !l.meets(i, j)) return;
+  const Body& bj = l.bodies.body[j];
+  const double dtj = l.now - bj.t;
+  const F& f = l.motion.flight();
+  const Vec2 r = f.pos(j, bj.x, bj.v, dtj) + shift - bi.x;
+  const Vec2 v = f.vel(j, bj.v, dtj) - bi.v;
+  const double t = l.now + f.toi_balls(i, j, r, v, bi.r + bj.r, p.t_coll - l.now);
   if (t < p.t_coll) {
-    p.take(t, Partner::wall, w);
-  }
-}
-
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::consider_end(std::uint32_t i, const Body& bi, std::uint32_t e,
-                                                              Vec2 shift, Pending& p) const {
-  if (!meets_end(i, e) || (straight(i) && last_[i] == LastPartner::of(Partner::end, e))) return;
-  const Vec2 rel = bi.x - (ends_[e].p + shift);
-  double dt;
-  if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(rel, bi.v, flight_.a, bi.r, p.t_coll - now_);
-  else dt = toi_disc_point(rel, bi.v, bi.r);
-  const double t = now_ + dt;
-  if (t < p.t_coll) {
-    p.take(t, Partner::end, e);
-  }
-}
-
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::consider_ball_from_turtle(std::uint32_t i, const Body& bi,
-                                                                           std::uint32_t j, Vec2 shift,
-                                                                           Pending& p) const {
-  // i is a turtle (straight flight), j a ball (which may fall).
-  if (!meets(i, j)) return;
-  const Body& bj = body_[j];
-  const double dtj = now_ - bj.t;
-  const Vec2 rel = flight_.pos(bj.x, bj.v, dtj) + shift - bi.x;
-  const Vec2 v = flight_.vel(bj.v, dtj) - bi.v;
-  double dt;
-  if constexpr (Flight::kAccelerates) dt = toi_disc_point_accel(rel, v, flight_.a, bi.r + bj.r, p.t_coll - now_);
-  else dt = toi_disc_disc(rel, v, bi.r + bj.r);
-  const double t = now_ + dt;
-  if (t < p.t_coll) {
-    if (!Flight::kAccelerates && last_[i] == LastPartner::of(Partner::body, j) && last_[j] == LastPartner::of(Partner::body, i)) return;
-    p.take(t, Partner::body, j, bj.count);
-  }
-}
-
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
-  const Pending p = pending_[i];
-  switch (p.kind) {
-    case Partner::body:
-      if (body_[p.partner].count != p.partner_count) {
-        ++stats_.stale;
-        sync(i);
-        predict(i);
-        schedule(i);
-        return;
-      }
-      if (is_turtle(i) || is_turtle(p.partner)) collide_with_turtle(i, p.partner);
-      else collide_balls(i, p.partner);
+    // Checked only for a winner: most candidates miss, and last[j] is a cache miss.
+    if (f.straight_pair(i, j) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
+        l.bodies.last[j] == LastPartner::of(Partner::body, i))
       return;
-    case Partner::wall: collide_wall(i, p.partner); return;
-    case Partner::end: collide_end(i, p.partner); return;
-    case Partner::moving_end: collide_moving_end(i, p.partner); return;
-    case Partner::none: break;
+    p.take(t, Partner::body, j, bj.count);
   }
-  // A body with nothing pending has an infinite key and is never popped.
-  sync(i);
-  predict(i);
-  schedule(i);
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-double Engine<Flight, kBallBall, kStep, kExtras>::restitution_for(std::uint32_t i) const {
-  // The TC rule (Luding & McNamara): a ball that collided less than tc ago collides elastically,
-  // so a cluster cannot collapse into infinitely many collisions in finite time.
-  return now_ - last_time_[i] < tc_ ? 1.0 : e_;
-}
-
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-Vec2 Engine<Flight, kBallBall, kStep, kExtras>::bounce(std::uint32_t i, Vec2 v, Vec2 n) const {
-  // n: unit contact normal pointing from the obstacle to the ball; v relative to the obstacle.
-  // Walls take the plain restitution: the TC rule is for ball clusters; a ball pressed onto a wall
-  // is kept from collapsing by the rest threshold below.
-  const double w = -dot(v, n);
-  double w_out = e_ * w;
-  if constexpr (Flight::kAccelerates) {
-    // The rest threshold: a ball pressed onto the obstacle by the field leaves it at least fast
-    // enough to stay away for tc. Without it an inelastic ball would bounce infinitely often before
-    // coming to rest, and a ball at rest would sink.
-    const double a_n = dot(accel(i), n);
-    if (a_n < 0.0) w_out = std::max(w_out, -a_n * tc_ / 2.0);
-  }
-  return v + (w + w_out) * n;
-}
-
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::collide_balls(std::uint32_t i, std::uint32_t j) {
-  sync(i);
-  sync(j);
-  Body& a = body_[i];
-  Body& b = body_[j];
-  const Vec2 F = min_image(b.x - a.x);
+template <Flight Fl, bool kStep, bool kExtras>
+Changed apply_ball_ball(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, std::uint32_t j) {
+  w.sync(i);
+  w.sync(j);
+  Body& a = w.bodies.body[i];
+  Body& b = w.bodies.body[j];
+  const Vec2 F = w.arena.min_image(b.x - a.x);
   const double sigma = a.r + b.r;
-  note_contact(sigma - norm(F), std::min(a.r, b.r));
-  double e = e_;
-  if (inelastic_) e = std::max(restitution_for(i), restitution_for(j));
-  respond_disc_disc(a.v, b.v, mass_[i], mass_[j], F, e);
-  ++stats_.ball_ball;
-  log(EventKind::ball_ball, i, j);
-  after_change(i);
-  after_change(j);
-  last_[i] = LastPartner::of(Partner::body, j);
-  last_[j] = LastPartner::of(Partner::body, i);
-  repredict(i);
-  repredict(j);
+  w.record.note_contact(sigma - norm(F), std::min(a.r, b.r));
+  const double e = w.restitution.for_pair(i, j, w.now);
+  respond_disc_disc(a.v, b.v, w.bodies.mass[i], w.bodies.mass[j], F, e);
+  ++w.record.stats.ball_ball;
+  w.note(EventKind::ball_ball, i, j);
+  w.changed(i);
+  w.changed(j);
+  w.bodies.last[i] = LastPartner::of(Partner::body, j);
+  w.bodies.last[j] = LastPartner::of(Partner::body, i);
+  return {i, j};
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::collide_with_turtle(std::uint32_t i, std::uint32_t j) {
-  sync(i);
-  sync(j);
+// ---------------------------------------------------------------------------------------------
+// Turtle-body: a turtle (a disc of infinite mass that flies straight) with a ball or a turtle
+
+/// Turtle j, seen from body i (a ball or a turtle).
+template <Flight F, bool kExtras>
+void predict_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift,
+                    Pending& p) {
+  if (j == i || !l.meets(i, j)) return;
+  const Body& bj = l.bodies.body[j];
+  const Vec2 rel = bi.x - (bj.x + (l.now - bj.t) * bj.v + shift);
+  const Vec2 v = bi.v - bj.v;
+  const double t = l.now + l.motion.toi_point(i, rel, v, bi.r + bj.r, p.t_coll - l.now);
+  if (t < p.t_coll) {
+    if (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
+        l.bodies.last[j] == LastPartner::of(Partner::body, i))
+      return;
+    p.take(t, Partner::body, j, bj.count);
+  }
+}
+
+/// Ball j (which may fall), seen from turtle i.
+template <Flight F, bool kExtras>
+void predict_ball_from_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j,
+                              Vec2 shift, Pending& p) {
+  if (!l.meets(i, j)) return;
+  const Body& bj = l.bodies.body[j];
+  const double dtj = l.now - bj.t;
+  const F& f = l.motion.flight();
+  const Vec2 rel = f.pos(j, bj.x, bj.v, dtj) + shift - bi.x;
+  const Vec2 v = f.vel(j, bj.v, dtj) - bi.v;
+  const double t = l.now + f.toi_point(j, rel, v, bi.r + bj.r, p.t_coll - l.now);
+  if (t < p.t_coll) {
+    if (f.straight(j) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
+        l.bodies.last[j] == LastPartner::of(Partner::body, i))
+      return;
+    p.take(t, Partner::body, j, bj.count);
+  }
+}
+
+template <Flight Fl, bool kStep, bool kExtras>
+Changed apply_turtle_body(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, std::uint32_t j) {
+  w.sync(i);
+  w.sync(j);
+  const std::uint32_t nb = w.bodies.balls();
   // Name the pair (turtle, other) with the turtle first.
-  const std::uint32_t t = is_turtle(i) ? i : j;
+  const std::uint32_t t = w.is_turtle(i) ? i : j;
   const std::uint32_t o = t == i ? j : i;
-  Body& bt = body_[t];
-  Body& bo = body_[o];
-  const Vec2 F = min_image(bo.x - bt.x);  // from the turtle to the other body
+  Body& bt = w.bodies.body[t];
+  Body& bo = w.bodies.body[o];
+  const Vec2 F = w.arena.min_image(bo.x - bt.x);  // from the turtle to the other body
   const double dist = norm(F);
-  note_contact(bt.r + bo.r - dist, std::min(bt.r, bo.r));
+  w.record.note_contact(bt.r + bo.r - dist, std::min(bt.r, bo.r));
   const Vec2 n = F / dist;
-  if (!is_turtle(o)) {
+  if (!w.is_turtle(o)) {
     // The turtle stops dead (or bounces) at the contact first; the ball then bounces off it as
     // off a wall of infinite mass moving at the turtle's new velocity. (Against the old velocity,
     // a ball that caught up with a turtle from behind would keep closing on it once it stopped.)
-    touch(t, EventKind::turtle_ball, o, -n);
-    const Vec2 w = bo.v - bt.v;
-    if (dot(w, n) < 0.0) bo.v = bt.v + bounce(o, w, n);
-    ++stats_.turtle_ball;
-    log(EventKind::turtle_ball, t - nb_, o);
+    w.touch(t, EventKind::turtle_ball, o, -n);
+    const Vec2 rel = bo.v - bt.v;
+    if (dot(rel, n) < 0.0) bo.v = bt.v + w.bounce(o, rel, n);
+    ++w.record.stats.turtle_ball;
+    w.note(EventKind::turtle_ball, t - nb, o);
   } else {
-    ++stats_.turtle_turtle;
-    log(EventKind::turtle_turtle, t - nb_, o - nb_);
-    touch(t, EventKind::turtle_turtle, o - nb_, -n);
-    touch(o, EventKind::turtle_turtle, t - nb_, n);
+    ++w.record.stats.turtle_turtle;
+    w.note(EventKind::turtle_turtle, t - nb, o - nb);
+    w.touch(t, EventKind::turtle_turtle, o - nb, -n);
+    w.touch(o, EventKind::turtle_turtle, t - nb, n);
   }
-  after_change(t);
-  after_change(o);
-  last_[t] = LastPartner::of(Partner::body, o);
-  last_[o] = LastPartner::of(Partner::body, t);
-  repredict(t);
-  repredict(o);
+  w.changed(t);
+  w.changed(o);
+  w.bodies.last[t] = LastPartner::of(Partner::body, o);
+  w.bodies.last[o] = LastPartner::of(Partner::body, t);
+  return {t, o};
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::collide_wall(std::uint32_t i, std::uint32_t w) {
-  sync(i);
-  Body& a = body_[i];
-  const std::uint32_t mi = mover_of_[w];
-  const Segment s = mi == kNone ? walls_[w] : mover_segment(movers_[mi], now_);
+// ---------------------------------------------------------------------------------------------
+// Body-wall: a fixed wall's interior (a moving wall's is predicted with the moving walls, below,
+// and applied here)
+
+template <Flight F, bool kExtras>
+void predict_wall(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t w, Vec2 shift,
+                  Pending& p) {
+  if (!l.meets_wall(i, w) || (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::wall, w))) return;
+  const Segment& s = l.walls.segments[w];
+  // Relative to the wall's first end, so walls far from the origin lose nothing.
+  const double t = l.now + l.motion.toi_segment(i, bi.x - (s.p1 + shift), bi.v, s, bi.r);
+  if (t < p.t_coll) p.take(t, Partner::wall, w);
+}
+
+template <Flight Fl, bool kStep, bool kExtras>
+Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t w) {
+  p.sync(i);
+  Body& a = p.bodies.body[i];
+  const std::uint32_t mi = p.walls.mover_of[w];
+  const Segment s = mi == kNone ? p.walls.segments[w] : p.schedule.movers[mi].segment_at(p.walls.segments[w], p.now);
   // The velocity of the wall's material point at the contact: the ends' velocities interpolated
   // at the foot (the same for every point of a translating wall).
   Vec2 u{};
   if (mi != kNone) {
-    const Mover& m = movers_[mi];
+    const Mover& m = p.schedule.movers[mi];
     u = m.u;
     if (!m.rigid()) u += std::clamp(dot(a.x - s.p1, s.u) / s.len, 0.0, 1.0) * m.w;
   }
-  const double d = dot(rel_to_segment(a.x, s), s.n);
+  const double d = dot(p.arena.rel_to_segment(a.x, s), s.n);
   const Vec2 n = d >= 0.0 ? s.n : -s.n;
-  note_contact(a.r - std::abs(d), a.r);
-  if (is_turtle(i)) {
-    ++stats_.turtle_wall;
-    log(EventKind::turtle_wall, i - nb_, w);
-    touch(i, EventKind::turtle_wall, w, n);
+  p.record.note_contact(a.r - std::abs(d), a.r);
+  if (p.is_turtle(i)) {
+    ++p.record.stats.turtle_wall;
+    p.note(EventKind::turtle_wall, i - p.bodies.balls(), w);
+    p.touch(i, EventKind::turtle_wall, w, n);
     if (dot(u, n) > 0.0) {
       // A moving wall pushing a turtle carries it along at its normal speed (both have
       // infinite mass), until the wall's next keyframe. A turning or stretching wall's push
       // changes along the way, so it knocks the turtle off instead, at twice its normal speed
       // (an elastic bounce off the wall), which the wall can only catch up with by speeding up.
-      a.v = (movers_[mi].rigid() ? 1.0 : 2.0) * dot(u, n) * n;
-      pushed_by_[i - nb_] = mi;
+      a.v = (p.schedule.movers[mi].rigid() ? 1.0 : 2.0) * dot(u, n) * n;
+      p.turtles.pushed_by[i - p.bodies.balls()] = mi;
     }
   } else {
-    a.v = u + bounce(i, a.v - u, n);
-    ++stats_.ball_wall;
-    log(EventKind::ball_wall, i, w);
+    a.v = u + p.bounce(i, a.v - u, n);
+    ++p.record.stats.ball_wall;
+    p.note(EventKind::ball_wall, i, w);
   }
-  after_change(i);
-  last_[i] = LastPartner::of(Partner::wall, w);
-  repredict(i);
+  p.changed(i);
+  p.bodies.last[i] = LastPartner::of(Partner::wall, w);
+  return {i};
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::collide_end(std::uint32_t i, std::uint32_t e) {
-  sync(i);
-  Body& a = body_[i];
-  const Vec2 F = min_image(a.x - ends_[e].p);
+// ---------------------------------------------------------------------------------------------
+// Body-wall end: a fixed wall's end point, one per distinct point
+
+template <Flight F, bool kExtras>
+void predict_end(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift,
+                 Pending& p) {
+  if (!l.meets_end(i, e) || (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::end, e))) return;
+  const Vec2 rel = bi.x - (l.walls.ends[e].p + shift);
+  const double t = l.now + l.motion.toi_point(i, rel, bi.v, bi.r, p.t_coll - l.now);
+  if (t < p.t_coll) p.take(t, Partner::end, e);
+}
+
+template <Flight Fl, bool kStep, bool kExtras>
+Changed apply_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t e) {
+  p.sync(i);
+  Body& a = p.bodies.body[i];
+  const WallEnd& end = p.walls.ends[e];
+  const Vec2 F = p.arena.min_image(a.x - end.p);
   const double dist = norm(F);
-  note_contact(a.r - dist, a.r);
-  if (is_turtle(i)) {
-    ++stats_.turtle_wall_end;
-    log(EventKind::turtle_wall_end, i - nb_, ends_[e].wall);
-    touch(i, EventKind::turtle_wall_end, ends_[e].wall, F / dist);
+  p.record.note_contact(a.r - dist, a.r);
+  if (p.is_turtle(i)) {
+    ++p.record.stats.turtle_wall_end;
+    p.note(EventKind::turtle_wall_end, i - p.bodies.balls(), end.wall);
+    p.touch(i, EventKind::turtle_wall_end, end.wall, F / dist);
   } else {
-    a.v = bounce(i, a.v, F / dist);
-    ++stats_.ball_wall_end;
-    log(EventKind::ball_wall_end, i, ends_[e].wall);
+    a.v = p.bounce(i, a.v, F / dist);
+    ++p.record.stats.ball_wall_end;
+    p.note(EventKind::ball_wall_end, i, end.wall);
   }
-  after_change(i);
-  last_[i] = LastPartner::of(Partner::end, e);
-  repredict(i);
+  p.changed(i);
+  p.bodies.last[i] = LastPartner::of(Partner::end, e);
+  return {i};
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::consider_mover(std::uint32_t i, const Body& bi, std::uint32_t mi,
-                                                               Pending& p) const {
-  // In the wall's frame the body flies with v - u; contacts after the next keyframe are not
-  // predicted (the keyframe makes everyone predict again).
-  const Mover& m = movers_[mi];
+// ---------------------------------------------------------------------------------------------
+// Moving walls: outside the table, checked by every prediction up to the next keyframe (which
+// makes every body predict again), in the wall's frame, where a body flies with v - u. A contact
+// with the interior is applied as a wall's (apply_wall); the ends are `moving_end` partners,
+// numbered 2 mover + (0: first end, 1: second).
+
+template <Flight F, bool kExtras>
+void predict_mover(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t mi, Pending& p) {
+  const Mover& m = l.schedule.movers[mi];
   const std::uint32_t w = m.wall;
-  if (!meets_wall(i, w)) return;
-  const Segment& s = walls_[w];
-  const Vec2 p1 = mover_p1(m, now_);
+  if (!l.meets_wall(i, w)) return;
+  const Segment& s = l.walls.segments[w];
+  const Vec2 p1 = m.p1_at(l.now);
   const Vec2 v = bi.v - m.u;
-  const double horizon = std::min(p.t_coll, next_key_);
+  const double horizon = std::min(p.t_coll, l.schedule.next_key);
+  const LastPartner last = l.bodies.last[i];
   double t_wall = kNever;
   if (!m.rigid()) {
     // Turning or stretching: no straight-line argument rules out meeting the same wall again.
-    t_wall = now_ + toi_disc_deforming_segment(bi.x - p1, v, accel(i), mover_d(m, now_), m.w, bi.r, horizon - now_);
-  } else if (!(straight(i) && last_[i] == LastPartner::of(Partner::wall, w))) {
-    t_wall = now_ + toi_disc_segment(bi.x - p1, v, accel(i), s, bi.r);
+    t_wall = l.now + l.motion.toi_deforming_segment(i, bi.x - p1, v, m.d_at(l.now), m.w, bi.r, horizon - l.now);
+  } else if (!(l.motion.straight(i) && last == LastPartner::of(Partner::wall, w))) {
+    t_wall = l.now + l.motion.toi_segment(i, bi.x - p1, v, s, bi.r);
   }
-  if (t_wall < p.t_coll && t_wall <= horizon) {
-    p.take(t_wall, Partner::wall, w);
-  }
+  if (t_wall < p.t_coll && t_wall <= horizon) p.take(t_wall, Partner::wall, w);
   for (std::uint32_t which = 0; which < 2; ++which) {
     const std::uint32_t code = 2 * mi + which;
-    if (straight(i) && last_[i] == LastPartner::of(Partner::moving_end, code)) continue;
+    if (l.motion.straight(i) && last == LastPartner::of(Partner::moving_end, code)) continue;
     // Each end moves in a straight line, so its contacts have the closed forms of a fixed point.
-    const Vec2 e = mover_end(m, which == 1, now_);
+    const Vec2 e = m.end_at(s, which == 1, l.now);
     const Vec2 ve = which == 0 ? v : v - m.w;  // the body's velocity relative to that end
-    double dt;
-    if (Flight::kAccelerates && !is_turtle(i)) dt = toi_disc_point_accel(bi.x - e, ve, flight_.a, bi.r, horizon - now_);
-    else dt = toi_disc_point(bi.x - e, ve, bi.r);
-    const double t = now_ + dt;
-    if (t < p.t_coll && t <= horizon) {
-      p.take(t, Partner::moving_end, code);
-    }
+    const double t = l.now + l.motion.toi_point(i, bi.x - e, ve, bi.r, horizon - l.now);
+    if (t < p.t_coll && t <= horizon) p.take(t, Partner::moving_end, code);
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::collide_moving_end(std::uint32_t i, std::uint32_t code) {
-  sync(i);
-  Body& a = body_[i];
-  const Mover& m = movers_[code / 2];
+template <Flight Fl, bool kStep, bool kExtras>
+Changed apply_moving_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t code) {
+  p.sync(i);
+  Body& a = p.bodies.body[i];
+  const Mover& m = p.schedule.movers[code / 2];
   const bool second = code % 2 == 1;
-  const Vec2 e = mover_end(m, second, now_);
-  const Vec2 ue = mover_end_velocity(m, second);
+  const Vec2 e = m.end_at(p.walls.segments[m.wall], second, p.now);
+  const Vec2 ue = m.end_velocity(second);
   const Vec2 F = a.x - e;
   const double dist = norm(F);
-  note_contact(a.r - dist, a.r);
-  if (is_turtle(i)) {
-    ++stats_.turtle_wall_end;
-    log(EventKind::turtle_wall_end, i - nb_, m.wall);
-    touch(i, EventKind::turtle_wall_end, m.wall, F / dist);
+  p.record.note_contact(a.r - dist, a.r);
+  if (p.is_turtle(i)) {
+    ++p.record.stats.turtle_wall_end;
+    p.note(EventKind::turtle_wall_end, i - p.bodies.balls(), m.wall);
+    p.touch(i, EventKind::turtle_wall_end, m.wall, F / dist);
   } else {
-    a.v = ue + bounce(i, a.v - ue, F / dist);
-    ++stats_.ball_wall_end;
-    log(EventKind::ball_wall_end, i, m.wall);
+    a.v = ue + p.bounce(i, a.v - ue, F / dist);
+    ++p.record.stats.ball_wall_end;
+    p.note(EventKind::ball_wall_end, i, m.wall);
   }
-  after_change(i);
-  last_[i] = LastPartner::of(Partner::moving_end, code);
-  repredict(i);
+  p.changed(i);
+  p.bodies.last[i] = LastPartner::of(Partner::moving_end, code);
+  return {i};
 }
 
 }  // namespace

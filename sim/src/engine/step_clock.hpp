@@ -1,74 +1,66 @@
 // SPDX-License-Identifier: MIT
-// The step clock: the start and the end of one of the memo's steps, with the field kick.
-// Part of engine.hpp (members of Engine), included at its end.
+// The step clock: the start and the end of one of the memo's steps. Inside a step every body flies
+// straight; at its end the field acts as a kick (kick.hpp). (Part of the Engine, whose loop serves
+// the collisions inside a step: included at engine.hpp's end.)
 #pragma once
+
+#include "engine.hpp"
 
 namespace turtlegas::sim::detail {
 namespace {
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::begin_step() {
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::begin_step() {
   // Internal time zero is the start of the step; all bodies are there.
-  const std::size_t n = body_.size();
+  const std::size_t n = bodies_.size();
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (body_[i].cell != kNone) unlink(i);
+    if (bodies_.body[i].cell != kNone) unlink(i);
   }
-  dmax_ = 0.0;
+  step_.dmax = 0.0;
   for (std::uint32_t i = 0; i < n; ++i) {
-    Body& b = body_[i];
+    Body& b = bodies_.body[i];
     if (b.cell == kNone) continue;
     b.t = 0.0;
-    travel_[i] = 0.0;
-    if (boundary_ == Boundary::periodic) {
-      b.x.x -= width_ * std::floor(b.x.x / width_);
-      b.x.y -= height_ * std::floor(b.x.y / height_);
-    } else if (b.x.x < 0.0 || b.x.x > width_ || b.x.y < 0.0 || b.x.y > height_) {
-      const bool turtle = is_turtle(i);
-      log(EventKind::exit, turtle ? i - nb_ : i, turtle ? 1 : 0);
-      ++stats_.exits;
-      b.cell = kNone;
-      ++b.count;
-      heap_.remove(i);
-      if (turtle) {
-        busy_[i - nb_] = 0;
-        end_[i] = kNever;
-        b.v = {};
-      }
+    step_.travel[i] = 0.0;
+    if (arena_.periodic()) {
+      b.x.x -= arena_.width * std::floor(b.x.x / arena_.width);
+      b.x.y -= arena_.height * std::floor(b.x.y / arena_.height);
+    } else if (!arena_.contains(b.x)) {
+      exit(i);
       continue;
     }
     link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(b.x)));
-    dmax_ = std::max(dmax_, path_length(b.v, dt_));
+    step_.dmax = std::max(step_.dmax, path_length(b.v, dt_));
   }
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (body_[i].cell == kNone) continue;
+    if (bodies_.body[i].cell == kNone) continue;
     predict(i);
     schedule(i);
   }
 }
 
-template <class Flight, bool kBallBall, bool kStep, bool kExtras>
-void Engine<Flight, kBallBall, kStep, kExtras>::finish_step() {
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::finish_step() {
   now_ = dt_;
-  for (std::uint32_t i = 0; i < body_.size(); ++i) {
-    if (body_[i].cell == kNone) continue;
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_.body[i].cell == kNone) continue;
     sync(i);
     // The memo: fields act as velocity kicks between steps (not on turtles).
-    if (!is_turtle(i)) body_[i].v += dt_ * kick_;
+    if (!is_turtle(i)) kick_.apply(i, bodies_.body[i].v, dt_);
   }
   // A kick changes every course, so "just collided, cannot meet again" no longer holds.
-  if (kick_.x != 0.0 || kick_.y != 0.0) for (std::uint32_t i = 0; i < last_.size(); ++i) last_[i] = LastPartner::none();
-  ++step_index_;
-  ++stats_.steps;
-  ++stats_.events;
-  for (std::size_t k = 0; k < run_.size(); ++k) {
-    run_[k].t_start -= dt_;
-    end_[nb_ + k] -= dt_;
-  }
-  for (Mover& m : movers_) m.t_ref -= dt_;
-  if (inelastic_)
-    for (double& t : last_time_) t -= dt_;
-  t_base_ = static_cast<double>(step_index_) * dt_;
-  refresh_next_key();
+  if (kick_.changes_courses())
+    for (std::uint32_t i = 0; i < bodies_.last.size(); ++i) bodies_.last[i] = LastPartner::none();
+  ++step_.index;
+  ++record_.stats.steps;
+  ++record_.stats.events;
+  turtles_.shift_times(dt_);
+  for (std::size_t k = 0; k < turtles_.size(); ++k) bodies_.end[bodies_.balls() + k] -= dt_;
+  schedule_.shift_times(dt_);
+  if (restitution_.inelastic)
+    for (double& t : restitution_.last_time) t -= dt_;
+  t_base_ = static_cast<double>(step_.index) * dt_;
+  schedule_.refresh_next_key(walls_, t_base_);
   now_ = 0.0;
   begin_step();
 }

@@ -152,6 +152,10 @@ std::vector<WallDef> arena_walls(const ArenaDef& arena);
 /// moves it (each end linearly), the last pose after the last keyframe; from/to if it is fixed.
 WallKey wall_pose(const WallDef& wall, double t);
 
+/// Whether point p lies in the closed rectangle [0, width] x [0, height] of the arena (a periodic
+/// arena's walls must: validate() and World::add_wall check both ends).
+bool inside_arena(const ArenaDef& arena, Vec2 p);
+
 /// Whether a wall is there at time t (its visibility keys; always, if it has none).
 bool wall_visible(const WallDef& wall, double t);
 
