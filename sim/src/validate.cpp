@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "turtlegas/sim/cover_grid.hpp"
@@ -92,6 +93,37 @@ std::optional<DefProblem> check_keyframes(const WallDef& w, std::size_t i) {
   return std::nullopt;
 }
 
+/// A wall in a periodic arena: both ends inside it (the engine's table wraps bodies, not walls),
+/// and fixed (moving walls are not supported there yet).
+std::optional<DefProblem> check_periodic_wall(const WallDef& w, std::size_t i, const ArenaDef& a) {
+  for (const auto& [field, p] : {std::pair<const char*, Vec2>{"from", w.from}, {"to", w.to}})
+    if (!inside_arena(a, p))
+      return problem(Where::wall, i, field,
+                     wall_name(w, i) + " reaches outside a periodic arena (its end " + field + " " + vec(p) +
+                         " is not in [0, " + num(a.width) + "] x [0, " + num(a.height) +
+                         "]); keep walls inside it");
+  if (!w.keys.empty())
+    return problem(Where::wall, i, "keys",
+                   wall_name(w, i) + " moves: moving walls are not supported in a periodic arena yet; "
+                                     "remove its keys or use boundary \"walls\" or \"none\"");
+  return std::nullopt;
+}
+
+/// Visibility keys: times increasing and >= 0.
+std::optional<DefProblem> check_visibility(const WallDef& w, std::size_t i) {
+  double prev = -1.0;
+  for (std::size_t k = 0; k < w.visibility.size(); ++k) {
+    const double t = w.visibility[k].t;
+    if (!(t > prev) || t < 0.0)
+      return problem(Where::wall, i, "visible",
+                     wall_name(w, i) + " visibility key " + std::to_string(k) +
+                         ": times must increase and be >= 0 (got " + num(t) +
+                         (k > 0 ? " after " + num(prev) : std::string()) + ")");
+    prev = t;
+  }
+  return std::nullopt;
+}
+
 std::optional<DefProblem> check_walls(const WorldDef& def) {
   for (std::size_t i = 0; i < def.walls.size(); ++i) {
     const WallDef& w = def.walls[i];
@@ -102,6 +134,9 @@ std::optional<DefProblem> check_walls(const WorldDef& def) {
     if (w.from == w.to)
       return problem(Where::wall, i, "to", wall_name(w, i) + " has zero length (from and to are both " + vec(w.from) + "); move one end or remove the wall");
     if (auto p = check_keyframes(w, i)) return p;
+    if (def.arena.boundary == Boundary::periodic)
+      if (auto p = check_periodic_wall(w, i, def.arena)) return p;
+    if (auto p = check_visibility(w, i)) return p;
   }
   return std::nullopt;
 }

@@ -251,13 +251,6 @@ Engine<F, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<Ba
   dt_ = def.dt;
 
   walls_ = Walls(def, kExtras);
-  for (const WallDef& w : walls_.defs) {
-    if (arena_.periodic() && (!inside_arena(def.arena, w.from) || !inside_arena(def.arena, w.to)))
-      throw std::invalid_argument("wall '" + w.id + "' reaches outside a periodic arena; keep walls inside it");
-  }
-  for (const WallDef& w : walls_.defs)
-    if (!w.keys.empty() && arena_.periodic())
-      throw std::invalid_argument("wall '" + w.id + "' moves: moving walls are not supported in a periodic arena yet");
   schedule_ = WallSchedule(walls_);
   for (const auto& b : def.balls) step_.rmax = std::max(step_.rmax, b.radius);
   for (const auto& t : def.turtles) step_.rmax = std::max(step_.rmax, t.radius);
@@ -271,15 +264,6 @@ Engine<F, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<Ba
     throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell_) +
                                 "); enlarge the arena or use smaller balls");
 
-  if constexpr (kExtras)
-    for (const WallDef& w : walls_.defs) {
-      double prev = -1.0;
-      for (const VisibilityKey& k : w.visibility) {
-        if (!(k.t > prev) || k.t < 0.0)
-          throw std::invalid_argument("wall '" + w.id + "': visibility times must increase and be >= 0");
-        prev = k.t;
-      }
-    }
   if (restitution_.inelastic) restitution_.last_time.assign(n, -kNever);
   bodies_.make_lists(static_cast<std::size_t>(grid_.cell_count()), kExtras);
   heap_.reset(bodies_.nodes(), sizeof(Record), n);

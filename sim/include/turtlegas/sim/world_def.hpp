@@ -141,8 +141,10 @@ struct DefProblem {
 inline constexpr std::size_t kMaxObjects = std::size_t{1} << 29;
 
 /// Checks a scene for everything the engine relies on: finite numbers, positive radii and masses,
-/// non-zero-length walls, unique ids, balls inside the arena and not overlapping each other or a
-/// wall, restitution in [0, 1]. Returns the first problem found, if any. O(N) expected time.
+/// non-zero-length walls, keyframes and visibility keys in order, in a periodic arena walls inside
+/// it and fixed, unique ids, balls inside the arena and not overlapping each other or a wall,
+/// restitution in [0, 1], no more than kMaxObjects bodies or wall ends. (The engine's own checks
+/// are those that depend on the mode: the cell size, and what a step may hold.) Returns the first problem found, if any. O(N) expected time.
 std::optional<DefProblem> validate(const WorldDef& def);
 
 /// The arena walls that `Boundary::walls` adds, in the order and with the ids the engine uses.
