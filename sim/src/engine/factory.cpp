@@ -50,12 +50,12 @@ bool needs_extras(const WorldDef& def) {
   return !def.turtles.empty() || layered;
 }
 
-/// Whether a row's flight serves the scene: in exact mode when the flight fits its effects (the
+/// Whether a row's flight serves the scene: in exact mode when the flight fits it (the
 /// rows are in order of cost, so the first that fits is the cheapest); in step mode always (it
 /// flies straight and kicks between steps).
 template <Flight F>
 bool flight_serves(const WorldDef& def, bool step) {
-  return step || F::fits(def.effects);
+  return step || F::fits(def);
 }
 
 std::unique_ptr<EngineBase> make(const WorldDef& def, Mode mode, std::vector<BallDef>* release) {

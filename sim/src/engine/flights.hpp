@@ -55,12 +55,13 @@ inline AxisExit straight_exit(double x, double v, double lo, double hi) {
 /// `t_max` (the prediction's horizon: the earliest candidate so far).
 template <class F>
 concept Flight = std::constructible_from<F, const WorldDef&> &&
-    requires(const F f, const EffectsDef fx, std::uint32_t ball, std::uint32_t other, Vec2 x, Vec2 v, double dt,
+    requires(const F f, const WorldDef& def, std::uint32_t ball, std::uint32_t other, Vec2 x, Vec2 v, double dt,
              double sigma, double t_max, const Segment& s, Vec2 d0, Vec2 w, const CellBox& box) {
   { F::kName } -> std::convertible_to<std::string_view>;
-  /// Whether this flight is exact for a scene with these effects (the factory takes the first row
-  /// of its table whose flight fits).
-  { F::fits(fx) } -> std::same_as<bool>;
+  /// Whether this flight is exact for the scene (its effects, and the balls' own parameters: a
+  /// charged flight is not needed when no ball is charged). The factory takes the first row of its
+  /// table whose flight fits.
+  { F::fits(def) } -> std::same_as<bool>;
   /// Where the ball is, and how fast it goes, dt after being at x with velocity v.
   { f.pos(ball, x, v, dt) } -> std::same_as<Vec2>;
   { f.vel(ball, v, dt) } -> std::same_as<Vec2>;
@@ -82,8 +83,9 @@ concept Flight = std::constructible_from<F, const WorldDef&> &&
   { f.straight(ball) } -> std::same_as<bool>;
   /// The same question for two balls' relative motion.
   { f.straight_pair(ball, other) } -> std::same_as<bool>;
-  /// The field's acceleration of the ball along n (the rest threshold when it bounces off a wall).
-  { f.normal_accel(ball, x) } -> std::same_as<double>;
+  /// The field's acceleration along the unit normal n of the ball flying at v (the rest threshold
+  /// when it bounces off an obstacle; a magnetic force would depend on v).
+  { f.normal_accel(ball, v, x) } -> std::same_as<double>;
   /// The ball's potential energy per unit mass at x (energy()).
   { f.potential(ball, x) } -> std::same_as<double>;
 };
@@ -91,7 +93,7 @@ concept Flight = std::constructible_from<F, const WorldDef&> &&
 /// Straight-line flight: no field acts between events.
 struct FreeFlight {
   static constexpr std::string_view kName = "free";
-  static bool fits(const EffectsDef& fx) { return fx.gravity.x == 0.0 && fx.gravity.y == 0.0; }
+  static bool fits(const WorldDef& def) { return def.effects.gravity.x == 0.0 && def.effects.gravity.y == 0.0; }
   FreeFlight() = default;
   explicit FreeFlight(const WorldDef&) {}
 
@@ -112,14 +114,14 @@ struct FreeFlight {
   }
   static constexpr bool straight(std::uint32_t) { return true; }
   static constexpr bool straight_pair(std::uint32_t, std::uint32_t) { return true; }
-  static constexpr double normal_accel(std::uint32_t, Vec2) { return 0.0; }
+  static constexpr double normal_accel(std::uint32_t, Vec2, Vec2) { return 0.0; }
   static constexpr double potential(std::uint32_t, Vec2) { return 0.0; }
 };
 
 /// Parabolic flight under a uniform acceleration shared by all balls (gravity).
 struct GravityFlight {
   static constexpr std::string_view kName = "gravity";
-  static bool fits(const EffectsDef&) { return true; }
+  static bool fits(const WorldDef&) { return true; }
   GravityFlight() = default;
   explicit GravityFlight(const WorldDef& def) : a(def.effects.gravity) {}
 
@@ -144,7 +146,7 @@ struct GravityFlight {
   }
   static constexpr bool straight(std::uint32_t) { return false; }
   static constexpr bool straight_pair(std::uint32_t, std::uint32_t) { return true; }
-  double normal_accel(std::uint32_t, Vec2 n) const { return dot(a, n); }
+  double normal_accel(std::uint32_t, Vec2, Vec2 n) const { return dot(a, n); }
   double potential(std::uint32_t, Vec2 x) const { return -dot(a, x); }
 };
 

@@ -150,9 +150,10 @@ struct Parts {
   void touch(std::uint32_t id, EventKind kind, std::uint32_t other, Vec2 normal) const {
     turtles.touch(id - bodies.balls(), bodies.body[id], bodies.end[id], now, t_base, dt, kind, other, normal);
   }
-  /// The bounce of ball i off an obstacle (Restitution::bounce, under the ball's field).
+  /// The bounce of ball i (at the contact, its velocity not yet changed) off an obstacle, v its
+  /// velocity relative to the obstacle (Restitution::bounce, under the ball's field).
   Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n) const {
-    return restitution.bounce(v, n, motion.flight().normal_accel(i, n));
+    return restitution.bounce(v, n, motion.flight().normal_accel(i, bodies.body[i].v, n));
   }
 };
 
