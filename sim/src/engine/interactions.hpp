@@ -76,7 +76,7 @@ Changed apply_ball_ball(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, std
 
 /// Turtle j, seen from body i (a ball or a turtle).
 template <Flight F, bool kExtras>
-void predict_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift,
+[[gnu::always_inline]] inline void predict_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift,
                     Pending& p) {
   if (j == i || !l.meets(i, j)) return;
   const Body& bj = l.bodies.body[j];
@@ -93,7 +93,7 @@ void predict_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, 
 
 /// Ball j (which may fall), seen from turtle i.
 template <Flight F, bool kExtras>
-void predict_ball_from_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j,
+[[gnu::always_inline]] inline void predict_ball_from_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j,
                               Vec2 shift, Pending& p) {
   if (!l.meets(i, j)) return;
   const Body& bj = l.bodies.body[j];
@@ -151,7 +151,7 @@ Changed apply_turtle_body(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, s
 // and applied here)
 
 template <Flight F, bool kExtras>
-void predict_wall(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t w, Vec2 shift,
+[[gnu::always_inline]] inline void predict_wall(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t w, Vec2 shift,
                   Pending& p) {
   if (!l.meets_wall(i, w) || (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::wall, w))) return;
   const Segment& s = l.walls.segments[w];
@@ -203,7 +203,7 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
 // Body-wall end: a fixed wall's end point, one per distinct point
 
 template <Flight F, bool kExtras>
-void predict_end(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift,
+[[gnu::always_inline]] inline void predict_end(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift,
                  Pending& p) {
   if (!l.meets_end(i, e) || (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::end, e))) return;
   const Vec2 rel = bi.x - (l.walls.ends[e].p + shift);
@@ -240,7 +240,7 @@ Changed apply_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint
 // numbered 2 mover + (0: first end, 1: second).
 
 template <Flight F, bool kExtras>
-void predict_mover(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t mi, Pending& p) {
+[[gnu::always_inline]] inline void predict_mover(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t mi, Pending& p) {
   const Mover& m = l.schedule.movers[mi];
   const std::uint32_t w = m.wall;
   if (!l.meets_wall(i, w)) return;
