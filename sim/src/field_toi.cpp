@@ -48,37 +48,48 @@ double falling_phase(double c0, double b, double c2, double disc, double aw) {
 }
 
 // ---- Bracketed refinement ------------------------------------------------------------------
-// gap(lo) >= 0 > gap(hi). Shrinks the bracket to adjacent doubles (or 400 steps) by regula falsi
-// with the Illinois weights, taking a midpoint whenever two steps have not halved the bracket, so
-// it is never slower than a third of bisection's speed; returns lo, where the bodies are apart.
-template <class Gap>
-double refine_fall(const Gap& gap, double lo, double glo, double hi, double ghi) {
-  double wlo = glo, whi = ghi;
-  int last = 0;  // +1: lo moved last, -1: hi moved last
-  int stale = 0;
-  double width = hi - lo;
+// gap(lo) >= 0 > gap(hi). Shrinks the bracket to adjacent doubles (or 400 steps) and returns lo,
+// where the bodies are apart.
+// gap_d(t) returns {g, g'} (one evaluation of the flight gives both). Newton from the end nearer
+// the root, its step lengthened by a thousandth and four ulps so that the iterate lands just beyond
+// the root and the bracket's far end closes in too (the bracket, not the iterate, is the answer);
+// a midpoint whenever the step would leave the bracket or is not at most half the previous one
+// (Numerical Recipes' rtsafe rule), and once the bracket is 64 ulps wide, where the values are
+// round-off. So it converges quadratically where Newton does and never slower than bisection.
+struct GapD {
+  double g, d;
+};
+template <class GapDeriv>
+double refine_fall_newton(const GapDeriv& gap_d, double lo, GapD vlo, double hi, GapD vhi) {
+  double last_step = hi - lo;
   for (int it = 0; it < 400; ++it) {
-    double m = stale >= 2 ? lo + 0.5 * (hi - lo) : lo + (hi - lo) * (wlo / (wlo - whi));
-    if (!(m > lo)) m = std::nextafter(lo, hi);
+    const double next = std::nextafter(lo, hi);
+    if (!(next < hi)) break;  // adjacent doubles
+    double m = lo + 0.5 * (hi - lo);
+    const bool fine = hi - lo <= 64.0 * kEps * std::max(std::abs(lo), std::abs(hi));
+    if (!fine) {
+      const bool from_lo = vlo.g <= -vhi.g;
+      const double x = from_lo ? lo : hi;
+      const GapD vx = from_lo ? vlo : vhi;
+      const double step = -vx.g / vx.d;
+      const double cand = x + (step + 1e-3 * step) + (from_lo ? 4.0 : -4.0) * kEps * std::abs(x);
+      if (cand > lo && cand < hi && std::abs(step) <= 0.5 * last_step) {
+        m = cand;
+        last_step = std::abs(step);
+      } else {
+        last_step = 0.5 * (hi - lo);
+      }
+    }
+    if (!(m > lo)) m = next;
     if (!(m < hi)) m = std::nextafter(hi, lo);
-    if (!(m > lo && m < hi)) break;  // adjacent doubles
-    const double gm = gap(m);
-    if (gm >= 0.0) {
+    const GapD vm = gap_d(m);
+    if (vm.g == 0.0) return m;  // touching: apart, and the root to round-off
+    if (vm.g > 0.0) {
       lo = m;
-      wlo = gm;
-      if (last == 1) whi *= 0.5;
-      last = 1;
+      vlo = vm;
     } else {
       hi = m;
-      whi = gm;
-      if (last == -1) wlo *= 0.5;
-      last = -1;
-    }
-    if (hi - lo <= 0.5 * width) {
-      width = hi - lo;
-      stale = 0;
-    } else {
-      ++stale;
+      vhi = vm;
     }
   }
   return lo;
@@ -96,6 +107,11 @@ struct Projection {
   double value(double t) const {
     const FlightCoefficients k = flight_coefficients(w, t);
     return k.s * A + k.c * B + k.ca * C + k.da * D;
+  }
+  // {p(t), p'(t)}.
+  GapD eval(double t) const {
+    const FlightCoefficients k = flight_coefficients(w, t);
+    return {k.s * A + k.c * B + k.ca * C + k.da * D, k.cos_theta * A + k.sin_theta * B + k.s * C + k.c * D};
   }
 };
 
@@ -145,7 +161,7 @@ double first_fall_pieces(const Projection& p, const Gap1* gaps, int ngaps, doubl
   double k = std::floor(t_begin * aw / kTwoPi) - 1.0;  // period index of the next critical time
   int j = 0;
   double t0 = t_begin;
-  double p0 = p.value(t0);
+  GapD p0 = p.eval(t0);
   while (t0 < t_end) {
     double t1 = t_end;
     while (np > 0) {
@@ -159,12 +175,16 @@ double first_fall_pieces(const Projection& p, const Gap1* gaps, int ngaps, doubl
         break;
       }
     }
-    const double p1 = p.value(t1);
+    const GapD p1 = p.eval(t1);
     for (int g = 0; g < ngaps; ++g) {
-      const double gl = gaps[g].g0 + gaps[g].sign * p0, gr = gaps[g].g0 + gaps[g].sign * p1;
-      if (!(gl >= 0.0 && gr < 0.0)) continue;
       const Gap1 gap = gaps[g];
-      const double t = refine_fall([&](double s) { return gap.g0 + gap.sign * p.value(s); }, t0, gl, t1, gr);
+      const GapD gl{gap.g0 + gap.sign * p0.g, gap.sign * p0.d}, gr{gap.g0 + gap.sign * p1.g, gap.sign * p1.d};
+      if (!(gl.g >= 0.0 && gr.g < 0.0)) continue;
+      auto gap_d = [&](double s) {
+        const GapD v = p.eval(s);
+        return GapD{gap.g0 + gap.sign * v.g, gap.sign * v.d};
+      };
+      const double t = refine_fall_newton(gap_d, t0, gl, t1, gr);
       if (accept(t)) {
         *which = g;
         return t;
@@ -206,7 +226,8 @@ int reach_windows(const Projection& p, double rho, const Gap1* gaps, int ngaps, 
     const Window w{std::max(t1 - two_periods, t_begin), std::min(t2 + two_periods, t_end)};
     if (w.begin < w.end) out[n++] = w;
   }
-  std::sort(out, out + n, [](const Window& a, const Window& b) { return a.begin < b.begin; });
+  for (int a = 1; a < n; ++a)  // n <= 2: an insertion sort
+    for (int b = a; b > 0 && out[b].begin < out[b - 1].begin; --b) std::swap(out[b], out[b - 1]);
   int m = 0;
   for (int k = 0; k < n; ++k) {
     if (m > 0 && out[k].begin <= out[m - 1].end) {
@@ -304,9 +325,14 @@ class PairGap {
     return u == 0.0 ? kNever : clear / u * (1.0 - 1e-12);
   }
 
-  double gap(double t) const {
-    const Vec2 r = r0_ + (field_displacement(f2_, t) - field_displacement(f1_, t));
-    return norm2(r) - sigma2_;
+  // {g(t), g'(t)}.
+  GapD gap_d(double t) const {
+    Vec2 d1, d2, v1, v2;
+    double m = 0.0, mv = 0.0;
+    body(f1_, nv1_, na1_, t, d1, v1, m, mv);
+    body(f2_, nv2_, na2_, t, d2, v2, m, mv);
+    const Vec2 r = r0_ + (d2 - d1);
+    return {norm2(r) - sigma2_, 2.0 * dot(r, v2 - v1)};
   }
 
   // g''(0) = 2 |r'(0)|^2 + 2 r(0).r''(0).
@@ -412,7 +438,9 @@ double bracketed_search(const PairGap& pg, double t_begin, const PairSample& s_b
     const bool rising = sa.dg - sa.edg - m_lo * h > 0.0 || sb.dg - sb.edg - m_hi * h > 0.0;
     const bool can_split = h > h_min && splits < kMaxSplits && top + 2 <= 160;
     const bool fall_between = sa.g >= 0.0 && sb.g < 0.0;
-    auto refine = [&] { return refine_fall([&](double t) { return pg.gap(t); }, nd.a, sa.g, nd.b, sb.g); };
+    auto refine = [&] {
+      return refine_fall_newton([&](double t) { return pg.gap_d(t); }, nd.a, GapD{sa.g, sa.dg}, nd.b, GapD{sb.g, sb.dg});
+    };
     if (fall_between && (falling || !can_split)) return refine();
     if (!fall_between && (falling || rising || !can_split)) continue;
     // The parts next to each end on which g keeps that end's sign, proven by the parabolas.
@@ -537,8 +565,9 @@ double toi_field_disc_segment(Vec2 rel, const FieldFlight& f, const Segment& s, 
   const Projection p(f, s.n);
   const double d0 = dot(rel, s.n);
   const double side = d0 >= 0.0 ? 1.0 : -1.0;
+  auto foot_at = [&](double t) { return dot(rel + field_displacement(f, t), s.u); };
   auto foot_on = [&](double t) {
-    const double foot = dot(rel + field_displacement(f, t), s.u);
+    const double foot = foot_at(t);
     return foot >= 0.0 && foot <= s.len;
   };
   // Touching and approaching the near face with the foot on the segment collides now.
@@ -565,12 +594,12 @@ double toi_field_disc_segment(Vec2 rel, const FieldFlight& f, const Segment& s, 
       auto time_k = [&](double k) { return (phase + kTwoPi * k) / aw; };
       const double t0 = time_k(0.0);
       if (t0 >= best || t0 > horizon) continue;
-      if (foot_on(t0)) {
+      const double foot0 = foot_at(t0);
+      if (foot0 >= 0.0 && foot0 <= s.len) {
         best = t0;
         continue;
       }
       if (foot_step == 0.0) continue;  // the same foot every period
-      const double foot0 = dot(rel + field_displacement(f, t0), s.u);
       double k = -1.0;
       if (foot0 < 0.0 && foot_step > 0.0) k = std::ceil(-foot0 / foot_step);
       if (foot0 > s.len && foot_step < 0.0) k = std::ceil((foot0 - s.len) / -foot_step);

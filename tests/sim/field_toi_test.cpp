@@ -10,6 +10,8 @@
 #include <cstdlib>
 #include <cmath>
 #include <functional>
+#include <vector>
+#include <algorithm>
 #include <numbers>
 
 #include "field_oracle.hpp"
@@ -646,6 +648,115 @@ TEST_CASE("cell exits against the oracle, and a small w tends to axis_exit", "[f
       REQUIRE(e1.upper == e0.upper);
       REQUIRE(std::abs(e1.t - e0.t) <= 1e-9 * e0.t + 1e3 * std::pow(10.0, -e) * e0.t * e0.t);
     }
+  }
+}
+
+// ---- Shallow contacts ------------------------------------------------------------------------
+
+namespace {
+
+// The oracle's global minimum of a distance over [0, H]: every sample within 1e-3 of the lowest,
+// refined by a ternary search between its neighbours; the lowest of those.
+struct Lowest {
+  L t = 0, value = 0;
+};
+Lowest oracle_min(const std::function<L(L)>& dist, L H, int N) {
+  std::vector<L> v(N + 1);
+  for (int i = 0; i <= N; ++i) v[i] = dist(H * i / N);
+  const L lowest = *std::min_element(v.begin(), v.end());
+  Lowest best{0, v[0]};
+  for (int i = 0; i <= N; ++i) {
+    if (v[i] > lowest + 1e-3L * std::fabs(lowest)) continue;
+    L a = H * std::max(i - 1, 0) / N, b = H * std::min(i + 1, N) / N;
+    for (int it = 0; it < 100; ++it) {
+      const L m1 = a + (b - a) / 3, m2 = b - (b - a) / 3;
+      if (dist(m1) < dist(m2)) b = m2; else a = m1;
+    }
+    const L t = (a + b) / 2, d = dist(t);
+    if (d < best.value || (i == 0 && d <= best.value)) best = {t, d};
+  }
+  return best;
+}
+
+// The contact depth the issue asks to be caught, and the near-miss that must not be.
+constexpr double kShallow = 1e-9;
+
+// For a scene whose distance function `dist` (centre to obstacle, or between centres) has an
+// interior minimum d_min over [0, H]: a contact distance of d_min (1 + 1e-9) must be met near the
+// minimum, d_min (1 - 1e-9) never. toi(c) is the solver with contact distance c.
+bool check_shallow(const std::function<L(L)>& dist, const std::function<double(double)>& toi, L H, int& tested) {
+  const Lowest m = oracle_min(dist, H, 3000);
+  // An interior minimum, not a crossing of the line (|y| has a corner at 0) nor a start or end.
+  if (!(m.value > 1e-6L * dist(0)) || m.t < H * 1e-3L || m.t > H * (1 - 1e-3L) || dist(0) < m.value * (1 + 1e-6L)) return true;
+  ++tested;
+  const double d_min = static_cast<double>(m.value);
+  const double hit = toi(d_min * (1 + kShallow)), miss = toi(d_min * (1 - kShallow));
+  INFO("d_min " << d_min << " at " << static_cast<double>(m.t) << " H " << static_cast<double>(H) << " hit " << hit
+                << " miss " << miss);
+  CHECK(miss == kNever);
+  CHECK(hit <= static_cast<double>(m.t) * (1 + 1e-9) + 1e-9 * static_cast<double>(H));
+  if (hit == kNever) return false;
+  CHECK(std::fabs(dist(hit) - d_min * (1 + kShallow)) <= 1e-12L * d_min + 1e-13L * static_cast<double>(H));
+  return miss == kNever;
+}
+
+}  // namespace
+
+TEST_CASE("shallow contacts: 1e-9 of the distance deep is a contact, 1e-9 short is not, for every solver",
+          "[field][toi][shallow]") {
+  Rng rng(kSeed + 13);
+  int tested = 0;
+  SECTION("unequal pairs, bracketed") {
+    for (int k = 0; k < 400; ++k) {
+      const PairScene s = random_pair(rng);
+      auto dist = [&](L t) { return ld_norm(ld_pos(s.r0, s.f2, t) - ld_pos({}, s.f1, t)); };
+      INFO("seed " << kSeed + 13 << " case " << k);
+      check_shallow(dist, [&](double c) { return toi_field_disc_disc(s.r0, s.f1, s.f2, c, s.H); }, s.H, tested);
+    }
+    CHECK(tested > 100);
+  }
+  SECTION("equal pairs, closed form and bracketed") {
+    for (int k = 0; k < 400; ++k) {
+      const double w = random_qm(rng) * random_bz(rng), speed = rng.log_uniform(1e-2, 1e2), rho = speed / std::abs(w);
+      const Vec2 a = rng.uniform(0, 2) * speed * std::abs(w) * rng.direction();
+      const FieldFlight f1{speed * rng.direction(), a, w}, f2{speed * rng.direction(), a, w};
+      const Vec2 r0 = rho * rng.uniform(0.5, 3) * rng.direction();
+      const double H = 0.9 * gyration_period(w);
+      auto dist = [&](L t) { return ld_norm(ld_pos(r0, f2, t) - ld_pos({}, f1, t)); };
+      INFO("seed " << kSeed + 13 << " case " << k);
+      check_shallow(dist, [&](double c) { return toi_field_disc_disc(r0, f1, f2, c, H); }, H, tested);
+      check_shallow(dist, [&](double c) { return toi_field_disc_disc_bracketed(r0, f1, f2, c, H); }, H, tested);
+    }
+    CHECK(tested > 200);
+  }
+  SECTION("wall ends, with and without drift") {
+    for (int k = 0; k < 400; ++k) {
+      const double w = random_qm(rng) * random_bz(rng), tau = rng.log_uniform(0.3, 3) / std::abs(w);
+      const Vec2 a = (k % 2 ? rng.uniform(0, 2) / tau * std::abs(w) : 0.0) * rng.direction();
+      const FieldFlight f{rng.uniform(0.2, 2) / tau * rng.direction(), a, w};
+      const Vec2 rel = rng.uniform(0.1, 3) * rng.direction();
+      const double H = tau * rng.uniform(1, 6);
+      auto dist = [&](L t) { return ld_norm(ld_pos(rel, f, t)); };
+      INFO("seed " << kSeed + 13 << " case " << k);
+      check_shallow(dist, [&](double c) { return toi_field_disc_point(rel, f, c, H); }, H, tested);
+    }
+    CHECK(tested > 100);
+  }
+  SECTION("wall faces, drift across (pieces), along and none (closed forms)") {
+    for (int k = 0; k < 600; ++k) {
+      const double w = random_qm(rng) * random_bz(rng), tau = rng.log_uniform(0.3, 3) / std::abs(w);
+      const Segment s = make_segment(Vec2{-1e6, 0}, Vec2{1e6, 0});  // the foot is always on it
+      Vec2 a = rng.uniform(0, 2) / tau * std::abs(w) * rng.direction();
+      if (k % 3 == 1) a = {a.x, 0.0};  // along the wall: closed form
+      if (k % 3 == 2) a = {};
+      const FieldFlight f{rng.uniform(0.2, 2) / tau * rng.direction(), a, w};
+      const Vec2 rel{0.0, rng.sign() * rng.uniform(0.1, 3)};
+      const double H = tau * rng.uniform(1, 6);
+      auto dist = [&](L t) { return std::fabs(ld_pos(rel, f, t).y); };
+      INFO("seed " << kSeed + 13 << " case " << k);
+      check_shallow(dist, [&](double c) { return toi_field_disc_segment(rel - s.p1, f, s, c, H); }, H, tested);
+    }
+    CHECK(tested > 150);
   }
 }
 
