@@ -625,9 +625,10 @@ double toi_field_disc_segment(Vec2 rel, const FieldFlight& f, const Segment& s, 
   // beside the segment, or around it, for many periods is ruled out a stretch at a time.
   const double rho = gyration_radius(f);
   const Vec2 gc0 = rel - (f.w * perp(f.v) - f.a) / (f.w * f.w), ud = drift_velocity(f);
-  const double margin = 64.0 * kEps * (norm(rel) + 2.0 * rho + radius + s.len + norm(ud) * std::min(horizon, 1e300));
+  const double fixed_margin = 64.0 * kEps * (norm(rel) + 2.0 * rho + radius + s.len);
   auto relevant = [&](double ta, double tb) {
     const Vec2 g0 = gc0 + ta * ud, g1 = gc0 + tb * ud;
+    const double margin = fixed_margin + 64.0 * kEps * norm(ud) * tb;
     for (double face : {1.0, -1.0}) {
       const Vec2 s0 = (face * radius) * s.n, s1 = s0 + s.len * s.u;
       if (segment_distance(g0, g1, s0, s1) > rho + margin) continue;

@@ -259,7 +259,7 @@ TEST_CASE("step-mode kicks: drift-then-kick is first order, a half kick each sid
       if (prev > 0.0) {
         const double ratio = prev / err;
         INFO("scheme " << static_cast<int>(scheme) << " n " << n << " ratio " << ratio);
-        CHECK(ratio == Approx(std::pow(2.0, order)).epsilon(0.05));
+        CHECK(ratio == Approx(std::pow(2.0, order)).epsilon(0.01));
       }
       prev = err;
     }

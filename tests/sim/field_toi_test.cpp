@@ -798,6 +798,32 @@ TEST_CASE("a circle of radius 1e-10 neither hangs nor loses time", "[field][toi]
   CHECK(seconds < 5.0);
 }
 
+TEST_CASE("a large fast circle round a short segment, drifting slowly across it, costs no more than a few periods", "[field][toi][tiny]") {
+  // w = 1e6, radius 4 about the origin, a shelf from (-0.5, 0) to (0.5, 0) inside the circle, ball
+  // radius 0.1, starting at the bottom (0, -4) moving -x (clockwise). The circle crosses the shelf's
+  // line beside the shelf twice a period; a drift of 0.1 upwards (a = (-1e5, 0): J(a)/w = (0, 0.1))
+  // brings the circle up to the shelf's underside (y = -0.1) after 38.7 s, 6.2e6 periods.
+  const Segment shelf = make_segment({-0.5, 0}, {0.5, 0});
+  const Vec2 x0{0, -4};
+  const FieldFlight f{{-4e6, 0.1}, {-1e5, 0}, 1e6};
+  REQUIRE(gyration_radius(f) == Approx(4).epsilon(1e-12));
+  const auto start = std::chrono::steady_clock::now();
+  const double t = toi_field_disc_segment(x0 - shelf.p1, f, shelf, 0.1, kNever);
+  const double never = toi_field_disc_segment(x0 - shelf.p1, {{-4e6, 0}, {}, 1e6}, shelf, 0.1, kNever);
+  const double short_horizon = toi_field_disc_segment(x0 - shelf.p1, f, shelf, 0.1, 38.0);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  CHECK(never == kNever);
+  CHECK(short_horizon == kNever);
+  // The ball first touches the underside (foot at the shelf's end, going up on the left) when the
+  // circle's chord at y = -0.1 is the shelf's length: centre at sqrt(16 - 0.25) - 0.1, within a
+  // period (6.3e-6 s) of t = 38.686.
+  CHECK(t == Approx((std::sqrt(15.75) - 0.1) / 0.1).epsilon(2e-7));
+  const Vec2 at = x0 + field_displacement(f, t);
+  CHECK(at.y == Approx(-0.1).margin(1e-9));
+  CHECK(std::abs(at.x) <= 0.5);
+  CHECK(seconds < 5.0);  // a hang guard, not a timing
+}
+
 TEST_CASE("no NaN and no negative time over the issue's whole field range", "[field][toi][stability]") {
   Rng rng(kSeed + 12);
   for (int k = 0; k < 20000; ++k) {

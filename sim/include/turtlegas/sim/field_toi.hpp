@@ -21,13 +21,15 @@ double toi_field_disc_disc_rotating(Vec2 r, Vec2 dv, double w, double sigma, dou
 
 /// Two discs on any field flights (a turtle is w = 0, a = 0). Dispatches to the closed forms when
 /// the relative motion allows (equal w and a; both w == 0, a relative parabola; one body at rest
-/// and the other without drift) and otherwise to toi_field_disc_disc_bracketed. horizon finite.
+/// and the other without drift) and otherwise to toi_field_disc_disc_bracketed.
 double toi_field_disc_disc(Vec2 r, const FieldFlight& f1, const FieldFlight& f2, double sigma, double horizon);
 
 /// The general solver, for any two flights and a finite horizon: gap g(t) = |r(t)|^2 - sigma^2
 /// searched on [0, horizon] by splitting it into pieces, each either proven free of a fall (Taylor
 /// bounds from |r''| <= |a1 + w1 J v1| + |a2 + w2 J v2|, which holds for every t, with the
-/// evaluation error included) or proven monotone and then bisected to adjacent doubles.
+/// evaluation error included) or proven monotone and then refined to adjacent doubles. The horizon
+/// must be finite unless both bodies gyrate (or rest) with different drifts, whose envelopes part
+/// for good; a non-finite horizon otherwise returns kNever.
 double toi_field_disc_disc_bracketed(Vec2 r, const FieldFlight& f1, const FieldFlight& f2, double sigma,
                                      double horizon);
 
@@ -36,13 +38,15 @@ double toi_field_disc_disc_bracketed(Vec2 r, const FieldFlight& f1, const FieldF
 /// a drift term (n.u_d) t plus a sinusoid: without normal drift (cross(n, a) == 0) each face's
 /// falls come in closed form once per period, the foot of each checked and stepped along by the
 /// tangential drift per period in closed form; with normal drift the distance's critical points
-/// are in closed form, and each monotone piece between them is bisected. w == 0 is
-/// toi_disc_segment. horizon may be kNever only without normal drift.
+/// are in closed form, and each monotone piece between them is refined, searched only while the
+/// circle can reach a face's contact segment. w == 0 is toi_disc_segment. horizon may be kNever.
+/// Cost grows with the periods during which the circle keeps crossing the wall's line beside the
+/// segment: pass the best candidate found so far (a wall end's contact) as the horizon.
 double toi_field_disc_segment(Vec2 rel, const FieldFlight& f, const Segment& s, double radius, double horizon);
 
 /// A disc at rel = x - p on flight f reaching the point p (a wall end). Without drift (a == 0) the
 /// closed form of toi_field_disc_disc_rotating; w == 0 is toi_disc_point_accel; otherwise the
-/// bracketed solver. horizon finite unless a == 0 or (w == 0 and a == 0).
+/// bracketed solver, searching only while the circle can reach the point. horizon may be kNever.
 double toi_field_disc_point(Vec2 rel, const FieldFlight& f, double radius, double horizon);
 
 /// The first time in [0, horizon] the coordinate x + (x(t) - x(0)) along `axis` (0: x, 1: y)
