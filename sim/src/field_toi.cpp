@@ -23,9 +23,7 @@ bool at_rest(const FieldFlight& f) { return f.w == 0.0 && f.a == Vec2{} && f.v =
 // T >= 0 is the first half period (|w| t = 2 atan(|w| T / 2)), T = +-inf the middle, T < 0 the
 // second half; sign(f) = sign(q) and T grows with t, so f's falls are q's falls.
 
-// The phase |w| t in [0, 2 pi) of T = num / den (den == 0: T infinite, phase pi). atan2 keeps the
-// digits of small phases (the time is then num / den to a few ulps) and 2 pi + 2 alpha, alpha in
-// [-pi/2, 0), adds quantities of the same sign.
+// The phase |w| t in [0, 2 pi) of T = num / den (den == 0: T infinite, phase pi), for knots.
 double phase_of(double num, double den, double aw) {
   if (den < 0.0) {
     num = -num;
@@ -36,15 +34,35 @@ double phase_of(double num, double den, double aw) {
   return kTwoPi + 2.0 * half;
 }
 
-// The phase in [0, 2 pi) of the falling root of q (where q' = -2 sqrt(disc) < 0), disc = b^2 - c0
-// c2 given by the caller in its own cancellation-free form; -1 when q has no simple root (a miss
+// The time in [0, 2 pi / |w|) of T = num / den: 2 atan(|w| T / 2) / |w| in the first half period
+// (T >= 0), formed as T (1 - x^2/3), x = |w| T / 2, when x < 1e-8 (the next term, x^4/5, is below
+// 2e-33), so that neither an underflow of |w| num nor a tiny w can turn it into 0: a small w is
+// never zero; pi / |w| for T infinite; (2 pi + 2 alpha) / |w|, alpha in [-pi/2, 0), in the second
+// half, a sum of like signs.
+double time_of(double num, double den, double aw) {
+  if (den < 0.0) {
+    num = -num;
+    den = -den;
+  }
+  if (num >= 0.0 && den > 0.0) {
+    const double q = num / den;
+    const double x = 0.5 * aw * q;
+    if (x < 1e-8) return q * (1.0 - x * x / 3.0);
+    return 2.0 * std::atan(x) / aw;
+  }
+  if (den == 0.0) return kPi / aw;
+  return (kTwoPi + 2.0 * std::atan2(0.5 * aw * num, den)) / aw;
+}
+
+// The time in [0, 2 pi / |w|) of the falling root of q (where q' = -2 sqrt(disc) < 0), disc = b^2 -
+// c0 c2 given by the caller in its own cancellation-free form; -1 when q has no simple root (a miss
 // or a graze). The root (-b - sqrt(disc)) / c2 is formed as c0 / (-b + sqrt(disc)) when b < 0, so
-// that neither form subtracts; c2 == 0 with b > 0 puts it at infinity (phase pi).
-double falling_phase(double c0, double b, double c2, double disc, double aw) {
+// that neither form subtracts; c2 == 0 with b > 0 puts it at infinity (half a period).
+double falling_time(double c0, double b, double c2, double disc, double aw) {
   if (!(disc > 0.0)) return -1.0;
   const double sq = std::sqrt(disc);
-  if (b < 0.0) return phase_of(c0, sq - b, aw);
-  return phase_of(-(b + sq), c2, aw);
+  if (b < 0.0) return time_of(c0, sq - b, aw);
+  return time_of(-(b + sq), c2, aw);
 }
 
 // ---- Bracketed refinement ------------------------------------------------------------------
@@ -517,9 +535,8 @@ double toi_field_disc_disc_rotating(Vec2 r, Vec2 dv, double w, double sigma, dou
   const double c2 = m2 - ws * ws;
   const double cm = cross(r, m);
   const double disc = sigma * sigma * (m2 + hw * hw * g0) - cm * cm;
-  const double phase = falling_phase(g0, b, c2, disc, std::abs(w));
-  if (phase < 0.0) return kNever;
-  const double t = phase / std::abs(w);
+  const double t = falling_time(g0, b, c2, disc, std::abs(w));
+  if (t < 0.0) return kNever;
   return t <= horizon ? t : kNever;
 }
 
@@ -589,10 +606,9 @@ double toi_field_disc_segment(Vec2 rel, const FieldFlight& f, const Segment& s, 
     for (const Gap1& g : gaps) {
       const double b = 0.5 * g.sign * p.A;
       const double c2 = g.g0 * (0.25 * f.w * f.w) + 0.5 * g.sign * p.acc_n;
-      const double phase = falling_phase(g.g0, b, c2, b * b - g.g0 * c2, aw);
-      if (phase < 0.0) continue;
-      auto time_k = [&](double k) { return (phase + kTwoPi * k) / aw; };
-      const double t0 = time_k(0.0);
+      const double t0 = falling_time(g.g0, b, c2, b * b - g.g0 * c2, aw);
+      if (t0 < 0.0) continue;
+      auto time_k = [&](double k) { return t0 + k * period; };
       if (t0 >= best || t0 > horizon) continue;
       const double foot0 = foot_at(t0);
       if (foot0 >= 0.0 && foot0 <= s.len) {
@@ -671,9 +687,8 @@ AxisExit field_axis_exit(double x, const FieldFlight& f, int axis, double lo, do
         t = 0.0;
       } else {
         const double c2 = c0 * (0.25 * f.w * f.w) + e2;
-        const double phase = falling_phase(c0, b, c2, b * b - c0 * c2, aw);
-        if (phase < 0.0) continue;
-        t = phase / aw;
+        t = falling_time(c0, b, c2, b * b - c0 * c2, aw);
+        if (t < 0.0) continue;
       }
       if (t < best.t) best = {t, g == 0};
     }

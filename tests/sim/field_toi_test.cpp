@@ -183,6 +183,24 @@ TEST_CASE("rotating pair: w = 0 is toi_disc_disc and a small w tends to it", "[f
   }
 }
 
+TEST_CASE("a w so small that w times anything underflows is still not zero", "[field][toi][continuity]") {
+  // Subnormal w: the closed forms take their small-phase branch and give the straight and parabola
+  // times, not 0 (an underflowed phase) and not never.
+  for (double w : {1e-300, 1e-310, 5e-324, -5e-324}) {
+    INFO("w " << w);
+    const Vec2 r0{5, 1}, dv{-1, 0.1};
+    const double t0 = toi_disc_disc(r0, dv, 2.0);
+    CHECK(toi_field_disc_disc_rotating(r0, dv, w, 2.0, kNever) == Approx(t0).epsilon(1e-14));
+    const Segment s = make_segment({-5, 0}, {5, 0});
+    const Vec2 v{0.3, -1}, a{0, -1};  // a along n: the closed form for faces
+    const double ts = toi_disc_segment(Vec2{0, 3} - s.p1, v, a, s, 0.5);
+    CHECK(toi_field_disc_segment(Vec2{0, 3} - s.p1, {v, a, w}, s, 0.5, kNever) == Approx(ts).epsilon(1e-14));
+    const AxisExit e0 = axis_exit(0.0, v.y, a.y, -1, 1);
+    CHECK(field_axis_exit(0.0, {v, a, w}, 1, -1, 1, kNever).t == Approx(e0.t).epsilon(1e-14));
+    CHECK(toi_field_disc_point({0, 3}, {v, {}, w}, 0.5, kNever) == Approx(toi_disc_point({0, 3}, v, 0.5)).epsilon(1e-14));
+  }
+}
+
 // ---- Exact tangencies (the issue's hard cases) -------------------------------------------------
 // A ball at (0, -4) moving at (-2, 0) with w = 1 circles clockwise about (0, -2) with radius 2; its
 // top is (0, 0). Every number below is a dyadic rational, so the closed forms see exact tangency.
