@@ -425,7 +425,9 @@ struct Node {
 //   -M_lo <= g'' <= M_hi,  M_lo = 2 R A,  M_hi = 2 V^2 + 2 R A,
 // so from either end g lies between two parabolas. With the evaluation errors subtracted:
 //   * g > 0 on the node if the lower parabolas from a and from b, positive at their ends, stay
-//     positive over lengths that together cover h (safe_step); g < 0 likewise with the upper ones;
+//     positive over lengths that together cover h (safe_step; the envelopes' bound, when both
+//     bodies have one, may lengthen them: PairGap::envelope_step); g < 0 likewise with the upper
+//     parabolas;
 //   * g is monotone if g'(a) + M_hi h < 0 or g'(b) + M_lo h < 0 (falling), or the mirror (rising).
 // A node whose computed ends fall (g(a) >= 0 > g(b)) and is monotone is refined; a node proven
 // positive, negative or monotone without such a fall holds no fall (of the exact g, deeper than the
