@@ -150,8 +150,6 @@ TEST_CASE("guiding centre, drift, period and radius hold along random flights", 
     for (double frac : {0.1, 0.37, 0.5, 0.99, 1.0, 7.3}) {
       const double t = frac * gyration_period(f.w);
       const FieldState s = field_advance(x0, f, t);
-      const FlightCoefficients unused = flight_coefficients(f.w, t);
-      (void)unused;
       // The centre moves at the drift; the body stays at the radius from it; |x''| is constant.
       const Vec2 c = guiding_centre(s.x, {s.v, f.a, f.w});
       REQUIRE(norm(c - (c0 + t * ud)) <= 1e-12 * scale);
