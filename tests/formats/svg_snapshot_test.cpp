@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "turtlegas/world/svg_snapshot.hpp"
+#include "turtlegas/formats/svg_snapshot.hpp"
 
 #include <sstream>
 #include <string>
@@ -7,7 +7,7 @@
 #include <catch2/catch.hpp>
 
 namespace sim = turtlegas::sim;
-namespace tw = turtlegas::world;
+namespace tf = turtlegas::formats;
 
 namespace {
 
@@ -34,12 +34,12 @@ TEST_CASE("an SVG snapshot draws the arena, walls and balls with +y up") {
     b.radius = 3;
     def.balls.push_back(b);
   }
-  const tw::Snapshot snap = tw::snapshot_of(def);
+  const tf::Snapshot snap = tf::snapshot_of(def);
   CHECK(snap.walls.size() == 5);  // the scene's wall and the four arena walls
   CHECK(snap.balls.size() == 5);
 
   std::ostringstream out;
-  tw::write_svg(out, snap, 400.0);
+  tf::write_svg(out, snap, 400.0);
   const std::string svg = out.str();
   CHECK(svg.starts_with("<?xml"));
   CHECK(svg.find("</svg>") != std::string::npos);
@@ -65,12 +65,12 @@ TEST_CASE("an SVG snapshot draws turtles with a heading tick and their id, and p
   t.heading = 1.5707963267948966;  // Logo: 90 degrees, towards +x
   t.radius = 10;
   def.turtles.push_back(t);
-  tw::Snapshot snap = tw::snapshot_of(def);
+  tf::Snapshot snap = tf::snapshot_of(def);
   REQUIRE(snap.turtles.size() == 1);
   snap.turtles[0].trail = {{10, 10}, {10, 50}, {50, 50}};
 
   std::ostringstream out;
-  tw::write_svg(out, snap, 100.0);
+  tf::write_svg(out, snap, 100.0);
   const std::string svg = out.str();
   CHECK(count(svg, "class=\"turtle\"") == 1);
   CHECK(count(svg, "class=\"trail\"") == 1);
@@ -100,10 +100,10 @@ TEST_CASE("an SVG snapshot draws moving walls where they are at its time, and ab
   CHECK(sim::wall_visible(gate, 0.5));
   CHECK_FALSE(sim::wall_visible(gate, 1.0));
 
-  tw::Snapshot snap = tw::snapshot_of(def);
+  tf::Snapshot snap = tf::snapshot_of(def);
   snap.time = 1.0;
   std::ostringstream out;
-  tw::write_svg(out, snap, 100.0);
+  tf::write_svg(out, snap, 100.0);
   const std::string svg = out.str();
   CHECK(svg.find("x1=\"10\" y1=\"10\" x2=\"20\" y2=\"20\"") != std::string::npos);
   CHECK(count(svg, "stroke-dasharray") == 1);

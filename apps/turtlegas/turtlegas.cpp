@@ -32,11 +32,11 @@
 #include "tag_command.hpp"
 #include "test_command.hpp"
 #include "turtlegas/controllers/registry.hpp"
+#include "turtlegas/formats/svg_snapshot.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/turtle/game.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 #include "turtlegas/world/game_file.hpp"
-#include "turtlegas/world/svg_snapshot.hpp"
 #include "turtlegas/world/world_file.hpp"
 
 namespace {
@@ -44,6 +44,7 @@ namespace {
 namespace fs = std::filesystem;
 namespace sim = turtlegas::sim;
 namespace tw = turtlegas::world;
+namespace tf = turtlegas::formats;
 namespace tt = turtlegas::turtle;
 using Clock = std::chrono::steady_clock;
 
@@ -645,7 +646,7 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
   }
 
   if (svg_file) {
-    tw::write_svg(svg_file->stream(), server ? tw::snapshot_of(*server, def) : tw::snapshot_of(world, def));
+    tf::write_svg(svg_file->stream(), server ? tf::snapshot_of(*server, def) : tf::snapshot_of(world, def));
     svg_file->commit();
   }
 

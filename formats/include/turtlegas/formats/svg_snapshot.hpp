@@ -9,7 +9,7 @@
 #include "turtlegas/sim/world_def.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
-namespace turtlegas::world {
+namespace turtlegas::formats {
 
 /// What an SVG snapshot draws: the arena, the walls, the live balls and the turtles (with their pen
 /// trails) at one time.
@@ -70,4 +70,4 @@ Snapshot snapshot_of(const turtle::WorldServer& server, const sim::WorldDef& def
 /// size of the arena's longer side in the image.
 void write_svg(std::ostream& out, const Snapshot& snapshot, double width_px = 800.0);
 
-}  // namespace turtlegas::world
+}  // namespace turtlegas::formats

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "turtlegas/world/svg_snapshot.hpp"
+#include "turtlegas/formats/svg_snapshot.hpp"
 
 #include <algorithm>
 #include <array>
@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <ostream>
 
-namespace turtlegas::world {
+namespace turtlegas::formats {
 namespace {
 
 /// Six significant digits: a pixel is far coarser, and the file stays small.
@@ -184,4 +184,4 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
       << "</svg>\n";
 }
 
-}  // namespace turtlegas::world
+}  // namespace turtlegas::formats
