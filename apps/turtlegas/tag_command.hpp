@@ -9,7 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/turtle/registry.hpp"
 
 namespace turtlegas::apps {
 

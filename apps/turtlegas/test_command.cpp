@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "turtlegas/world/expect.hpp"
+#include "turtlegas/world/scenario.hpp"
 #include "turtlegas/world/world_file.hpp"
 
 namespace turtlegas::apps {

@@ -8,7 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/turtle/registry.hpp"
 
 namespace turtlegas::apps {
 

@@ -36,7 +36,7 @@
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/turtle/game.hpp"
 #include "turtlegas/turtle/world_server.hpp"
-#include "turtlegas/world/game_file.hpp"
+#include "turtlegas/world/scene.hpp"
 #include "turtlegas/world/world_file.hpp"
 
 namespace {
@@ -290,7 +290,7 @@ tw::Scene load(const std::string& file, const tt::Registry& registry) {
 std::unique_ptr<tt::WorldServer> make_server(const tw::Scene& scene, const tt::Registry& registry,
                                              const tt::ServerOptions& options, const std::string& file) {
   try {
-    return tw::make_server(scene, registry, options);  // with the scene's game (game_file.hpp)
+    return tw::make_server(scene, registry, options);  // with the scene's game (scene.hpp)
   } catch (const std::invalid_argument& e) {
     throw BadInput(file + ": " + (options.mode == sim::Mode::exact ? "exact" : "step") + " mode: " + e.what());
   }

@@ -8,6 +8,7 @@
 
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/world/expect.hpp"
+#include "turtlegas/world/scenario.hpp"
 #include "turtlegas/world/world_file.hpp"
 
 using namespace turtlegas;

@@ -6,7 +6,6 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <set>
 #include <stdexcept>
 #include <string_view>
@@ -15,8 +14,8 @@
 
 #include "suggest.hpp"
 #include "turtlegas/sim/format.hpp"
-#include "turtlegas/world/game_file.hpp"
-#include "turtlegas/world/world_file.hpp"
+#include "turtlegas/turtle/game.hpp"
+#include "turtlegas/world/file_error.hpp"
 
 namespace turtlegas::world {
 namespace {
@@ -621,29 +620,6 @@ const std::vector<AssertionKind>& assertion_kinds() {
   return kinds;
 }
 
-// ---- RunView
-
-RunView::RunView(const turtle::WorldServer& server, const sim::WorldDef& def) : server_(server), def_(def) {}
-
-RunView::Body RunView::body(const std::string& id) const {
-  Body b;
-  const sim::World& w = world();
-  for (std::size_t i = 0; i < def_.turtles.size(); ++i)
-    if (def_.turtles[i].id == id) {
-      const sim::TurtleState s = w.turtle(i);
-      double h = std::fmod(s.heading * (180.0 / std::numbers::pi), 360.0);
-      if (h < 0.0) h += 360.0;
-      if (h >= 360.0) h = 0.0;
-      return {true, true, true, s.pos, s.vel, h};
-    }
-  for (std::size_t i = 0; i < def_.balls.size(); ++i)
-    if (def_.balls[i].id == id) {
-      const sim::BallState s = w.ball(i);
-      return {true, false, s.alive, s.pos, s.vel, 0.0};
-    }
-  return b;
-}
-
 // ---- ExpectParser
 
 ExpectParser::ExpectParser(std::string file, const sim::WorldDef& def) : file_(std::move(file)), def_(def) {}
@@ -795,63 +771,6 @@ Expectations parse_expect(const json& expect, const std::string& file, const sim
     out.entries.push_back({i, kind, it->parse(e, ep, p)});
   }
   return out;
-}
-
-// ---- run_expectations
-
-ExpectResult run_expectations(const Scene& scene, const turtle::Registry& registry, sim::Mode mode,
-                              turtle::ServerOptions options) {
-  const sim::WorldDef& def = scene.def;
-  const Expectations& expect = scene.expect;
-  if (!expect.until) throw std::invalid_argument("the scene's expect list has no {\"until\": T}");
-  const double until = *expect.until;
-  options.mode = mode;
-  // With the scene's game, so that {"it": ...} sees it played.
-  const std::unique_ptr<turtle::WorldServer> played = make_server(scene, registry, options);
-  turtle::WorldServer& server = *played;
-  std::vector<turtle::LogEvent> log;
-  server.set_event_log(&log);
-  const RunView view(server, def);
-
-  std::vector<std::unique_ptr<Check>> checks;
-  std::vector<double> times;
-  for (const auto& entry : expect.entries) {
-    checks.push_back(entry.assertion->start(view));
-    for (double t : entry.assertion->sample_times())
-      if (t <= until) times.push_back(t);
-  }
-  // Every control step boundary, as the server computes it (k dt), then the end.
-  for (std::uint64_t k = 1;; ++k) {
-    const double t = static_cast<double>(k) * def.dt;
-    if (!(t < until)) break;
-    times.push_back(t);
-  }
-  times.push_back(until);
-  std::sort(times.begin(), times.end());
-  times.erase(std::unique(times.begin(), times.end()), times.end());
-
-  ExpectResult result;
-  result.assertions = checks.size();
-  for (auto& c : checks) c->on_step(view);
-  try {
-    for (double t : times) {
-      if (t <= 0.0) continue;
-      server.run_until(t);
-      for (const turtle::LogEvent& e : log)
-        for (auto& c : checks) c->on_event(e, view);
-      log.clear();
-      for (auto& c : checks) c->on_step(view);
-    }
-  } catch (const turtle::BusyLoopError& e) {
-    server.set_event_log(nullptr);
-    result.failures.push_back("the run stopped at t = " + num(server.time()) + ": " + e.what());
-    return result;
-  }
-  server.set_event_log(nullptr);
-  for (std::size_t i = 0; i < checks.size(); ++i)
-    if (auto failure = checks[i]->finish(view))
-      result.failures.push_back("expect[" + std::to_string(expect.entries[i].index) + "] " + *failure);
-  return result;
 }
 
 }  // namespace turtlegas::world

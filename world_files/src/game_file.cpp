@@ -4,8 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "turtlegas/world/world_file.hpp"
-
 namespace turtlegas::world {
 
 turtle::TagRules read_game(const nlohmann::json& game, const sim::WorldDef& def,
@@ -45,18 +43,6 @@ turtle::TagRules read_game(const nlohmann::json& game, const sim::WorldDef& def,
     rules.no_tag_back = v.get<double>();
   }
   return rules;
-}
-
-std::unique_ptr<turtle::Game> make_game(const Scene& scene) {
-  if (!scene.game) return nullptr;
-  return std::make_unique<turtle::TagGame>(*scene.game);
-}
-
-std::unique_ptr<turtle::WorldServer> make_server(const Scene& scene, const turtle::Registry& registry,
-                                                 const turtle::ServerOptions& options) {
-  auto server = std::make_unique<turtle::WorldServer>(scene.def, scene.programs, registry, options);
-  if (auto game = make_game(scene)) server->set_game(std::move(game));
-  return server;
 }
 
 }  // namespace turtlegas::world

@@ -31,13 +31,6 @@ namespace {
 using json = nlohmann::json;
 using sim::Vec2;
 
-std::string prefix(const std::string& file, const std::string& path, const std::string& reason, std::size_t line,
-                   std::size_t column) {
-  if (line > 0) return file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + reason;
-  if (!path.empty()) return file + ": " + path + ": " + reason;
-  return file + ": " + reason;
-}
-
 std::string num(double v) { return sim::format_number(v); }
 std::string vec(Vec2 v) { return sim::format_vec(v); }
 
@@ -801,19 +794,6 @@ std::pair<std::size_t, std::size_t> line_and_column(std::string_view text, std::
     if (text[i] == '\n') ++line, line_start = i + 1;
   return {line, pos - line_start + 1};
 }
-
-}  // namespace
-
-WorldFileError::WorldFileError(std::string file_, std::string json_path_, std::string reason_, std::size_t line_,
-                               std::size_t column_)
-    : std::runtime_error(prefix(file_, json_path_, reason_, line_, column_)),
-      file(std::move(file_)),
-      json_path(std::move(json_path_)),
-      reason(std::move(reason_)),
-      line(line_),
-      column(column_) {}
-
-namespace {
 
 Scene parse(std::string_view text, std::string_view file_name, const turtle::Registry* registry) {
   const std::string file(file_name);

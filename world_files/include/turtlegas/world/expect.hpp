@@ -6,6 +6,7 @@
 // {"until": T} (the run's length, required by `turtlegas test`) and {"mode": "exact"|"step"|"both"}.
 // The assertion kinds are an explicit table in expect.cpp (assertion_kinds()): a new kind is one
 // class and one line there. docs/worlds.md, "Scripted test worlds", is the user's reference.
+// Running a scene against its list is scenario.hpp's.
 #pragma once
 
 #include <cstddef>
@@ -19,49 +20,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "turtlegas/sim/world.hpp"
-#include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/sim/world_def.hpp"
+#include "turtlegas/turtle/log_event.hpp"
+#include "turtlegas/world/run_view.hpp"
 
 namespace turtlegas::world {
-
-struct Scene;  // world_file.hpp
-
-/// What a check sees of a run in progress: the server (and through it the engine) and the scene's
-/// bodies by id. Valid only during run_expectations.
-class RunView {
- public:
-  RunView(const turtle::WorldServer& server, const sim::WorldDef& def);
-
-  double time() const { return server_.time(); }
-  const turtle::WorldServer& server() const { return server_; }
-  const sim::World& world() const { return server_.world(); }
-  const sim::WorldDef& def() const { return def_; }
-
-  /// A body by id: a ball (alive or not) or a turtle. `heading` in degrees [0, 360), turtles only.
-  struct Body {
-    bool found = false;
-    bool turtle = false;
-    bool alive = true;
-    sim::Vec2 pos;
-    sim::Vec2 vel;
-    double heading = 0.0;
-  };
-  Body body(const std::string& id) const;
-  /// Every ball (alive) and turtle, as (id, position).
-  template <class F>
-  void for_each_body(F&& f) const {
-    const sim::World& w = world();
-    for (std::size_t i = 0; i < w.ball_count(); ++i) {
-      const sim::BallState b = w.ball(i);
-      if (b.alive) f(def_.balls[i].id, b.pos);
-    }
-    for (std::size_t i = 0; i < w.turtle_count(); ++i) f(def_.turtles[i].id, w.turtle(i).pos);
-  }
-
- private:
-  const turtle::WorldServer& server_;
-  const sim::WorldDef& def_;
-};
 
 /// One run's checking of one assertion: fed every event and every control step, asked at the end.
 class Check {
@@ -98,7 +61,7 @@ struct Expectations {
 };
 
 /// Helpers a kind's parser uses: typed reads that fail as world-file errors at a JSON path.
-/// (Throws WorldFileError from world_file.hpp.)
+/// (Throws WorldFileError, file_error.hpp.)
 class ExpectParser {
  public:
   ExpectParser(std::string file, const sim::WorldDef& def);
@@ -142,18 +105,5 @@ const std::vector<AssertionKind>& assertion_kinds();
 
 /// Parses a world file's `expect` value (at JSON path /expect). Throws WorldFileError naming `file`.
 Expectations parse_expect(const nlohmann::json& expect, const std::string& file, const sim::WorldDef& def);
-
-struct ExpectResult {
-  std::size_t assertions = 0;           ///< how many were checked
-  std::vector<std::string> failures;    ///< "expect[2] count ball-wall = 7, wanted >= 10"
-  bool passed() const { return failures.empty(); }
-};
-
-/// Runs a scene in `mode` through a WorldServer until its {"until": T}, stopping at every control
-/// step (and at the times assertions ask for) to feed the checks. A program fault is not an error
-/// here: it is a `fault` event (assert {"no_event": "fault"}); a busy loop ends the run as a failure.
-/// Throws std::invalid_argument when the server rejects the scene or it has no `until`.
-ExpectResult run_expectations(const Scene& scene, const turtle::Registry& registry, sim::Mode mode,
-                              turtle::ServerOptions options = {});
 
 }  // namespace turtlegas::world

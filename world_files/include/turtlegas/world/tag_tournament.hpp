@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "turtlegas/turtle/world_server.hpp"
-#include "turtlegas/world/world_file.hpp"
+#include "turtlegas/world/scene.hpp"
 
 namespace turtlegas::world {
 
