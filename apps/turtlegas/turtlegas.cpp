@@ -17,7 +17,6 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -33,6 +32,7 @@
 #include "test_command.hpp"
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/formats/svg_snapshot.hpp"
+#include "turtlegas/sim/angles.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/turtle/game.hpp"
 #include "turtlegas/turtle/world_server.hpp"
@@ -478,9 +478,7 @@ void write_state(AtomicFile& file, const sim::World& world, const IdTable& ball_
     buf += ", ";
     append_number(buf, tu.pos.y);
     // Radians inside, degrees in files (Logo convention: 0 is +y, clockwise), in [0, 360).
-    double heading = std::fmod(tu.heading * (180.0 / std::numbers::pi), 360.0);
-    if (heading < 0.0) heading += 360.0;
-    if (heading >= 360.0) heading = 0.0;  // -1e-17 + 360 rounds to 360
+    const double heading = sim::wrap_heading_degrees(sim::file_degrees(tu.heading));
     buf += "], \"heading\": ";
     append_number(buf, heading);
     buf += "}";

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <ostream>
 
+#include "turtlegas/sim/angles.hpp"
+
 namespace turtlegas::formats {
 namespace {
 
@@ -137,9 +139,7 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
   }
   for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
     const auto& t = snap.turtles[i];
-    // Logo convention: heading 0 points to +y and angles grow clockwise, so the direction is
-    // (sin h, cos h).
-    const sim::Vec2 tip = t.pos + t.radius * sim::Vec2{std::sin(t.heading), std::cos(t.heading)};
+    const sim::Vec2 tip = t.pos + t.radius * sim::heading_unit(t.heading);
     out << "<circle class=\"turtle\" cx=\"" << fmt(t.pos.x) << "\" cy=\"" << fmt(t.pos.y) << "\" r=\"" << fmt(t.radius)
         << "\" fill=\"" << turtle_colours[i % turtle_colours.size()]
         << "\" fill-opacity=\"0.8\" stroke=\"#222\" stroke-width=\"1\" vector-effect=\"non-scaling-stroke\"/>\n"

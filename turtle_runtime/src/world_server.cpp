@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -12,22 +11,11 @@
 
 #include "fiber.hpp"
 #include "mt64.hpp"
+#include "turtlegas/sim/angles.hpp"
 #include "turtlegas/turtle/game.hpp"
 
 namespace turtlegas::turtle {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-double wrap_degrees(double a) {
-  // Within two turns either way (bearings, arcs), one or two exact steps of 360 give fmod's
-  // answer bit for bit (the differences are exact by Sterbenz's lemma); fmod only beyond.
-  if (a >= 0.0 && a < 360.0) return a;
-  if (a >= 360.0 && a < 720.0) return a - 360.0;
-  if (a < 0.0 && a > -360.0) return a + 360.0;
-  a = std::fmod(a, 360.0);
-  return a < 0 ? a + 360.0 : a;
-}
 
 // FNV-1a: a stable hash, so that per-turtle random streams do not depend on the library.
 std::uint64_t fnv1a(const std::string& s) {
@@ -250,7 +238,7 @@ std::uint64_t WorldServer::Impl::sensors_for(const Agent& a, double bearing) con
   for (std::size_t k = 0; k < a.program.sensors.size(); ++k) {
     const SensorArc& s = a.program.sensors[k];
     const double span = s.to - s.from;
-    if (wrap_degrees(bearing - s.from) < (span >= 360.0 ? 360.0 : wrap_degrees(span))) fired |= std::uint64_t{1} << k;
+    if (sim::wrap_degrees(bearing - s.from) < (span >= 360.0 ? 360.0 : sim::wrap_degrees(span))) fired |= std::uint64_t{1} << k;
   }
   return fired;
 }
@@ -258,9 +246,9 @@ std::uint64_t WorldServer::Impl::sensors_for(const Agent& a, double bearing) con
 Touch Agent::make_touch(const sim::TurtleContact& c) const {
   // The contact point lies against the normal (which points from the obstacle to the turtle).
   const sim::Vec2 d = -c.normal;
-  const double heading_deg = server->world.turtle(index).heading / kDeg;
+  const double heading_deg = sim::api_degrees(server->world.turtle(index).heading);
   Touch t;
-  t.bearing = wrap_degrees(std::atan2(d.x, d.y) / kDeg - heading_deg);
+  t.bearing = sim::wrap_degrees(sim::api_degrees(sim::heading_of(d)) - heading_deg);
   t.sensors = server->sensors_for(*this, t.bearing);
   t.sensor_names = &sensor_names;
   t.what = server->other_id(c.kind, c.other);
@@ -315,7 +303,7 @@ void WorldServer::Impl::finish_command(Agent& a) {
   if (a.waiting_on == sim::TurtleCommand::Kind::move) a.odometer += s.done;
   if (a.pen_down) a.trail.push_back(s.pos);
   if (a.lays_wall && s.pos != a.stroke_start) lay_wall(a, a.stroke_start, s.pos);
-  const double done = a.waiting_on == sim::TurtleCommand::Kind::turn ? s.done / kDeg : s.done;
+  const double done = a.waiting_on == sim::TurtleCommand::Kind::turn ? sim::api_degrees(s.done) : s.done;
   // A touch that cut the command short is the first of those delivered on resuming.
   a.answer = s.touched && !a.inbox.empty() ? Result(done, a.inbox.front()) : Result(done, std::nullopt);
 }
@@ -325,8 +313,8 @@ void WorldServer::Impl::finish_command(Agent& a) {
 
 Result Turtle::forward(double distance) { return agent_->issue({sim::TurtleCommand::Kind::move, distance}); }
 Result Turtle::back(double distance) { return agent_->issue({sim::TurtleCommand::Kind::move, -distance}); }
-Result Turtle::right(double degrees) { return agent_->issue({sim::TurtleCommand::Kind::turn, degrees * kDeg}); }
-Result Turtle::left(double degrees) { return agent_->issue({sim::TurtleCommand::Kind::turn, -degrees * kDeg}); }
+Result Turtle::right(double degrees) { return agent_->issue({sim::TurtleCommand::Kind::turn, sim::to_radians(degrees)}); }
+Result Turtle::left(double degrees) { return agent_->issue({sim::TurtleCommand::Kind::turn, sim::to_radians(-degrees)}); }
 Result Turtle::wait(double seconds) { return agent_->issue({sim::TurtleCommand::Kind::wait, seconds}); }
 void Turtle::yield() { agent_->issue({sim::TurtleCommand::Kind::stop, 0.0}); }
 void Turtle::pen_up() { agent_->pen_down = false; }
@@ -345,7 +333,7 @@ void Turtle::on_touch(std::function<void(const Touch&)> handler) { agent_->handl
 void Turtle::on_message(std::function<void(const Message&)> handler) { agent_->message_handler = std::move(handler); }
 bool Turtle::it() const { return agent_->it; }
 double Turtle::odometer() const { return agent_->odometer; }
-double Turtle::heading() const { return wrap_degrees(agent_->server->world.turtle(agent_->index).heading / kDeg); }
+double Turtle::heading() const { return sim::wrap_degrees(sim::api_degrees(agent_->server->world.turtle(agent_->index).heading)); }
 std::optional<sim::Vec2> Turtle::position() const {
   if (!agent_->program.gps) return std::nullopt;
   return agent_->server->world.turtle(agent_->index).pos;
@@ -358,11 +346,11 @@ void Turtle::log(const std::string& message) { spdlog::info("turtle '{}' t={:.6g
 std::vector<Touch> Turtle::touching() const {
   // Contacts in force, with their sensors worked out for the heading the turtle has now.
   std::vector<Touch> out;
-  const double heading_deg = agent_->server->world.turtle(agent_->index).heading / kDeg;
+  const double heading_deg = sim::api_degrees(agent_->server->world.turtle(agent_->index).heading);
   for (const sim::TurtleContact& c : agent_->in_contact) {
     Touch t;
     const sim::Vec2 d = -c.normal;
-    t.bearing = wrap_degrees(std::atan2(d.x, d.y) / kDeg - heading_deg);
+    t.bearing = sim::wrap_degrees(sim::api_degrees(sim::heading_of(d)) - heading_deg);
     t.sensors = agent_->server->sensors_for(*agent_, t.bearing);
     t.sensor_names = &agent_->sensor_names;
     t.what = agent_->server->other_id(c.kind, c.other);

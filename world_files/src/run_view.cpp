@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "turtlegas/world/run_view.hpp"
 
-#include <cmath>
-#include <numbers>
+#include "turtlegas/sim/angles.hpp"
 
 namespace turtlegas::world {
 
@@ -14,10 +13,7 @@ RunView::Body RunView::body(const std::string& id) const {
   for (std::size_t i = 0; i < def_.turtles.size(); ++i)
     if (def_.turtles[i].id == id) {
       const sim::TurtleState s = w.turtle(i);
-      double h = std::fmod(s.heading * (180.0 / std::numbers::pi), 360.0);
-      if (h < 0.0) h += 360.0;
-      if (h >= 360.0) h = 0.0;
-      return {true, true, true, s.pos, s.vel, h};
+      return {true, true, true, s.pos, s.vel, sim::wrap_heading_degrees(sim::file_degrees(s.heading))};
     }
   for (std::size_t i = 0; i < def_.balls.size(); ++i)
     if (def_.balls[i].id == id) {

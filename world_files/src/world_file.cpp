@@ -9,7 +9,6 @@
 #include <cstring>
 #include <fstream>
 #include <initializer_list>
-#include <numbers>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -21,6 +20,7 @@
 
 #include "gas.hpp"
 #include "suggest.hpp"
+#include "turtlegas/sim/angles.hpp"
 #include "turtlegas/sim/format.hpp"
 #include "turtlegas/world/draw_walker.hpp"
 #include "turtlegas/world/game_file.hpp"
@@ -72,9 +72,6 @@ constexpr std::array<std::string_view, 6> draw_commands = {"forward", "back", "l
 constexpr std::string_view default_category = "default";
 /// Bits 0..31 of a category mask: "default" and at most 31 names.
 constexpr std::size_t max_categories = 32;
-
-/// Degrees (world files, the controller API) to radians (everything inside).
-constexpr double radians_per_degree = std::numbers::pi / 180.0;
 
 constexpr std::array<std::string_view, 4> arena_wall_ids = {"arena-bottom", "arena-right", "arena-top", "arena-left"};
 
@@ -448,17 +445,15 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
     // Angles are degrees in the file and radians inside: converted here, once. The heading is
     // wrapped into [0, 360) first so that a state written back reads like the file.
     double heading = 0.0;
-    if (const json* x = find(t, "heading")) heading = std::fmod(number(*x, at(p, "heading")), 360.0);
-    if (heading < 0.0) heading += 360.0;
-    if (heading >= 360.0) heading = 0.0;  // -1e-17 + 360 rounds to 360
-    body.heading = heading * radians_per_degree;
+    if (const json* x = find(t, "heading")) heading = number(*x, at(p, "heading"));
+    body.heading = sim::to_radians(sim::wrap_heading_degrees(heading));
     body.radius = 10.0;
     if (const json* x = find(t, "radius")) body.radius = positive(*x, at(p, "radius"), "radius");
     body.speed = 30.0;
     if (const json* x = find(t, "speed")) body.speed = positive(*x, at(p, "speed"), "speed (units/s)");
     double turn_rate = 90.0;
     if (const json* x = find(t, "turn_rate")) turn_rate = positive(*x, at(p, "turn_rate"), "turn_rate (degrees/s)");
-    body.turn_rate = turn_rate * radians_per_degree;
+    body.turn_rate = sim::to_radians(turn_rate);
     if (const json* x = find(t, "bounce")) {
       body.bounce = number(*x, at(p, "bounce"));
       if (!(body.bounce >= 0.0 && body.bounce <= 1.0))

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "turtlegas/sim/angles.hpp"
 #include "turtlegas/sim/vec2.hpp"
 #include "turtlegas/sim/world_def.hpp"
 
@@ -38,8 +39,7 @@ class DrawWalker {
   std::size_t walls_ = 0;
 };
 
-/// The unit vector of a Logo heading in degrees: (sin h, cos h), exact (0 or ±1) at multiples of
-/// 90 degrees, where the library's sin and cos of a radian value are not.
-sim::Vec2 heading_direction(double heading_degrees);
+/// The unit vector of a Logo heading in degrees, exact at quarter turns (angles.hpp).
+using sim::heading_direction;
 
 }  // namespace turtlegas::world
