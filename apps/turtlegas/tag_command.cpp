@@ -6,6 +6,7 @@
 #include <fstream>
 #include <vector>
 
+#include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/tag_tournament.hpp"
 #include "turtlegas/world/world_file.hpp"
 
@@ -21,7 +22,7 @@ CLI::App* add_tag_command(CLI::App& app, TagCommandOptions& options) {
   tag->add_option("--until", options.until, "Simulated seconds per round")->capture_default_str();
   tag->add_option("--json", options.json_out, "Write the ranking and every round's score here (JSON)");
   tag->add_option("--mode", options.mode, "exact (event-driven) or step (the memo's fixed steps)")
-      ->check(CLI::IsMember({"exact", "step"}))
+      ->check(CLI::IsMember(sim::mode_names))
       ->capture_default_str();
   return tag;
 }
@@ -39,7 +40,7 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
   }
   t.rounds = options.rounds;
   t.until = options.until;
-  t.server.mode = options.mode == "step" ? sim::Mode::step : sim::Mode::exact;
+  t.server.mode = sim::mode_from_string(options.mode).value_or(sim::Mode::exact);  // CLI11 checked it
 
   world::Scene scene;
   try {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/expect.hpp"
 #include "turtlegas/world/scenario.hpp"
 #include "turtlegas/world/world_file.hpp"
@@ -15,7 +16,7 @@ namespace {
 namespace tw = turtlegas::world;
 using Clock = std::chrono::steady_clock;
 
-const char* mode_name(sim::Mode m) { return m == sim::Mode::exact ? "exact" : "step"; }
+const char* mode_name(sim::Mode m) { return sim::to_string(m).data(); }
 
 /// 0 pass, 1 fail, 2 bad input; prints the world's line.
 int test_one(const std::string& file, const TestOptions& options, const turtle::Registry& registry) {
@@ -37,7 +38,7 @@ int test_one(const std::string& file, const TestOptions& options, const turtle::
     return 2;
   }
   std::vector<sim::Mode> modes = expect.modes;
-  if (options.mode) modes = {*options.mode == "step" ? sim::Mode::step : sim::Mode::exact};
+  if (options.mode) modes = {sim::mode_from_string(*options.mode).value_or(sim::Mode::exact)};  // CLI11 checked it
   if (modes.empty()) modes = {sim::Mode::exact};
 
   turtle::ServerOptions server_options;
@@ -79,7 +80,7 @@ CLI::App* add_test_command(CLI::App& app, TestOptions& options) {
       "test", "Run scripted test worlds headless against their \"expect\" lists; one line per world, exit 1 on a failure");
   cmd->add_option("worlds", options.worlds, "World files with an \"expect\" list")->required();
   cmd->add_option("--mode", options.mode, "exact or step: overrides each world's own {\"mode\": ...}")
-      ->check(CLI::IsMember({"exact", "step"}));
+      ->check(CLI::IsMember(sim::mode_names));
   cmd->add_option("--program-budget", options.program_budget,
                   "Wall-clock seconds a turtle program may run without issuing a command before the run stops")
       ->capture_default_str();

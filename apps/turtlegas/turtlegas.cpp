@@ -33,6 +33,7 @@
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/formats/svg_snapshot.hpp"
 #include "turtlegas/sim/angles.hpp"
+#include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/turtle/game.hpp"
 #include "turtlegas/turtle/world_server.hpp"
@@ -292,7 +293,7 @@ std::unique_ptr<tt::WorldServer> make_server(const tw::Scene& scene, const tt::R
   try {
     return tw::make_server(scene, registry, options);  // with the scene's game (scene.hpp)
   } catch (const std::invalid_argument& e) {
-    throw BadInput(file + ": " + (options.mode == sim::Mode::exact ? "exact" : "step") + " mode: " + e.what());
+    throw BadInput(file + ": " + std::string(sim::to_string(options.mode)) + " mode: " + e.what());
   }
 }
 
@@ -303,7 +304,7 @@ sim::World make_world(Def&& def, sim::Mode mode, const std::string& file) {
   try {
     return sim::World(std::forward<Def>(def), mode);
   } catch (const std::invalid_argument& e) {
-    throw BadInput(file + ": " + (mode == sim::Mode::exact ? "exact" : "step") + " mode: " + e.what());
+    throw BadInput(file + ": " + std::string(sim::to_string(mode)) + " mode: " + e.what());
   }
 }
 
@@ -500,7 +501,7 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
   if (!std::isfinite(opt.program_budget) || opt.program_budget <= 0.0)
     throw BadInput("--program-budget must be a finite time > 0 in seconds of wall clock (got " +
                    fmt(opt.program_budget) + ")");
-  const sim::Mode mode = opt.mode == "step" ? sim::Mode::step : sim::Mode::exact;
+  const sim::Mode mode = sim::mode_from_string(opt.mode).value_or(sim::Mode::exact);  // CLI11 checked it
 
   // Outputs are opened before the run, so a bad path costs nothing.
   std::optional<AtomicFile> events_file, state_file, stats_file, svg_file;
@@ -601,7 +602,7 @@ int run_command(const RunOptions& opt, const tt::Registry& registry) {
   if (events_file) events_file->commit();
   if (state_file) write_state(*state_file, world, ball_ids, def);
 
-  const char* mode_name = mode == sim::Mode::exact ? "exact" : "step";
+  const char* mode_name = sim::to_string(mode).data();
   const double per_second = wall_seconds > 0.0 ? static_cast<double>(st.collisions()) / wall_seconds : 0.0;
   if (stats_file) {
     const nlohmann::json j = {
@@ -702,7 +703,7 @@ int main(int argc, char** argv) {
   run->add_option("world", opt.world, "World file (format turtlegas-world/1)")->required();
   run->add_option("--until", opt.until, "Simulated time to stop at, seconds")->required();
   run->add_option("--mode", opt.mode, "exact (event-driven) or step (the memo's fixed steps)")
-      ->check(CLI::IsMember({"exact", "step"}))
+      ->check(CLI::IsMember(sim::mode_names))
       ->capture_default_str();
   double dt = 0.0;
   CLI::Option* dt_option = run->add_option("--dt", dt, "Step in seconds (overrides the world file's dt)");

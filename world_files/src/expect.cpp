@@ -14,6 +14,7 @@
 
 #include "suggest.hpp"
 #include "turtlegas/sim/format.hpp"
+#include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/turtle/game.hpp"
 #include "turtlegas/world/file_error.hpp"
 
@@ -760,8 +761,7 @@ Expectations parse_expect(const json& expect, const std::string& file, const sim
     if (kind == "mode") {
       p.check_keys(e, ep, "mode", {});
       const std::string m = p.string(e.at("mode"), at(ep, "mode"));
-      if (m == "exact") out.modes = {sim::Mode::exact};
-      else if (m == "step") out.modes = {sim::Mode::step};
+      if (const auto mode = sim::mode_from_string(m)) out.modes = {*mode};
       else if (m == "both") out.modes = {sim::Mode::exact, sim::Mode::step};
       else p.fail(at(ep, "mode"), "mode must be \"exact\", \"step\" or \"both\" (got \"" + m + "\")");
       continue;
