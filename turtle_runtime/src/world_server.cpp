@@ -12,6 +12,7 @@
 #include "fiber.hpp"
 #include "mt64.hpp"
 #include "turtlegas/sim/angles.hpp"
+#include "turtlegas/sim/suggest.hpp"
 #include "turtlegas/turtle/game.hpp"
 
 namespace turtlegas::turtle {
@@ -68,6 +69,15 @@ void Registry::add(std::string name, Controller controller, std::string summary)
 const Controller* Registry::find(const std::string& name) const {
   auto it = entries_.find(name);
   return it == entries_.end() ? nullptr : &it->second.first;
+}
+
+const Controller& Registry::require(const std::string& name, const std::string& context) const {
+  if (const Controller* c = find(name)) return *c;
+  throw std::invalid_argument(context.empty() ? not_registered(name) : context + ": " + not_registered(name));
+}
+
+std::string Registry::not_registered(const std::string& name) const {
+  return "controller '" + name + "' is not registered; known: " + sim::join_names(names());
 }
 
 std::vector<std::string> Registry::names() const {
@@ -442,18 +452,12 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
     a->index = k;
     a->id = def.turtles[k].id;
     a->program = std::move(programs[k]);
-    const Controller* c = registry.find(a->program.controller);
-    if (!c) {
-      std::string known;
-      for (const auto& n : registry.names()) known += (known.empty() ? "" : ", ") + n;
-      throw std::invalid_argument("turtle '" + a->id + "': controller '" + a->program.controller +
-                                  "' is not registered; known: " + known);
-    }
+    const Controller& controller = registry.require(a->program.controller, "turtle '" + a->id + "'");
     if (a->program.sensors.empty() || a->program.sensors.size() > 64)
       throw std::invalid_argument("turtle '" + a->id + "' needs 1 to 64 sensors (has " +
                                   std::to_string(a->program.sensors.size()) + ")");
     for (const SensorArc& arc : a->program.sensors) a->sensor_names.push_back(arc.name);
-    a->controller = *c;
+    a->controller = controller;
     a->params = Params(a->program.params);
     a->pen_down = a->program.pen_down || a->program.pen_walls;
     if (a->program.pen_walls) {

@@ -12,9 +12,9 @@
 #include <utility>
 #include <vector>
 
-#include "suggest.hpp"
 #include "turtlegas/sim/format.hpp"
 #include "turtlegas/sim/mode_names.hpp"
+#include "turtlegas/sim/suggest.hpp"
 #include "turtlegas/turtle/game.hpp"
 #include "turtlegas/world/file_error.hpp"
 
@@ -46,13 +46,8 @@ bool drawn_wall_id(const std::string& id, const sim::WorldDef& def) {
   return false;
 }
 
-std::string join(const auto& items) {
-  std::string s;
-  for (const auto& k : items) s += (s.empty() ? "" : ", ") + std::string(k);
-  return s;
-}
-
-using detail::suggestion;
+using sim::join_names;
+using sim::suggestion;
 
 // ---- event filters: {"event"|"no_event"|"count": KIND, "a": id, "b": id, "after": t, "before": t}
 
@@ -633,8 +628,9 @@ void ExpectParser::check_keys(const json& entry, const std::string& path, std::s
                               std::initializer_list<std::string_view> known) const {
   for (const auto& [key, value] : entry.items()) {
     if (key == kind || key.starts_with("x-") || std::find(known.begin(), known.end(), key) != known.end()) continue;
-    std::string list = "\"" + std::string(kind) + "\"";
-    for (std::string_view k : known) list += ", \"" + std::string(k) + "\"";
+    std::vector<std::string_view> takes{kind};
+    takes.insert(takes.end(), known.begin(), known.end());
+    const std::string list = join_names(takes, "\"");
     fail(at(path, key), "unknown key \"" + key + "\" in a \"" + std::string(kind) + "\" expectation" +
                             suggestion(key, known) + " (it takes " + list + "; keys starting with x- are ignored)");
   }
@@ -705,7 +701,7 @@ std::vector<std::string> ExpectParser::who(const json& v, const std::string& pat
 std::string ExpectParser::event_kind(const json& v, const std::string& path) const {
   const std::string k = string(v, path);
   if (std::find(event_kinds.begin(), event_kinds.end(), k) == event_kinds.end())
-    fail(path, "unknown event kind \"" + k + "\"; known: " + join(event_kinds));
+    fail(path, "unknown event kind \"" + k + "\"; known: " + join_names(event_kinds));
   return k;
 }
 
@@ -744,7 +740,7 @@ Expectations parse_expect(const json& expect, const std::string& file, const sim
       const std::string where = unknown.empty() ? ep : at(ep, unknown);
       p.fail(where, (unknown.empty() ? std::string("empty expectation")
                                      : "unknown assertion key \"" + unknown + "\"" + suggestion(unknown, all)) +
-                        " (an expectation names one of: " + join(all) + "; keys starting with x- are ignored)");
+                        " (an expectation names one of: " + join_names(all) + "; keys starting with x- are ignored)");
     }
     if (kinds.size() > 1)
       p.fail(ep, "an expectation names one kind, this one names \"" + kinds[0] + "\" and \"" + kinds[1] +

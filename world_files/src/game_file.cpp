@@ -1,8 +1,13 @@
 // SPDX-License-Identifier: MIT
 #include "turtlegas/world/game_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string_view>
+#include <vector>
+
+#include "turtlegas/sim/suggest.hpp"
 
 namespace turtlegas::world {
 
@@ -28,13 +33,10 @@ turtle::TagRules read_game(const nlohmann::json& game, const sim::WorldDef& def,
     const auto& it = game["it"];
     if (!it.is_string()) die("/game/it", "expected a turtle id (a string), got " + it.dump());
     rules.it = it.get<std::string>();
-    bool found = false;
-    std::string known;
-    for (const auto& t : def.turtles) {
-      found = found || t.id == rules.it;
-      known += (known.empty() ? "" : ", ") + t.id;
-    }
-    if (!found) die("/game/it", "no turtle has id '" + rules.it + "'; the turtles are: " + known);
+    std::vector<std::string_view> ids;
+    for (const auto& t : def.turtles) ids.push_back(t.id);
+    if (std::find(ids.begin(), ids.end(), rules.it) == ids.end())
+      die("/game/it", "no turtle has id '" + rules.it + "'; the turtles are: " + sim::join_names(ids));
   }
   if (game.contains("no_tag_back")) {
     const auto& v = game["no_tag_back"];

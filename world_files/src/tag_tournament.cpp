@@ -18,11 +18,7 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
   if (names.empty()) throw std::invalid_argument("--controllers: name at least one controller");
   std::set<std::string> seen;
   for (const std::string& n : names) {
-    if (!registry.find(n)) {
-      std::string known;
-      for (const auto& k : registry.names()) known += (known.empty() ? "" : ", ") + k;
-      throw std::invalid_argument("--controllers: controller '" + n + "' is not registered; known: " + known);
-    }
+    registry.require(n, "--controllers");
     if (!seen.insert(n).second) throw std::invalid_argument("--controllers: '" + n + "' is named twice");
   }
   if (options.rounds < 1) throw std::invalid_argument("--rounds must be at least 1");

@@ -19,9 +19,9 @@
 #include <nlohmann/json.hpp>
 
 #include "gas.hpp"
-#include "suggest.hpp"
 #include "turtlegas/sim/angles.hpp"
 #include "turtlegas/sim/format.hpp"
+#include "turtlegas/sim/suggest.hpp"
 #include "turtlegas/world/draw_walker.hpp"
 #include "turtlegas/world/game_file.hpp"
 
@@ -101,10 +101,8 @@ class Reader {
                   std::initializer_list<std::string_view> known) const {
     for (const auto& [key, value] : obj.items()) {
       if (key.starts_with("x-") || std::find(known.begin(), known.end(), key) != known.end()) continue;
-      std::string list;
-      for (std::string_view k : known) list += (list.empty() ? "" : ", ") + std::string(k);
-      std::string reason = "unknown key \"" + key + "\" in " + std::string(what) + detail::suggestion(key, known);
-      reason += " (known keys: " + list + "; keys starting with x- are ignored)";
+      std::string reason = "unknown key \"" + key + "\" in " + std::string(what) + sim::suggestion(key, known);
+      reason += " (known keys: " + sim::join_names(known) + "; keys starting with x- are ignored)";
       fail(at(path, key), reason);
     }
   }
@@ -229,10 +227,8 @@ std::uint32_t Reader::category_bits(const json& v, const std::string& path) cons
     const std::string n = string(name, np);
     const auto it = std::find(categories_.begin(), categories_.end(), n);
     if (it == categories_.end()) {
-      std::string known;
-      for (const auto& k : categories_) known += (known.empty() ? "" : ", ") + k;
       fail(np, "unknown category \"" + n + "\"; no wall, ball, gas or turtle has it as its \"category\" (known: " +
-                   known + "). A misspelt name would silently turn collisions off");
+                   sim::join_names(categories_) + "). A misspelt name would silently turn collisions off");
     }
     return std::uint32_t{1} << static_cast<unsigned>(it - categories_.begin());
   };
@@ -355,8 +351,7 @@ void Reader::read_walls(const json& v, std::vector<sim::WallDef>& walls) {
 void Reader::read_draw(const json& v, std::vector<sim::WallDef>& walls) {
   const std::string path = "/draw";
   expect_array(v, path, "draw");
-  std::string known;
-  for (std::string_view c : draw_commands) known += (known.empty() ? "" : ", ") + std::string(c);
+  const std::string known = sim::join_names(draw_commands);
   for (std::size_t i = 0; i < v.size(); ++i) {
     const std::string p = at(path, i);
     const json& b = v[i];
@@ -463,11 +458,8 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
 
     if (const json* x = find(t, "controller")) {
       program.controller = string(*x, at(p, "controller"));
-      if (registry_ && !registry_->find(program.controller)) {
-        std::string known;
-        for (const std::string& name : registry_->names()) known += (known.empty() ? "" : ", ") + name;
-        fail(at(p, "controller"), "controller '" + program.controller + "' is not registered; known: " + known);
-      }
+      if (registry_ && !registry_->find(program.controller))
+        fail(at(p, "controller"), registry_->not_registered(program.controller));
     }
     if (const json* x = find(t, "params")) {
       expect_object(*x, at(p, "params"), "params");
@@ -554,8 +546,7 @@ void Reader::check_script(const json& params, const std::string& path) const {
   if (!commands->is_array())
     fail(cp, "commands must be a list of [command, amount], e.g. [[\"forward\", 100], [\"right\", 90]], got " +
                  kind_of(*commands));
-  std::string known;
-  for (std::string_view c : script_commands) known += (known.empty() ? "" : ", ") + std::string(c);
+  const std::string known = sim::join_names(script_commands);
   for (std::size_t k = 0; k < commands->size(); ++k) {
     const std::string p = at(cp, k);
     const json& c = (*commands)[k];

@@ -17,6 +17,12 @@ class Registry {
  public:
   void add(std::string name, Controller controller, std::string summary = {});
   const Controller* find(const std::string& name) const;
+  /// The controller called `name`. Throws std::invalid_argument with not_registered(name), after
+  /// `context` and ": " when a context is given ("turtle 't1'", "--controllers").
+  const Controller& require(const std::string& name, const std::string& context = {}) const;
+  /// What require throws for a name it does not hold: "controller 'wandr' is not registered; known:
+  /// script, spiral, ..." (every registered name, in order).
+  std::string not_registered(const std::string& name) const;
   std::vector<std::string> names() const;
   const std::string& summary(const std::string& name) const;
 

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
-// "Did you mean" for the readers of world files and expectations.
+// Lists of names in messages: "known: a, b, c", and "did you mean" for a close misspelling. Shared
+// by every reader of names (the world-file loader, `expect`, games, the controller registry), as
+// format.hpp's numbers are.
 #pragma once
 
 #include <algorithm>
@@ -8,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-namespace turtlegas::world::detail {
+namespace turtlegas::sim {
 
 /// Levenshtein distance.
 inline std::size_t edit_distance(std::string_view a, std::string_view b) {
@@ -27,15 +29,33 @@ inline std::size_t edit_distance(std::string_view a, std::string_view b) {
 }
 
 /// `; did you mean "count"?` for a close misspelling (fewer than 3 edits) of one of `known`,
-/// else empty.
-inline std::string suggestion(std::string_view key, const auto& known) {
+/// else empty. `quote` goes around the suggestion.
+inline std::string suggestion(std::string_view key, const auto& known, std::string_view quote = "\"") {
   std::string best;
   std::size_t best_distance = 3;
   for (std::string_view k : known) {
     const std::size_t d = edit_distance(key, k);
     if (d < best_distance) best_distance = d, best = k;
   }
-  return best.empty() ? std::string() : "; did you mean \"" + best + "\"?";
+  if (best.empty()) return {};
+  std::string s = "; did you mean ";
+  s += quote;
+  s += best;
+  s += quote;
+  s += '?';
+  return s;
 }
 
-}  // namespace turtlegas::world::detail
+/// "a, b, c": the names in `known`, in their order, each between two `quote`s when one is given.
+inline std::string join_names(const auto& known, std::string_view quote = {}) {
+  std::string s;
+  for (std::string_view k : known) {
+    if (!s.empty()) s += ", ";
+    s += quote;
+    s += k;
+    s += quote;
+  }
+  return s;
+}
+
+}  // namespace turtlegas::sim
