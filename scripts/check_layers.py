@@ -262,7 +262,7 @@ def check(root, verbose=False):
         problems.append("include loop: " + loop_text(cycle, others))
     # A header and the source file that implements it (foo.cpp including .../foo.hpp) are one
     # unit: a loop through them is a loop of the design even when no file includes itself, e.g.
-    # world_file.hpp -> expect.hpp while expect.cpp -> world_file.hpp.
+    # world_file.hpp -> expect.hpp while expect.cpp -> world_file.hpp (two rooms' interfaces).
     unit = {f: f for f in files}
     for f in files:
         if f.endswith((".cpp", ".cc")):
@@ -276,6 +276,11 @@ def check(root, verbose=False):
     notes = []
     for cycle, others in find_cycles(units):
         if tuple(cycle) in file_loops:
+            continue
+        # A loop through one public header only is a room's own implementation seeing its interface
+        # (world_server.cpp -> agent.hpp -> world_server.hpp, a pimpl's private parts): not a loop
+        # between rooms. Two public headers that need each other are.
+        if sum(1 for f in set(cycle + others) if "/include/" in f) < 2:
             continue
         text = loop_text(cycle, others)
         known = [why for (inside, through, why) in KNOWN_LOOPS
@@ -310,6 +315,10 @@ def self_test():
         "apps/turtlegas/main.cpp": '#include "turtlegas/turtle/registry.hpp"\n// #include "nowhere.hpp"\n',
         "tests/runtime/fiber_test.cpp": '#include "fiber.hpp"\n',
         "turtle_runtime/src/fiber.hpp": "#pragma once\n",
+        # a pimpl: the implementation's private header sees the public one (not a loop of rooms)
+        "turtle_runtime/include/turtlegas/turtle/world_server.hpp": '#include "turtlegas/turtle/turtle.hpp"\n',
+        "turtle_runtime/src/agent.hpp": '#include "turtlegas/turtle/world_server.hpp"\n',
+        "turtle_runtime/src/world_server.cpp": '#include "turtlegas/turtle/world_server.hpp"\n#include "agent.hpp"\n',
     }
     broken = {
         # upward: layer 1 includes layer 2 (sim/src/world.cpp, below)
@@ -322,7 +331,6 @@ def self_test():
         "world_files/include/turtlegas/world/scene.hpp": "#pragma once\n",
         # a controller reaching past the API
         "controllers/spiral.cpp": '#include "turtlegas/turtle/world_server.hpp"\n',
-        "turtle_runtime/include/turtlegas/turtle/world_server.hpp": "#pragma once\n",
         # third-party headers where they do not belong
         "sim/src/toi.cpp": "#include <nlohmann/json.hpp>\n",
         "turtle_runtime/src/agent.cpp": "#include <boost/context/fiber.hpp>\n",
@@ -370,7 +378,7 @@ def self_test():
     for f in failures:
         print("check_layers self-test: FAIL: " + f)
     if not failures:
-        print("check_layers self-test: ok (a clean tree passes; an upward include, a loop of three files, a "
+        print("check_layers self-test: ok (a clean tree with a pimpl passes; an upward include, a loop of three files, a "
               "sideways include, a controller past the API, two misplaced third-party headers, a missing file, "
               "a loop through a header's .cpp and a file including itself are each caught; a known loop is noted)")
     return 1 if failures else 0

@@ -22,6 +22,7 @@
 #include "turtlegas/sim/angles.hpp"
 #include "turtlegas/sim/format.hpp"
 #include "turtlegas/sim/suggest.hpp"
+#include "turtlegas/turtle/script.hpp"
 #include "turtlegas/world/draw_walker.hpp"
 #include "turtlegas/world/game_file.hpp"
 
@@ -62,11 +63,14 @@ std::string kind_of(const json& v) {
 /// with a clear message rather than as an unknown key.
 constexpr std::array<std::string_view, 1> reserved_keys = {"views"};
 
-/// The commands of the built-in `script` controller; pendown and penup take no amount.
-constexpr std::array<std::string_view, 7> script_commands = {"forward", "back", "left", "right", "wait", "pendown", "penup"};
-
-/// The commands of a `draw` builder: turtle geometry only, no time.
-constexpr std::array<std::string_view, 6> draw_commands = {"forward", "back", "left", "right", "pendown", "penup"};
+/// The commands of a `draw` builder: the script commands (turtle/script.hpp) of turtle geometry,
+/// without those that only take time.
+std::vector<std::string_view> draw_commands() {
+  std::vector<std::string_view> names;
+  for (const turtle::ScriptCommand& c : turtle::script_commands)
+    if (!c.timed_only()) names.push_back(c.name);
+  return names;
+}
 
 /// The category every object is in unless it names others; bit 0, sim::Layers' default.
 constexpr std::string_view default_category = "default";
@@ -351,7 +355,8 @@ void Reader::read_walls(const json& v, std::vector<sim::WallDef>& walls) {
 void Reader::read_draw(const json& v, std::vector<sim::WallDef>& walls) {
   const std::string path = "/draw";
   expect_array(v, path, "draw");
-  const std::string known = sim::join_names(draw_commands);
+  const std::vector<std::string_view> commands_known = draw_commands();
+  const std::string known = sim::join_names(commands_known);
   for (std::size_t i = 0; i < v.size(); ++i) {
     const std::string p = at(path, i);
     const json& b = v[i];
@@ -370,7 +375,7 @@ void Reader::read_draw(const json& v, std::vector<sim::WallDef>& walls) {
       if (!c.is_array() || c.empty() || !c[0].is_string())
         fail(kp, "a command must be [command, amount], e.g. [\"forward\", 100], got " + c.dump());
       const std::string name = c[0].get<std::string>();
-      if (std::find(draw_commands.begin(), draw_commands.end(), name) == draw_commands.end())
+      if (std::find(commands_known.begin(), commands_known.end(), name) == commands_known.end())
         fail(at(kp, 0), "unknown command '" + name + "'; a draw builder knows: " + known +
                             " (it runs at load time, so there is no wait)");
       if (name == "pendown" || name == "penup") {
@@ -546,15 +551,15 @@ void Reader::check_script(const json& params, const std::string& path) const {
   if (!commands->is_array())
     fail(cp, "commands must be a list of [command, amount], e.g. [[\"forward\", 100], [\"right\", 90]], got " +
                  kind_of(*commands));
-  const std::string known = sim::join_names(script_commands);
+  const std::string known = sim::join_names(turtle::script_command_names());
   for (std::size_t k = 0; k < commands->size(); ++k) {
     const std::string p = at(cp, k);
     const json& c = (*commands)[k];
     if (!c.is_array() || c.empty() || !c[0].is_string())
       fail(p, "a command must be [command, amount], e.g. [\"forward\", 100], got " + c.dump());
     const std::string name = c[0].get<std::string>();
-    if (std::find(script_commands.begin(), script_commands.end(), name) == script_commands.end())
-      fail(at(p, 0), "unknown command '" + name + "'; known: " + known);
+    const turtle::ScriptCommand* command = turtle::find_script_command(name);
+    if (!command) fail(at(p, 0), "unknown command '" + name + "'; known: " + known);
     if (name == "pendown" && c.size() == 2 && c[1].is_string()) {
       if (c[1] != "wall" && c[1] != "line")
         fail(at(p, 1), "a pen mode is \"line\" (draws the path) or \"wall\" (lays walls), got " + c[1].dump());
@@ -568,9 +573,8 @@ void Reader::check_script(const json& params, const std::string& path) const {
     }
     if (c.size() != 2) fail(p, "'" + name + "' needs one number, e.g. [\"" + name + "\", 100], got " + c.dump());
     const double amount = number(c[1], at(p, 1));
-    const char* unit = name == "wait" ? "seconds" : (name == "left" || name == "right") ? "degrees" : "units";
     if (amount < 0.0)
-      fail(at(p, 1), "'" + name + "' needs an amount >= 0 in " + unit + " (got " + num(amount) + ")" +
+      fail(at(p, 1), "'" + name + "' needs an amount >= 0 in " + std::string(turtle::unit_name(command->amount)) + " (got " + num(amount) + ")" +
                          (name == "forward" ? "; use [\"back\", ...] to go backwards"
                           : name == "back"  ? "; use [\"forward\", ...] to go forwards"
                           : name == "left"  ? "; use [\"right\", ...] to turn the other way"
