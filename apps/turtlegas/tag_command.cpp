@@ -2,13 +2,15 @@
 #include "tag_command.hpp"
 
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
+#include <optional>
+#include <stdexcept>
 #include <vector>
+
+#include "atomic_file.hpp"
+#include "cli_common.hpp"
 
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/tag_tournament.hpp"
-#include "turtlegas/world/world_file.hpp"
 
 namespace turtlegas::apps {
 
@@ -42,31 +44,23 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
   t.until = options.until;
   t.server.mode = sim::mode_from_string(options.mode).value_or(sim::Mode::exact);  // CLI11 checked it
 
-  world::Scene scene;
-  try {
-    scene = world::load_scene(options.world, registry);
-  } catch (const world::WorldFileError& e) {
-    throw TagBadInput(e.what());
-  }
+  // Opened before the rounds are played, so a bad path costs nothing; renamed into place only
+  // when written whole.
+  std::optional<AtomicFile> json_file;
+  if (!options.json_out.empty()) json_file.emplace(options.json_out, "--json");
+  const world::Scene scene = load(options.world, registry);
   world::TournamentResult result;
   try {
     result = world::run_tag_tournament(scene, options.world, t, registry);
   } catch (const std::invalid_argument& e) {
-    throw TagBadInput(e.what());
+    throw BadInput(e.what());
   }
   std::printf("%s: %zu rounds of %g s, %zu turtles\n", options.world.c_str(), t.rounds, t.until,
               scene.def.turtles.size());
   std::fputs(world::ranking_table(result).c_str(), stdout);
-  if (!options.json_out.empty()) {
-    // Written beside the target and renamed into place, so a failed run leaves no half file.
-    const std::filesystem::path out(options.json_out), tmp(options.json_out + ".tmp");
-    {
-      std::ofstream f(tmp);
-      if (!f) throw TagBadInput("--json: cannot write " + tmp.string());
-      f << world::to_json(result).dump(2) << '\n';
-      if (!f) throw std::runtime_error("--json: writing " + tmp.string() + " failed");
-    }
-    std::filesystem::rename(tmp, out);
+  if (json_file) {
+    json_file->stream() << world::to_json(result).dump(2) << '\n';
+    json_file->commit();
   }
   return 0;
 }

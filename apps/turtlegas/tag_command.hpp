@@ -4,7 +4,6 @@
 
 #include <cstddef>
 #include <optional>
-#include <stdexcept>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -22,15 +21,10 @@ struct TagCommandOptions {
   std::string mode = "exact";
 };
 
-/// Bad arguments or a bad world file: exit code 2.
-struct TagBadInput : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
 /// Adds the `tag` subcommand, its options bound to `options`.
 CLI::App* add_tag_command(CLI::App& app, TagCommandOptions& options);
 
-/// Plays the tournament, prints the ranking and writes the JSON. Throws TagBadInput for bad input.
+/// Plays the tournament, prints the ranking and writes the JSON. Throws BadInput for bad input.
 int run_tag_command(const TagCommandOptions& options, const turtle::Registry& registry);
 
 }  // namespace turtlegas::apps
