@@ -584,8 +584,7 @@ std::shared_ptr<const Assertion> parse_wall(const json& e, const std::string& pa
   if (id.empty()) p.fail(at(path, "wall"), "a wall id must not be empty");
   bool exists = true;
   if (auto it = e.find("exists"); it != e.end()) {
-    if (!it->is_boolean()) p.fail(at(path, "exists"), "expected true or false, got " + it->dump());
-    exists = it->get<bool>();
+    exists = p.boolean(*it, at(path, "exists"));
   }
   return std::make_shared<WallExistsAssertion>(std::move(id), exists);
 }
@@ -618,45 +617,18 @@ const std::vector<AssertionKind>& assertion_kinds() {
 
 // ---- ExpectParser
 
-ExpectParser::ExpectParser(std::string file, const sim::WorldDef& def) : file_(std::move(file)), def_(def) {}
-
-void ExpectParser::fail(const std::string& path, const std::string& reason) const {
-  throw WorldFileError(file_, path, reason);
-}
+ExpectParser::ExpectParser(std::string file, const sim::WorldDef& def)
+    : json_(std::move(file), JsonReader::Wording::value), def_(def) {}
 
 void ExpectParser::check_keys(const json& entry, const std::string& path, std::string_view kind,
                               std::initializer_list<std::string_view> known) const {
-  for (const auto& [key, value] : entry.items()) {
-    if (key == kind || key.starts_with("x-") || std::find(known.begin(), known.end(), key) != known.end()) continue;
-    std::vector<std::string_view> takes{kind};
-    takes.insert(takes.end(), known.begin(), known.end());
-    const std::string list = join_names(takes, "\"");
-    fail(at(path, key), "unknown key \"" + key + "\" in a \"" + std::string(kind) + "\" expectation" +
-                            suggestion(key, known) + " (it takes " + list + "; keys starting with x- are ignored)");
-  }
-}
-
-double ExpectParser::number(const json& v, const std::string& path) const {
-  if (!v.is_number()) fail(path, "expected a number, got " + v.dump());
-  const double d = v.get<double>();
-  if (!std::isfinite(d)) fail(path, "expected a finite number");
-  return d;
-}
-
-double ExpectParser::non_negative(const json& v, const std::string& path) const {
-  const double d = number(v, path);
-  if (d < 0.0) fail(path, "expected a number >= 0, got " + num(d));
-  return d;
-}
-
-Vec2 ExpectParser::vec2(const json& v, const std::string& path) const {
-  if (!v.is_array() || v.size() != 2) fail(path, "expected [x, y] (an array of 2 numbers), got " + v.dump());
-  return {number(v[0], path + "/0"), number(v[1], path + "/1")};
-}
-
-std::string ExpectParser::string(const json& v, const std::string& path) const {
-  if (!v.is_string()) fail(path, "expected a string, got " + v.dump());
-  return v.get<std::string>();
+  const std::string* key = unknown_key(entry, known, kind);
+  if (!key) return;
+  std::vector<std::string_view> takes{kind};
+  takes.insert(takes.end(), known.begin(), known.end());
+  fail(at(path, *key), "unknown key \"" + *key + "\" in a \"" + std::string(kind) + "\" expectation" +
+                           suggestion(*key, known) + " (it takes " + join_names(takes, "\"") +
+                           "; keys starting with x- are ignored)");
 }
 
 std::string ExpectParser::body_id(const json& v, const std::string& path) const {

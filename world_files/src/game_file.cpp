@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <string_view>
 #include <vector>
 
@@ -11,17 +10,12 @@
 
 namespace turtlegas::world {
 
-turtle::TagRules read_game(const nlohmann::json& game, const sim::WorldDef& def,
-                           const std::function<void(const std::string&, const std::string&)>& fail) {
-  auto die = [&](const std::string& path, const std::string& reason) {
-    fail(path, reason);
-    throw std::logic_error("read_game: fail() returned");  // fail must throw
-  };
+turtle::TagRules read_game(const nlohmann::json& game, const sim::WorldDef& def, const JsonReader& reader) {
+  auto die = [&](const std::string& path, const std::string& reason) { reader.fail(path, reason); };
   if (!game.is_object()) die("/game", "game must be a JSON object ({\"kind\": \"tag\", \"it\": \"t1\"})");
-  for (const auto& [key, value] : game.items())
-    if (!key.starts_with("x-") && key != "kind" && key != "it" && key != "no_tag_back")
-      die("/game/" + key, "unknown key \"" + key +
-                              "\" in game (known keys: kind, it, no_tag_back; keys starting with x- are ignored)");
+  if (const std::string* key = unknown_key(game, {"kind", "it", "no_tag_back"}))
+    die("/game/" + *key, "unknown key \"" + *key +
+                             "\" in game (known keys: kind, it, no_tag_back; keys starting with x- are ignored)");
   if (!game.contains("kind")) die("/game", "game needs \"kind\"; the only kind so far is \"tag\"");
   if (!game["kind"].is_string() || game["kind"] != "tag")
     die("/game/kind", "unknown game kind " + game["kind"].dump() + "; the only kind so far is \"tag\"");

@@ -4,60 +4,24 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
-#include <charconv>
-#include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
-#include <initializer_list>
-#include <optional>
-#include <set>
 #include <sstream>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "gas.hpp"
-#include "turtlegas/sim/angles.hpp"
-#include "turtlegas/sim/format.hpp"
+#include "reader.hpp"
 #include "turtlegas/sim/suggest.hpp"
 #include "turtlegas/turtle/script.hpp"
 #include "turtlegas/world/draw_walker.hpp"
 #include "turtlegas/world/game_file.hpp"
 
 namespace turtlegas::world {
+namespace detail {
 namespace {
-
-using json = nlohmann::json;
-using sim::Vec2;
-
-std::string num(double v) { return sim::format_number(v); }
-std::string vec(Vec2 v) { return sim::format_vec(v); }
-
-/// A JSON-pointer reference token: `~` and `/` escaped as RFC 6901 has it.
-std::string token(std::string_view key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
-  }
-  return out;
-}
-
-std::string at(const std::string& path, std::string_view key) { return path + "/" + token(key); }
-std::string at(const std::string& path, std::size_t index) { return path + "/" + std::to_string(index); }
-
-/// "a string", "an array", ...: what nlohmann calls the type, with its article.
-std::string kind_of(const json& v) {
-  const std::string name = v.type_name();
-  if (v.is_null()) return "null";
-  if (v.is_boolean()) return "true or false";
-  const bool vowel = !name.empty() && std::strchr("aeiou", name[0]) != nullptr;
-  return (vowel ? "an " : "a ") + name;
-}
-
 
 /// Features that later versions add to the format: named so that a file written for them fails
 /// with a clear message rather than as an unknown key.
@@ -72,127 +36,9 @@ std::vector<std::string_view> draw_commands() {
   return names;
 }
 
-/// The category every object is in unless it names others; bit 0, sim::Layers' default.
-constexpr std::string_view default_category = "default";
-/// Bits 0..31 of a category mask: "default" and at most 31 names.
-constexpr std::size_t max_categories = 32;
-
 constexpr std::array<std::string_view, 4> arena_wall_ids = {"arena-bottom", "arena-right", "arena-top", "arena-left"};
 
-/// Reads one parsed document into a Scene, remembering where each ball came from so that a
-/// problem found later (by sim::validate) can be reported at its JSON path. Controller names are
-/// checked against `registry` when one is given.
-class Reader {
- public:
-  Reader(std::string file, const turtle::Registry* registry) : file_(std::move(file)), registry_(registry) {}
-
-  [[noreturn]] void fail(const std::string& path, const std::string& reason) const {
-    throw WorldFileError(file_, path, reason);
-  }
-
-  Scene read(const json& doc, std::string_view default_name);
-
- private:
-  void expect_object(const json& v, const std::string& path, std::string_view what) const {
-    if (!v.is_object()) fail(path, std::string(what) + " must be a JSON object ({...}), got " + kind_of(v));
-  }
-  void expect_array(const json& v, const std::string& path, std::string_view what) const {
-    if (!v.is_array()) fail(path, std::string(what) + " must be a JSON array ([...]), got " + kind_of(v));
-  }
-
-  /// Rejects keys outside `known`, except private `x-` keys.
-  void check_keys(const json& obj, const std::string& path, std::string_view what,
-                  std::initializer_list<std::string_view> known) const {
-    for (const auto& [key, value] : obj.items()) {
-      if (key.starts_with("x-") || std::find(known.begin(), known.end(), key) != known.end()) continue;
-      std::string reason = "unknown key \"" + key + "\" in " + std::string(what) + sim::suggestion(key, known);
-      reason += " (known keys: " + sim::join_names(known) + "; keys starting with x- are ignored)";
-      fail(at(path, key), reason);
-    }
-  }
-
-  const json* find(const json& obj, std::string_view key) const {
-    auto it = obj.find(key);
-    return it == obj.end() ? nullptr : &*it;
-  }
-  const json& require(const json& obj, const std::string& path, std::string_view key, std::string_view what) const {
-    if (const json* v = find(obj, key)) return *v;
-    fail(path, std::string(what) + " needs \"" + std::string(key) + "\"");
-  }
-
-  double number(const json& v, const std::string& path) const {
-    if (!v.is_number()) fail(path, "expected a number, got " + kind_of(v));
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) fail(path, "expected a finite number, got " + num(d));
-    return d;
-  }
-  double positive(const json& v, const std::string& path, std::string_view name) const {
-    const double d = number(v, path);
-    if (!(d > 0.0)) fail(path, std::string(name) + " must be > 0 (got " + num(d) + ")");
-    return d;
-  }
-  /// A non-negative integer; 1e6 is accepted as well as 1000000.
-  std::uint64_t natural(const json& v, const std::string& path) const {
-    if (v.is_number_unsigned()) return v.get<std::uint64_t>();
-    if (v.is_number_integer()) fail(path, "expected an integer >= 0, got " + std::to_string(v.get<std::int64_t>()));
-    if (v.is_number_float()) {
-      const double d = v.get<double>();
-      if (d >= 0.0 && d < 0x1.0p64 && std::floor(d) == d) return static_cast<std::uint64_t>(d);
-      fail(path, "expected an integer >= 0, got " + num(d));
-    }
-    fail(path, "expected an integer >= 0, got " + kind_of(v));
-  }
-  bool boolean(const json& v, const std::string& path) const {
-    if (!v.is_boolean()) fail(path, "expected true or false, got " + kind_of(v));
-    return v.get<bool>();
-  }
-  std::string string(const json& v, const std::string& path) const {
-    if (!v.is_string()) fail(path, "expected a string, got " + kind_of(v));
-    return v.get<std::string>();
-  }
-  Vec2 vec2(const json& v, const std::string& path) const {
-    if (!v.is_array()) fail(path, "expected [x, y] (an array of 2 numbers), got " + kind_of(v));
-    if (v.size() != 2) fail(path, "expected [x, y] (an array of 2 numbers), got an array of " + std::to_string(v.size()));
-    return {number(v[0], at(path, 0)), number(v[1], at(path, 1))};
-  }
-  std::string id(const json& obj, const std::string& path, std::string_view what) {
-    const std::string p = at(path, "id");
-    std::string s = string(require(obj, path, "id", what), p);
-    if (s.empty()) fail(p, "id must not be empty");
-    auto [it, fresh] = ids_.emplace(s, p);
-    if (!fresh) {
-      if (it->second.empty())
-        fail(p, "id \"" + s + "\" is taken by an arena wall of boundary \"walls\"; choose another id");
-      fail(p, "duplicate id \"" + s + "\" (already used at " + it->second +
-                  "); every wall, ball and turtle needs its own id");
-    }
-    return s;
-  }
-
-  void read_arena(const json& v, sim::ArenaDef& arena);
-  void read_effects(const json& v, sim::EffectsDef& effects);
-  void collect_categories(const json& doc);
-  void collect_category(const json& obj, const std::string& path);
-  sim::Layers layers(const json& obj, const std::string& path) const;
-  std::uint32_t category_bits(const json& v, const std::string& path) const;
-  void read_walls(const json& v, std::vector<sim::WallDef>& walls);
-  void read_draw(const json& v, std::vector<sim::WallDef>& walls);
-  void read_balls(const json& v, std::vector<sim::BallDef>& balls);
-  void read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles, std::vector<turtle::TurtleProgram>& programs);
-  std::vector<turtle::SensorArc> read_sensors(const json& v, const std::string& path) const;
-  void check_script(const json& params, const std::string& path) const;
-  std::vector<detail::GasSpec> read_gases(const json& v, const sim::WorldDef& def);
-  std::string path_of(const sim::DefProblem& p) const;
-  void check_gas_ids(const std::vector<detail::GasSpec>& gases) const;
-
-  std::string file_;
-  const turtle::Registry* registry_;
-  std::unordered_map<std::string, std::string> ids_;  // id -> JSON path of its "id" ("" for arena walls)
-  std::size_t explicit_balls_ = 0;
-  std::vector<std::size_t> gas_first_;  // index in WorldDef::balls of each gas entry's first ball
-  std::vector<std::string> wall_paths_;  // JSON path of each of WorldDef::walls (file walls, then drawn)
-  std::vector<std::string> categories_{std::string(default_category)};  // name of bit k
-};
+}  // namespace
 
 void Reader::collect_category(const json& obj, const std::string& path) {
   if (!obj.is_object()) return;  // reported by the section's reader
@@ -214,7 +60,7 @@ void Reader::collect_category(const json& obj, const std::string& path) {
   } else if (c->is_string()) {
     add(*c, p);
   } else {
-    fail(p, "category must be a name (\"walls\") or a list of names, got " + kind_of(*c));
+    fail(p, "category must be a name (\"walls\") or a list of names, got " + json_kind(*c));
   }
 }
 
@@ -237,7 +83,7 @@ std::uint32_t Reader::category_bits(const json& v, const std::string& path) cons
     return std::uint32_t{1} << static_cast<unsigned>(it - categories_.begin());
   };
   if (v.is_string()) return bit(v, path);
-  if (!v.is_array()) fail(path, "expected a category name or a list of names, got " + kind_of(v));
+  if (!v.is_array()) fail(path, "expected a category name or a list of names, got " + json_kind(v));
   std::uint32_t bits = 0;
   for (std::size_t k = 0; k < v.size(); ++k) bits |= bit(v[k], at(path, k));
   return bits;
@@ -424,260 +270,6 @@ void Reader::read_balls(const json& v, std::vector<sim::BallDef>& balls) {
   }
 }
 
-void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
-                          std::vector<turtle::TurtleProgram>& programs) {
-  const std::string path = "/turtles";
-  expect_array(v, path, "turtles");
-  turtles.reserve(v.size());
-  programs.reserve(v.size());
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const std::string p = at(path, i);
-    const json& t = v[i];
-    expect_object(t, p, "a turtle");
-    check_keys(t, p, "a turtle",
-               {"id", "pos", "heading", "radius", "speed", "turn_rate", "controller", "params", "sensors", "pen", "gps",
-                "bounce", "category", "collides_with", "builder"});
-    sim::TurtleDef body;
-    turtle::TurtleProgram program;
-    body.id = id(t, p, "a turtle");
-    body.pos = vec2(require(t, p, "pos", "a turtle"), at(p, "pos"));
-    body.layers = layers(t, p);
-    // Angles are degrees in the file and radians inside: converted here, once. The heading is
-    // wrapped into [0, 360) first so that a state written back reads like the file.
-    double heading = 0.0;
-    if (const json* x = find(t, "heading")) heading = number(*x, at(p, "heading"));
-    body.heading = sim::to_radians(sim::wrap_heading_degrees(heading));
-    body.radius = 10.0;
-    if (const json* x = find(t, "radius")) body.radius = positive(*x, at(p, "radius"), "radius");
-    body.speed = 30.0;
-    if (const json* x = find(t, "speed")) body.speed = positive(*x, at(p, "speed"), "speed (units/s)");
-    double turn_rate = 90.0;
-    if (const json* x = find(t, "turn_rate")) turn_rate = positive(*x, at(p, "turn_rate"), "turn_rate (degrees/s)");
-    body.turn_rate = sim::to_radians(turn_rate);
-    if (const json* x = find(t, "bounce")) {
-      body.bounce = number(*x, at(p, "bounce"));
-      if (!(body.bounce >= 0.0 && body.bounce <= 1.0))
-        fail(at(p, "bounce"), "bounce must be in [0, 1] (got " + num(body.bounce) +
-                                  "); leave it out for the memo's dead stop at a contact");
-    }
-
-    if (const json* x = find(t, "controller")) {
-      program.controller = string(*x, at(p, "controller"));
-      if (registry_ && !registry_->find(program.controller))
-        fail(at(p, "controller"), registry_->not_registered(program.controller));
-    }
-    if (const json* x = find(t, "params")) {
-      expect_object(*x, at(p, "params"), "params");
-      program.params = *x;
-    }
-    if (program.controller == "script") check_script(program.params, at(p, "params"));
-    if (const json* x = find(t, "sensors")) program.sensors = read_sensors(*x, at(p, "sensors"));
-    if (const json* x = find(t, "pen")) {
-      const std::string pp = at(p, "pen");
-      if (x->is_boolean()) {
-        program.pen_down = x->get<bool>();
-      } else if (x->is_string() && (*x == "up" || *x == "down" || *x == "wall")) {
-        program.pen_down = *x != "up";
-        program.pen_walls = *x == "wall";
-      } else {
-        fail(pp, "pen must be \"up\", \"down\", \"wall\" (down, laying walls), true (down) or false (up), got " +
-                     (x->is_string() ? "\"" + x->get<std::string>() + "\"" : kind_of(*x)));
-      }
-    }
-    // A turtle that may lay walls gets a private collision category in the world server; it must
-    // be known before the run. A wall pen or a script with ["pendown", "wall"] says so itself.
-    program.builder = program.pen_walls;
-    if (program.controller == "script")
-      if (const json* cs = find(program.params, "commands"); cs && cs->is_array())
-        for (const json& c : *cs)
-          if (c.is_array() && c.size() == 2 && c[0] == "pendown" && c[1] == "wall") program.builder = true;
-    if (const json* x = find(t, "builder")) {
-      const bool b = boolean(*x, at(p, "builder"));
-      if (!b && program.builder)
-        fail(at(p, "builder"), "builder is false but this turtle lays walls (its pen is \"wall\" or its script has "
-                               "[\"pendown\", \"wall\"]); remove \"builder\"");
-      program.builder = b;
-    }
-    if (const json* x = find(t, "gps")) program.gps = boolean(*x, at(p, "gps"));
-    turtles.push_back(std::move(body));
-    programs.push_back(std::move(program));
-  }
-}
-
-std::vector<turtle::SensorArc> Reader::read_sensors(const json& v, const std::string& path) const {
-  constexpr std::uint64_t max_sensors = 64;  // the runtime reports fired sensors as a 64-bit mask
-  if (v.is_number()) {
-    const std::uint64_t n = natural(v, path);
-    if (n < 1 || n > max_sensors)
-      fail(path, "a sensor count must be from 1 to " + std::to_string(max_sensors) + " (got " + std::to_string(n) + ")");
-    return turtle::equal_sensors(static_cast<int>(n));
-  }
-  const std::string shape =
-      "sensors must be a count (4: four equal arcs) or a list of arcs "
-      "[{\"name\": \"front\", \"from\": -45, \"to\": 45}, ...], got ";
-  if (!v.is_array()) fail(path, shape + kind_of(v));
-  if (v.empty()) fail(path, "a turtle needs at least one sensor; leave \"sensors\" out for the default four");
-  if (v.size() > max_sensors) fail(path, "at most " + std::to_string(max_sensors) + " sensors (got " + std::to_string(v.size()) + ")");
-  std::vector<turtle::SensorArc> arcs;
-  std::set<std::string> names;
-  for (std::size_t k = 0; k < v.size(); ++k) {
-    const std::string p = at(path, k);
-    const json& a = v[k];
-    expect_object(a, p, "a sensor arc");
-    check_keys(a, p, "a sensor arc", {"name", "from", "to"});
-    turtle::SensorArc arc;
-    arc.name = string(require(a, p, "name", "a sensor arc"), at(p, "name"));
-    if (arc.name.empty()) fail(at(p, "name"), "a sensor's name must not be empty");
-    if (!names.insert(arc.name).second) fail(at(p, "name"), "duplicate sensor name \"" + arc.name + "\"");
-    arc.from = number(require(a, p, "from", "a sensor arc"), at(p, "from"));
-    arc.to = number(require(a, p, "to", "a sensor arc"), at(p, "to"));
-    // Degrees clockwise from the heading, [from, to): an arc through the heading has a negative from.
-    if (!(arc.from < arc.to) || arc.to - arc.from > 360.0)
-      fail(p, "sensor \"" + arc.name + "\" covers [" + num(arc.from) + ", " + num(arc.to) +
-                  ") degrees; need from < to <= from + 360 (clockwise from the heading; an arc through the "
-                  "heading is written with a negative from, e.g. -45 to 45)");
-    arcs.push_back(std::move(arc));
-  }
-  return arcs;
-}
-
-void Reader::check_script(const json& params, const std::string& path) const {
-  // The script controller would only find these at run time, as a fault that stops the turtle; a
-  // typo in a scripted test world should stop the load instead.
-  check_keys(params, path, "the script controller's params", {"commands"});
-  const json* commands = find(params, "commands");
-  if (!commands) return;  // a script turtle without commands stands still: an obstacle
-  const std::string cp = at(path, "commands");
-  if (!commands->is_array())
-    fail(cp, "commands must be a list of [command, amount], e.g. [[\"forward\", 100], [\"right\", 90]], got " +
-                 kind_of(*commands));
-  const std::string known = sim::join_names(turtle::script_command_names());
-  for (std::size_t k = 0; k < commands->size(); ++k) {
-    const std::string p = at(cp, k);
-    const json& c = (*commands)[k];
-    if (!c.is_array() || c.empty() || !c[0].is_string())
-      fail(p, "a command must be [command, amount], e.g. [\"forward\", 100], got " + c.dump());
-    const std::string name = c[0].get<std::string>();
-    const turtle::ScriptCommand* command = turtle::find_script_command(name);
-    if (!command) fail(at(p, 0), "unknown command '" + name + "'; known: " + known);
-    if (name == "pendown" && c.size() == 2 && c[1].is_string()) {
-      if (c[1] != "wall" && c[1] != "line")
-        fail(at(p, 1), "a pen mode is \"line\" (draws the path) or \"wall\" (lays walls), got " + c[1].dump());
-      continue;
-    }
-    if (name == "pendown" || name == "penup") {
-      if (c.size() != 1)
-        fail(p, "'" + name + "' takes no amount: [\"" + name + "\"]" +
-                    (name == "pendown" ? " (or a pen mode: [\"pendown\", \"wall\"])" : ""));
-      continue;
-    }
-    if (c.size() != 2) fail(p, "'" + name + "' needs one number, e.g. [\"" + name + "\", 100], got " + c.dump());
-    const double amount = number(c[1], at(p, 1));
-    if (amount < 0.0)
-      fail(at(p, 1), "'" + name + "' needs an amount >= 0 in " + std::string(turtle::unit_name(command->amount)) + " (got " + num(amount) + ")" +
-                         (name == "forward" ? "; use [\"back\", ...] to go backwards"
-                          : name == "back"  ? "; use [\"forward\", ...] to go forwards"
-                          : name == "left"  ? "; use [\"right\", ...] to turn the other way"
-                          : name == "right" ? "; use [\"left\", ...] to turn the other way"
-                                            : ""));
-  }
-}
-
-std::vector<detail::GasSpec> Reader::read_gases(const json& v, const sim::WorldDef& def) {
-  const std::string path = "/gas";
-  expect_array(v, path, "gas");
-  std::vector<detail::GasSpec> out;
-  for (std::size_t k = 0; k < v.size(); ++k) {
-    const std::string p = at(path, k);
-    const json& g = v[k];
-    expect_object(g, p, "a gas");
-    check_keys(g, p, "a gas", {"count", "radius", "mass", "speed", "region", "seed", "id_prefix", "category", "collides_with"});
-    detail::GasSpec gas;
-    const std::uint64_t count = natural(require(g, p, "count", "a gas"), at(p, "count"));
-    constexpr std::uint64_t max_count = 100'000'000;
-    if (count > max_count)
-      fail(at(p, "count"), "count " + std::to_string(count) + " is more than this loader places (" +
-                               std::to_string(max_count) + "); split the gas or use fewer, larger balls");
-    gas.count = static_cast<std::size_t>(count);
-    gas.radius = positive(require(g, p, "radius", "a gas"), at(p, "radius"), "radius");
-    if (const json* x = find(g, "mass")) gas.mass = positive(*x, at(p, "mass"), "mass");
-    gas.speed = number(require(g, p, "speed", "a gas"), at(p, "speed"));
-    if (gas.speed < 0.0) fail(at(p, "speed"), "speed must be >= 0 (got " + num(gas.speed) + "); directions are random");
-    gas.lo = {0.0, 0.0};
-    gas.hi = {def.arena.width, def.arena.height};
-    if (const json* r = find(g, "region")) {
-      const std::string rp = at(p, "region");
-      const std::string shape = "expected [[x0, y0], [x1, y1]] (two corners), got ";
-      if (!r->is_array()) fail(rp, shape + kind_of(*r));
-      if (r->size() != 2) fail(rp, shape + "an array of " + std::to_string(r->size()));
-      gas.lo = vec2((*r)[0], at(rp, 0));
-      gas.hi = vec2((*r)[1], at(rp, 1));
-      if (!(gas.lo.x < gas.hi.x && gas.lo.y < gas.hi.y))
-        fail(rp, "region " + vec(gas.lo) + " to " + vec(gas.hi) +
-                     " is empty; give the lower-left corner first: [[x0, y0], [x1, y1]] with x0 < x1 and y0 < y1");
-    }
-    // Entry k defaults to the world seed + k, so two default gases do not repeat each other.
-    gas.seed = def.seed + k;
-    if (const json* s = find(g, "seed")) gas.seed = natural(*s, at(p, "seed"));
-    gas.id_prefix = k == 0 ? "g" : "g" + std::to_string(k) + "-";
-    if (const json* x = find(g, "id_prefix")) gas.id_prefix = string(*x, at(p, "id_prefix"));
-    gas.layers = layers(g, p);
-
-    Vec2 lo, hi;
-    detail::centre_range(gas, def.arena, lo, hi);
-    if (lo.x > hi.x || lo.y > hi.y)
-      fail(at(p, "region"), "balls of radius " + num(gas.radius) + " do not fit in region [" + vec(gas.lo) + ", " +
-                                vec(gas.hi) + "] inside the arena; enlarge the region or reduce radius");
-    out.push_back(std::move(gas));
-  }
-  return out;
-}
-
-/// The number n if `digits` is n written as place_gas writes it (decimal, no leading zero).
-std::optional<std::uint64_t> gas_number(std::string_view digits) {
-  if (digits.empty() || digits.size() > 18 || (digits.size() > 1 && digits[0] == '0')) return std::nullopt;
-  std::uint64_t n = 0;
-  for (char c : digits) {
-    if (c < '0' || c > '9') return std::nullopt;
-    n = n * 10 + static_cast<std::uint64_t>(c - '0');
-  }
-  return n;
-}
-
-void Reader::check_gas_ids(const std::vector<detail::GasSpec>& gases) const {
-  // Gas k's ids are id_prefix + n for n < count. One collides with an explicit id when that id is
-  // the prefix followed by such an n.
-  for (std::size_t k = 0; k < gases.size(); ++k) {
-    const detail::GasSpec& g = gases[k];
-    if (g.count == 0) continue;
-    for (const auto& [id, path] : ids_) {
-      if (!id.starts_with(g.id_prefix)) continue;
-      const auto n = gas_number(std::string_view(id).substr(g.id_prefix.size()));
-      if (!n || *n >= g.count) continue;
-      fail(at("/gas", k), "this gas's id \"" + id + "\" is already used " +
-                              (path.empty() ? std::string("by an arena wall") : "at " + path) +
-                              "; set an id_prefix that no other id starts with");
-    }
-  }
-  // Two gases collide when one prefix is the other followed by digits t, so that
-  // short + (t + m) == long + m; the smallest such number of the shorter one is t followed by 0.
-  for (std::size_t a = 0; a < gases.size(); ++a)
-    for (std::size_t b = 0; b < gases.size(); ++b) {
-      const detail::GasSpec &ga = gases[a], &gb = gases[b];
-      if (a == b || ga.count == 0 || gb.count == 0 || !gb.id_prefix.starts_with(ga.id_prefix)) continue;
-      if (ga.id_prefix == gb.id_prefix && a > b) continue;  // reported once, at the later gas
-      bool clash = ga.id_prefix == gb.id_prefix;
-      if (!clash) {
-        const auto t = gas_number(std::string_view(gb.id_prefix).substr(ga.id_prefix.size()));
-        clash = t && *t != 0 && *t * 10 < ga.count;
-      }
-      if (clash)
-        fail(at("/gas", std::max(a, b)), "the ids of gases " + std::to_string(std::min(a, b)) + " and " +
-                                             std::to_string(std::max(a, b)) + " (prefixes \"" + ga.id_prefix +
-                                             "\" and \"" + gb.id_prefix + "\") overlap; give each gas its own id_prefix");
-    }
-}
-
 std::string Reader::path_of(const sim::DefProblem& p) const {
   using Where = sim::DefProblem::Where;
   auto with_field = [&](std::string base) { return p.field.empty() ? base : at(base, p.field); };
@@ -700,7 +292,7 @@ std::string Reader::path_of(const sim::DefProblem& p) const {
 }
 
 Scene Reader::read(const json& doc, std::string_view default_name) {
-  if (!doc.is_object()) fail("", "a world file must be a JSON object ({\"format\": \"turtlegas-world/1\", ...}), got " + kind_of(doc));
+  if (!doc.is_object()) fail("", "a world file must be a JSON object ({\"format\": \"turtlegas-world/1\", ...}), got " + json_kind(doc));
   const json* format = find(doc, "format");
   if (!format) fail("", "missing \"format\"; add \"format\": \"" + std::string(world_format) + "\" to the top-level object");
   if (!format->is_string() || format->get<std::string>() != world_format)
@@ -741,21 +333,21 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
     }
   }
   if (const json* v = find(doc, "game"))  // game_file.hpp
-    scene.game = read_game(*v, def, [this](const std::string& path, const std::string& reason) { fail(path, reason); });
+    scene.game = read_game(*v, def, *this);
 
   // The scene without its gases first: gases are placed around the walls, balls and turtles,
   // which must therefore be sound.
   if (auto problem = sim::validate(def)) fail(path_of(*problem), problem->message);
 
   if (const json* v = find(doc, "gas")) {
-    const std::vector<detail::GasSpec> gases = read_gases(*v, def);
+    const std::vector<GasSpec> gases = read_gases(*v, def);
     std::size_t total = def.balls.size();
     for (const auto& g : gases) total += g.count;
     def.balls.reserve(total);
     for (std::size_t k = 0; k < gases.size(); ++k) {
-      const detail::GasSpec& gas = gases[k];
+      const GasSpec& gas = gases[k];
       gas_first_.push_back(def.balls.size());
-      const std::size_t placed = detail::place_gas(def, gas);
+      const std::size_t placed = place_gas(def, gas);
       if (placed < gas.count)
         fail(at("/gas", k), "could only place " + std::to_string(placed) + " of " + std::to_string(gas.count) +
                                 " balls of radius " + num(gas.radius) + " in region [" + vec(gas.lo) + ", " +
@@ -767,13 +359,19 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
   }
   // Scripted test worlds (expect.hpp): read last, so that their ids can name any body.
   if (const json* v = find(doc, "expect")) {
-    scene.expect = parse_expect(*v, file_, def);
+    scene.expect = parse_expect(*v, file(), def);
     for (const auto& e : scene.expect.entries)
       if (e.kind == "it" && !scene.game)
         fail(at(at("/expect", e.index), "it"), "an \"it\" expectation needs a game; add \"game\": {\"kind\": \"tag\", ...}");
   }
   return scene;
 }
+
+}  // namespace detail
+
+namespace {
+
+using detail::json;
 
 /// Line and column (1-based, column in bytes) of the byte that nlohmann's parser stopped at.
 std::pair<std::size_t, std::size_t> line_and_column(std::string_view text, std::size_t byte) {
@@ -806,7 +404,7 @@ Scene parse(std::string_view text, std::string_view file_name, const turtle::Reg
     throw WorldFileError(file, "", "invalid JSON: " + what);
   }
   std::string stem = std::filesystem::path(file).stem().string();
-  return Reader(file, registry).read(doc, stem);
+  return detail::Reader(file, registry).read(doc, stem);
 }
 
 Scene load(const std::filesystem::path& path, const turtle::Registry* registry) {
@@ -822,7 +420,6 @@ Scene load(const std::filesystem::path& path, const turtle::Registry* registry) 
   if (in.bad()) throw WorldFileError(file, "", std::string("cannot read: ") + std::strerror(errno));
   return parse(text.str(), file, registry);
 }
-
 }  // namespace
 
 Scene parse_scene(std::string_view text, std::string_view file_name, const turtle::Registry& registry) {

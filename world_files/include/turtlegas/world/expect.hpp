@@ -22,6 +22,7 @@
 
 #include "turtlegas/sim/world_def.hpp"
 #include "turtlegas/turtle/log_event.hpp"
+#include "turtlegas/world/json_read.hpp"
 #include "turtlegas/world/run_view.hpp"
 
 namespace turtlegas::world {
@@ -60,20 +61,21 @@ struct Expectations {
   std::vector<Entry> entries;
 };
 
-/// Helpers a kind's parser uses: typed reads that fail as world-file errors at a JSON path.
-/// (Throws WorldFileError, file_error.hpp.)
+/// Helpers a kind's parser uses: typed reads that fail as world-file errors at a JSON path (the
+/// world files' JsonReader, in `expect`'s wording: "got" shows the value). Throws WorldFileError.
 class ExpectParser {
  public:
   ExpectParser(std::string file, const sim::WorldDef& def);
 
-  [[noreturn]] void fail(const std::string& path, const std::string& reason) const;
+  [[noreturn]] void fail(const std::string& path, const std::string& reason) const { json_.fail(path, reason); }
   /// Rejects keys of `entry` outside `known` (the kind key and x- keys are always allowed).
   void check_keys(const nlohmann::json& entry, const std::string& path, std::string_view kind,
                   std::initializer_list<std::string_view> known) const;
-  double number(const nlohmann::json& v, const std::string& path) const;
-  double non_negative(const nlohmann::json& v, const std::string& path) const;
-  sim::Vec2 vec2(const nlohmann::json& v, const std::string& path) const;
-  std::string string(const nlohmann::json& v, const std::string& path) const;
+  double number(const nlohmann::json& v, const std::string& path) const { return json_.number(v, path); }
+  double non_negative(const nlohmann::json& v, const std::string& path) const { return json_.non_negative(v, path); }
+  sim::Vec2 vec2(const nlohmann::json& v, const std::string& path) const { return json_.vec2(v, path); }
+  std::string string(const nlohmann::json& v, const std::string& path) const { return json_.string(v, path); }
+  bool boolean(const nlohmann::json& v, const std::string& path) const { return json_.boolean(v, path); }
   /// A wall, ball or turtle id that exists in the scene.
   std::string body_id(const nlohmann::json& v, const std::string& path) const;
   /// An id of a turtle.
@@ -86,7 +88,7 @@ class ExpectParser {
   std::optional<double> at_time(const nlohmann::json& v, const std::string& path) const;
 
  private:
-  std::string file_;
+  JsonReader json_;
   const sim::WorldDef& def_;
 };
 
