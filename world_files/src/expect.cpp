@@ -27,7 +27,9 @@ using sim::Vec2;
 std::string num(double v) { return sim::format_number(v); }
 std::string vec(Vec2 v) { return sim::format_vec(v); }
 
-std::string at(const std::string& path, std::string_view key) { return path + "/" + std::string(key); }
+// JSON pointers (RFC 6901), as the loader writes them.
+std::string at(const std::string& path, std::string_view key) { return json_at(path, key); }
+std::string at(const std::string& path, std::size_t index) { return json_at(path, index); }
 
 /// The event kinds a run's log carries (sim's kinds, plus the runtime's touch and fault).
 constexpr std::array<std::string_view, 13> event_kinds = {
@@ -246,7 +248,7 @@ std::shared_ptr<const Assertion> parse_inside(const json& e, const std::string& 
   const json& r = e.at("inside");
   const std::string rp = at(path, "inside");
   if (!r.is_array() || r.size() != 2) p.fail(rp, "expected [[x0, y0], [x1, y1]] (two corners), got " + r.dump());
-  const Vec2 lo = p.vec2(r[0], rp + "/0"), hi = p.vec2(r[1], rp + "/1");
+  const Vec2 lo = p.vec2(r[0], at(rp, 0)), hi = p.vec2(r[1], at(rp, 1));
   if (!(lo.x <= hi.x && lo.y <= hi.y)) p.fail(rp, "give the lower-left corner first: x0 <= x1 and y0 <= y1");
   std::vector<std::string> who;
   if (auto it = e.find("who"); it != e.end()) who = p.who(*it, at(path, "who"));
@@ -666,7 +668,7 @@ std::vector<std::string> ExpectParser::who(const json& v, const std::string& pat
   if (v.is_string()) return {one(v, path)};
   if (!v.is_array() || v.empty()) fail(path, "who must be \"*\", an id or a non-empty list of ids, got " + v.dump());
   std::vector<std::string> ids;
-  for (std::size_t i = 0; i < v.size(); ++i) ids.push_back(one(v[i], path + "/" + std::to_string(i)));
+  for (std::size_t i = 0; i < v.size(); ++i) ids.push_back(one(v[i], at(path, i)));
   return ids;
 }
 
@@ -696,7 +698,7 @@ Expectations parse_expect(const json& expect, const std::string& file, const sim
   std::vector<std::string_view> all(setting_keys.begin(), setting_keys.end());
   for (const AssertionKind& k : assertion_kinds()) all.push_back(k.key);
   for (std::size_t i = 0; i < expect.size(); ++i) {
-    const std::string ep = path + "/" + std::to_string(i);
+    const std::string ep = at(path, i);
     const json& e = expect[i];
     if (!e.is_object()) p.fail(ep, "an expectation must be a JSON object ({\"count\": \"ball-wall\", ...}), got " + e.dump());
     std::vector<std::string> kinds;

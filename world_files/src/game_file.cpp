@@ -13,9 +13,7 @@ namespace turtlegas::world {
 turtle::TagRules read_game(const nlohmann::json& game, const sim::WorldDef& def, const JsonReader& reader) {
   auto die = [&](const std::string& path, const std::string& reason) { reader.fail(path, reason); };
   if (!game.is_object()) die("/game", "game must be a JSON object ({\"kind\": \"tag\", \"it\": \"t1\"})");
-  if (const std::string* key = unknown_key(game, {"kind", "it", "no_tag_back"}))
-    die("/game/" + *key, "unknown key \"" + *key +
-                             "\" in game (known keys: kind, it, no_tag_back; keys starting with x- are ignored)");
+  reader.check_keys(game, "/game", "game", {"kind", "it", "no_tag_back"}, /*suggest=*/false);
   if (!game.contains("kind")) die("/game", "game needs \"kind\"; the only kind so far is \"tag\"");
   if (!game["kind"].is_string() || game["kind"] != "tag")
     die("/game/kind", "unknown game kind " + game["kind"].dump() + "; the only kind so far is \"tag\"");
