@@ -4,7 +4,7 @@
 // An `expect` entry is a JSON object whose *kind key* says what it asserts ({"count": "ball-wall",
 // "min": 10}); the other keys are that kind's options. Two entries are settings, not assertions:
 // {"until": T} (the run's length, required by `turtlegas test`) and {"mode": "exact"|"step"|"both"}.
-// The assertion kinds are an explicit table in expect.cpp (assertion_kinds()): a new kind is one
+// The assertion kinds are an explicit table in expect_kinds.cpp (assertion_kinds()): a new kind is one
 // class and one line there. docs/worlds.md, "Scripted test worlds", is the user's reference.
 // Running a scene against its list is scenario.hpp's.
 #pragma once
@@ -102,7 +102,7 @@ struct AssertionKind {
       parse;
 };
 
-/// Every assertion kind, an explicit table (expect.cpp).
+/// Every assertion kind, an explicit table (expect_kinds.cpp).
 const std::vector<AssertionKind>& assertion_kinds();
 
 /// Parses a world file's `expect` value (at JSON path /expect). Throws WorldFileError naming `file`.
