@@ -2,6 +2,8 @@
 #include "turtlegas/turtle/registry.hpp"
 
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "turtlegas/sim/suggest.hpp"
 
@@ -22,7 +24,9 @@ const Controller& Registry::require(const std::string& name, const std::string& 
 }
 
 std::string Registry::not_registered(const std::string& name) const {
-  return "controller '" + name + "' is not registered; known: " + sim::join_names(names());
+  const std::vector<std::string> known = names();
+  return "controller '" + name + "' is not registered; known: " + sim::join_names(known) +
+         sim::suggestion(name, known, "'");
 }
 
 std::vector<std::string> Registry::names() const {

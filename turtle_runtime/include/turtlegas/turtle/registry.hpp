@@ -21,7 +21,8 @@ class Registry {
   /// `context` and ": " when a context is given ("turtle 't1'", "--controllers").
   const Controller& require(const std::string& name, const std::string& context = {}) const;
   /// What require throws for a name it does not hold: "controller 'wandr' is not registered; known:
-  /// script, spiral, ..." (every registered name, in order).
+  /// script, spiral, ..., wander; did you mean 'wander'?" (every registered name, in order; the
+  /// suggestion only for a close misspelling, fewer than 3 edits).
   std::string not_registered(const std::string& name) const;
   std::vector<std::string> names() const;
   const std::string& summary(const std::string& name) const;
