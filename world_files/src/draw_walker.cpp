@@ -6,7 +6,7 @@
 namespace turtlegas::world {
 
 void DrawWalker::turn(double degrees) {
-  heading = sim::wrap_draw_degrees(heading + degrees);
+  heading = sim::wrap_degrees(heading + degrees);
 }
 
 std::optional<sim::WallDef> DrawWalker::move(double distance) {

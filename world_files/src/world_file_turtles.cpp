@@ -35,7 +35,7 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
     // wrapped into [0, 360) first so that a state written back reads like the file.
     double heading = 0.0;
     if (const json* x = find(t, "heading")) heading = number(*x, at(p, "heading"));
-    body.heading = sim::to_radians(sim::wrap_heading_degrees(heading));
+    body.heading = sim::to_radians(sim::wrap_degrees(heading));
     body.radius = 10.0;
     if (const json* x = find(t, "radius")) body.radius = positive(*x, at(p, "radius"), "radius");
     body.speed = 30.0;

@@ -30,37 +30,23 @@ constexpr double api_degrees(double radians) { return radians / radians_per_degr
 /// degrees_per_radian). It can differ from api_degrees in the last bit.
 constexpr double file_degrees(double radians) { return radians * degrees_per_radian; }
 
-/// An angle in degrees brought into [0, 360): bearings, sensor arcs, the API's heading. Within two
-/// turns either way (bearings, arcs), one or two exact steps of 360 give fmod's answer bit for bit
-/// (the differences are exact by Sterbenz's lemma); fmod only beyond.
+/// An angle in degrees brought into [0, 360): touch bearings, sensor arcs, the API's heading, the
+/// headings of world files, state files and draw builders. Within two turns either way one or two
+/// exact steps of 360 give fmod's answer bit for bit (the differences are exact by Sterbenz's
+/// lemma); fmod only beyond. A tiny negative angle plus 360 rounds to 360 itself: that is 0.
 inline double wrap_degrees(double a) {
   if (a >= 0.0 && a < 360.0) return a;
   if (a >= 360.0 && a < 720.0) return a - 360.0;
-  if (a < 0.0 && a > -360.0) return a + 360.0;
-  a = std::fmod(a, 360.0);
-  return a < 0 ? a + 360.0 : a;
-}
-
-/// A heading in degrees brought into [0, 360) through fmod, as world files' headings are read and
-/// the state file and `expect` write them back.
-inline double wrap_heading_degrees(double h) {
-  h = std::fmod(h, 360.0);
-  if (h < 0.0) h += 360.0;
-  if (h >= 360.0) h = 0.0;  // -1e-17 + 360 rounds to 360
-  return h;
-}
-
-/// A draw builder's heading in degrees after a turn: fmod, then one step of 360 up.
-inline double wrap_draw_degrees(double h) {
-  h = std::fmod(h, 360.0);
-  if (h < 0.0) h += 360.0;
-  return h;
+  if (!(a < 0.0 && a > -360.0)) a = std::fmod(a, 360.0);
+  if (a < 0.0) a += 360.0;
+  if (a >= 360.0) a = 0.0;  // -1e-17 + 360
+  return a;
 }
 
 /// The unit vector of a Logo heading in degrees: (sin h, cos h), exact (0 or ±1) at multiples of
 /// 90 degrees, where the library's sin and cos of a radian value are not.
 inline Vec2 heading_direction(double heading_degrees) {
-  const double h = wrap_draw_degrees(heading_degrees);
+  const double h = wrap_degrees(heading_degrees);
   // Quarter turns are exact: a square room drawn from integer corners closes exactly.
   if (h == 0.0) return {0.0, 1.0};
   if (h == 90.0) return {1.0, 0.0};
