@@ -46,7 +46,7 @@ void write_state(std::ostream& out, const sim::World& world, const RunNames& nam
     buf += ", ";
     append_number(buf, tu.pos.y);
     // Radians inside, degrees in files (Logo convention: 0 is +y, clockwise), in [0, 360).
-    const double heading = sim::wrap_degrees(sim::file_degrees(tu.heading));
+    const double heading = sim::wrap_degrees(sim::to_degrees(tu.heading));
     buf += "], \"heading\": ";
     append_number(buf, heading);
     buf += "}";

@@ -80,7 +80,7 @@ void Turtle::on_touch(std::function<void(const Touch&)> handler) { agent_->handl
 void Turtle::on_message(std::function<void(const Message&)> handler) { agent_->message_handler = std::move(handler); }
 bool Turtle::it() const { return agent_->it; }
 double Turtle::odometer() const { return agent_->odometer; }
-double Turtle::heading() const { return sim::wrap_degrees(sim::api_degrees(agent_->server->world.turtle(agent_->index).heading)); }
+double Turtle::heading() const { return sim::wrap_degrees(sim::to_degrees(agent_->server->world.turtle(agent_->index).heading)); }
 std::optional<sim::Vec2> Turtle::position() const {
   if (!agent_->program.gps) return std::nullopt;
   return agent_->server->world.turtle(agent_->index).pos;
@@ -93,7 +93,7 @@ void Turtle::log(const std::string& message) { spdlog::info("turtle '{}' t={:.6g
 std::vector<Touch> Turtle::touching() const {
   // Contacts in force, with their sensors worked out for the heading the turtle has now.
   std::vector<Touch> out;
-  const double heading_deg = sim::api_degrees(agent_->server->world.turtle(agent_->index).heading);
+  const double heading_deg = sim::to_degrees(agent_->server->world.turtle(agent_->index).heading);
   for (const sim::TurtleContact& c : agent_->in_contact)
     out.push_back(detail::make_touch(c, heading_deg, agent_->program.sensors, agent_->sensor_names,
                                      agent_->server->other_id(c.kind, c.other)));

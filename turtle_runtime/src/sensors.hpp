@@ -45,7 +45,7 @@ inline Touch make_touch(const sim::TurtleContact& c, double heading_degrees, con
   // The contact point lies against the normal (which points from the obstacle to the turtle).
   const sim::Vec2 d = -c.normal;
   Touch t;
-  t.bearing = sim::wrap_degrees(sim::api_degrees(sim::heading_of(d)) - heading_degrees);
+  t.bearing = sim::wrap_degrees(sim::to_degrees(sim::heading_of(d)) - heading_degrees);
   t.sensors = sensors_for(arcs, t.bearing);
   t.sensor_names = &sensor_names;
   t.what = std::string(what);

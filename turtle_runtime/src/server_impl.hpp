@@ -68,7 +68,7 @@ class WorldServer::Impl : public GameHost {
 };
 
 inline Touch Agent::make_touch(const sim::TurtleContact& c) const {
-  return detail::make_touch(c, sim::api_degrees(server->world.turtle(index).heading), program.sensors, sensor_names,
+  return detail::make_touch(c, sim::to_degrees(server->world.turtle(index).heading), program.sensors, sensor_names,
                             server->other_id(c.kind, c.other));
 }
 

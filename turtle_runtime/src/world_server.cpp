@@ -41,7 +41,7 @@ void WorldServer::Impl::finish_command(Agent& a) {
   if (a.waiting_on == sim::TurtleCommand::Kind::move) a.odometer += s.done;
   if (a.pen_down) a.trail.push_back(s.pos);
   if (a.lays_wall && s.pos != a.stroke_start) lay_wall(a, a.stroke_start, s.pos);
-  const double done = a.waiting_on == sim::TurtleCommand::Kind::turn ? sim::api_degrees(s.done) : s.done;
+  const double done = a.waiting_on == sim::TurtleCommand::Kind::turn ? sim::to_degrees(s.done) : s.done;
   // A touch that cut the command short is the first of those delivered on resuming.
   a.answer = s.touched && !a.inbox.empty() ? Result(done, a.inbox.front()) : Result(done, std::nullopt);
 }

@@ -13,7 +13,7 @@ RunView::Body RunView::body(const std::string& id) const {
   for (std::size_t i = 0; i < def_.turtles.size(); ++i)
     if (def_.turtles[i].id == id) {
       const sim::TurtleState s = w.turtle(i);
-      return {true, true, true, s.pos, s.vel, sim::wrap_degrees(sim::file_degrees(s.heading))};
+      return {true, true, true, s.pos, s.vel, sim::wrap_degrees(sim::to_degrees(s.heading))};
     }
   for (std::size_t i = 0; i < def_.balls.size(); ++i)
     if (def_.balls[i].id == id) {

@@ -14,21 +14,19 @@
 namespace turtlegas::sim {
 
 /// Radians in one degree: degrees (world files, the controller API) to radians (inside) is a
-/// product with it.
+/// product with it, and back a division by it.
 inline constexpr double radians_per_degree = std::numbers::pi / 180.0;
-/// Degrees in one radian.
-inline constexpr double degrees_per_radian = 180.0 / std::numbers::pi;
 
 /// Degrees to radians.
 constexpr double to_radians(double degrees) { return degrees * radians_per_degree; }
 
-/// Radians to degrees as the controller API, touch bearings and the log's bearings compute them
-/// (a division by radians_per_degree).
-constexpr double api_degrees(double radians) { return radians / radians_per_degree; }
-
-/// Radians to degrees as the state file and `expect` compute them (a product with
-/// degrees_per_radian). It can differ from api_degrees in the last bit.
-constexpr double file_degrees(double radians) { return radians * degrees_per_radian; }
+/// Radians to degrees: one formula for what a program sees (Turtle::heading, a turn's done,
+/// bearings) and what the state file and `expect` say, so the two never differ in the last bit.
+/// A division by radians_per_degree rather than a product with 180/pi: it is the correctly
+/// rounded degree value more often (89 % against 78 % of 200,000 random headings in [-4pi, 4pi],
+/// checked against 60-digit pi), and it takes a degree value through to_radians and back
+/// unchanged more often (93 % against 88 % of the integers -720..720 and of 3-decimal values).
+constexpr double to_degrees(double radians) { return radians / radians_per_degree; }
 
 /// An angle in degrees brought into [0, 360): touch bearings, sensor arcs, the API's heading, the
 /// headings of world files, state files and draw builders. Within two turns either way one or two
