@@ -77,9 +77,9 @@ std::string ExpectParser::body_id(const json& v, const std::string& path) const 
     if (b.id == id) return id;
   for (const auto& w : def_.walls)
     if (w.id == id) return id;
-  if (def_.arena.boundary == sim::Boundary::walls &&
-      (id == "arena-bottom" || id == "arena-right" || id == "arena-top" || id == "arena-left"))
-    return id;
+  if (def_.arena.boundary == sim::Boundary::walls)  // the arena's walls, with the engine's ids
+    for (const sim::WallDef& w : sim::arena_walls(def_.arena))
+      if (w.id == id) return id;
   if (drawn_wall_id(id, def_)) return id;  // a wall a turtle's pen may lay while the world runs
   fail(path, "no wall, ball or turtle has id \"" + id + "\" (nor is it <turtle>-w<k>, a wall a turtle may draw)");
 }

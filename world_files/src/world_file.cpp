@@ -36,8 +36,6 @@ std::vector<std::string_view> draw_commands() {
   return names;
 }
 
-constexpr std::array<std::string_view, 4> arena_wall_ids = {"arena-bottom", "arena-right", "arena-top", "arena-left"};
-
 }  // namespace
 
 void Reader::collect_category(const json& obj, const std::string& path) {
@@ -314,7 +312,7 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
   if (const json* v = find(doc, "arena")) read_arena(*v, def.arena);
   if (const json* v = find(doc, "effects")) read_effects(*v, def.effects);
   if (def.arena.boundary == sim::Boundary::walls)
-    for (std::string_view id : arena_wall_ids) ids_.emplace(std::string(id), "");
+    for (const sim::WallDef& w : sim::arena_walls(def.arena)) ids_.emplace(w.id, "");  // the engine's ids
   collect_categories(doc);
   if (const json* v = find(doc, "walls")) read_walls(*v, def.walls);
   if (const json* v = find(doc, "draw")) read_draw(*v, def.walls);
