@@ -18,6 +18,8 @@
 //      touches something stops at the contact point at the exact contact time; its command ends
 //      there and the interrupt waits for the next step.
 // Pacing (wall clock) never enters: the same world, seed and programs give the same event log.
+// Threads: every WorldServer of a process runs its programs on one thread (the fibers' fault
+// handling is process-wide; see src/fiber.hpp).
 #pragma once
 
 #include <cstddef>
