@@ -58,12 +58,14 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
     a->index = k;
     a->id = def.turtles[k].id;
     a->program = std::move(programs[k]);
-    const Controller& controller = registry.require(a->program.controller, "turtle '" + a->id + "'");
+    const Controller* controller = registry.find(a->program.controller);
+    if (!controller)  // Registry::require's message; its context built only when it is needed
+      throw std::invalid_argument("turtle '" + a->id + "': " + registry.not_registered(a->program.controller));
     if (a->program.sensors.empty() || a->program.sensors.size() > 64)
       throw std::invalid_argument("turtle '" + a->id + "' needs 1 to 64 sensors (has " +
                                   std::to_string(a->program.sensors.size()) + ")");
     for (const SensorArc& arc : a->program.sensors) a->sensor_names.push_back(arc.name);
-    a->controller = controller;
+    a->controller = *controller;
     a->params = Params(a->program.params);
     a->pen_down = a->program.pen_down || a->program.pen_walls;
     if (a->program.pen_walls) {
