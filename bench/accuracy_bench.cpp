@@ -44,6 +44,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.hpp"
+#include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/sim/reference.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/sim/world_def.hpp"
@@ -133,7 +134,7 @@ Run run(const sim::WorldDef& def, sim::Mode mode, double until, double min_cpu) 
   return best;
 }
 
-const char* mode_name(sim::Mode mode) { return mode == sim::Mode::exact ? "exact" : "step"; }
+const char* mode_name(sim::Mode mode) { return sim::to_string(mode).data(); }
 
 /// The fields every line has: what ran and what it cost.
 nlohmann::ordered_json common(std::string_view scene, const std::filesystem::path& file, const sim::WorldDef& def,

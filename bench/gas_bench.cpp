@@ -33,6 +33,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.hpp"
+#include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/sim/world_def.hpp"
 #include "turtlegas/world/world_file.hpp"
@@ -111,8 +112,7 @@ Options parse_options(int argc, char** argv) {
     };
     if (arg == "--mode") {
       const std::string m = value();
-      if (m == "exact") o.mode = sim::Mode::exact;
-      else if (m == "step") o.mode = sim::Mode::step;
+      if (const auto mode = sim::mode_from_string(m)) o.mode = *mode;
       else usage.error("--mode must be exact or step, got '" + m + "'");
     } else if (arg == "--collisions") {
       o.collisions = static_cast<std::uint64_t>(usage.positive(arg, value()));
@@ -273,7 +273,7 @@ int run_main(int argc, char** argv) {
   out["world"] = opt.world.stem().string();
   out["N"] = n;
   out["phi"] = phi;
-  out["mode"] = opt.mode == sim::Mode::exact ? "exact" : "step";
+  out["mode"] = std::string(sim::to_string(opt.mode));
   out["collisions"] = s.collisions();
   out["ball_ball"] = s.ball_ball;
   out["ball_wall"] = s.ball_wall + s.ball_wall_end;

@@ -17,6 +17,7 @@
 #include "bench_common.hpp"
 #include "fiber.hpp"
 #include "turtlegas/controllers/registry.hpp"
+#include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
 using namespace turtlegas;
@@ -67,7 +68,7 @@ int main(int argc, char** argv) {
     if (a == "--turtles") turtles = std::stoi(v);
     else if (a == "--steps") steps = std::stoi(v);
     else if (a == "--controller") controller = v;
-    else if (a == "--mode") mode = v == "step" ? sim::Mode::step : sim::Mode::exact;
+    else if (a == "--mode") mode = sim::mode_from_string(v).value_or(sim::Mode::exact);
     else if (a == "--stack-kib") stack_kib = std::stoul(v);
     else {
       std::cerr << "turtle_bench: unknown option " << a << "\n";
@@ -130,7 +131,7 @@ int main(int argc, char** argv) {
       {"turtles", turtles},
       {"steps", steps},
       {"controller", controller},
-      {"mode", mode == sim::Mode::exact ? "exact" : "step"},
+      {"mode", std::string(sim::to_string(mode))},
       {"wall_seconds", wall},
       {"start_seconds", start_seconds},
       {"turtle_steps_per_second", turtle_steps / wall},

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "turtlegas/turtle/turtle.hpp"
-#include "turtlegas/turtle/world_server.hpp"  // for turtle::Registry, in turtlegas_register only
+#include "turtlegas/turtle/registry.hpp"  // for turtle::Registry, in turtlegas_register only
 
 namespace {
 

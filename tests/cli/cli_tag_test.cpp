@@ -37,8 +37,30 @@ TEST_CASE("turtlegas tag prints a ranking and writes it as JSON, the same every 
 
   const Result bad = run(dir, {"tag", "worlds/tag.json", "--controllers", "tag_chaser,wandr"});
   CHECK(bad.code == 2);
-  CHECK(bad.err.find("controller 'wandr' is not registered") != std::string::npos);
+  CHECK(bad.err.find("--controllers: controller 'wandr' is not registered; known: script, ") != std::string::npos);
+  CHECK(bad.err.find("wander; did you mean 'wander'?") != std::string::npos);
   const Result missing = run(dir, {"tag", "worlds/nope.json", "--controllers", "tag_chaser"});
   CHECK(missing.code == 2);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("turtlegas tag --json checks its path before playing, and leaves no file behind a failure", "[cli][tag]") {
+  const fs::path dir = fs::temp_directory_path() / ("turtlegas-cli-tag-json-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  // A directory that does not exist: bad input, found before a single round is played (the
+  // ranking table is never printed).
+  const Result no_dir = run(dir, {"tag", "worlds/tag.json", "--controllers", "tag_chaser,tag_evader", "--json",
+                                  (dir / "nowhere" / "t.json").string()});
+  CHECK(no_dir.code == 2);
+  CHECK(no_dir.err.find("--json: directory") != std::string::npos);
+  CHECK(no_dir.out.find("rank") == std::string::npos);
+  // A bad world after a good path: no file, and no temporary file, is left.
+  const Result bad_world = run(dir, {"tag", "worlds/nope.json", "--controllers", "tag_chaser", "--json",
+                                     (dir / "t.json").string()});
+  CHECK(bad_world.code == 2);
+  for (const auto& entry : fs::directory_iterator(dir)) {  // only run()'s captures of the output
+    const std::string name = entry.path().filename().string();
+    CHECK((name == "stdout.txt" || name == "stderr.txt"));
+  }
   fs::remove_all(dir);
 }

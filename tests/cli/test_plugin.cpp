@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include "turtlegas/turtle/turtle.hpp"
-#include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/turtle/registry.hpp"
 
 extern "C" void turtlegas_register(turtlegas::turtle::Registry& registry) {
   registry.add(

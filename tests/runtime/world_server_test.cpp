@@ -70,6 +70,44 @@ TEST_CASE("the script controller drives a turtle", "[runtime]") {
   CHECK(info.fault.empty());
 }
 
+TEST_CASE("the script controller's own errors (a script no loader checked) are faults naming the command", "[runtime]") {
+  // World files are checked by the loader against the same table (turtle/script.hpp); a program
+  // built by hand is not, and the controller itself must say what is wrong.
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"commands": [["forward", 10], ["jump", 5]]})",
+       "params.commands[1]: unknown command 'jump'; known: forward, back, left, right, wait, pendown, penup"},
+      {R"({"commands": [["jump"]]})", "params.commands[0]: 'jump' needs one number, e.g. [\"jump\", 100]"},
+      {R"({"commands": [["wait"]]})", "params.commands[0]: 'wait' needs one number, e.g. [\"wait\", 100]"},
+      {R"({"commands": [["pendown", "crayon"]]})", "params.commands[0]: a pen mode is \"line\" or \"wall\", got \"crayon\""},
+      {R"({"commands": [7]})", "params.commands[0] must be [command, amount], e.g. [\"forward\", 100]"},
+      {R"({"commands": 7})", "params.commands must be a list of [command, amount]"},
+  };
+  for (const auto& [params, fault] : cases) {
+    CAPTURE(params);
+    sim::WorldDef d = arena();
+    d.turtles.push_back(body("t1", {100, 100}, 0));
+    WorldServer s(d, {program("script", params)}, base_registry());
+    s.run_until(1.0);
+    CHECK(s.turtle(0).finished);
+    CHECK(s.turtle(0).fault == std::string("its program threw: ") + fault);
+  }
+  // Every command of the table runs: penup, pendown (both pen modes need no builder for "line"),
+  // wait, the turns and both moves.
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("t1", {100, 100}, 0));
+  WorldServer s(d, {program("script", R"({"commands": [["pendown"], ["forward", 20], ["back", 10], ["penup"],
+                     ["pendown", "line"], ["left", 90], ["right", 180], ["wait", 0.5]]})")},
+                base_registry());
+  s.run_until(10.0);
+  const auto info = s.turtle(0);
+  CHECK(info.fault.empty());
+  CHECK(info.finished);
+  CHECK(info.state.pos.x == Approx(100));
+  CHECK(info.state.pos.y == Approx(110));
+  CHECK(info.state.heading == Approx(M_PI / 2));
+  CHECK(info.pen_down);
+}
+
 TEST_CASE("a touch cuts a command short, fires the right sensor, arrives on the next step", "[runtime]") {
   sim::WorldDef d = arena();
   d.walls.push_back({"w", {202, 0}, {202, 400}});
@@ -259,7 +297,16 @@ TEST_CASE("an unknown controller names the known ones", "[runtime]") {
   sim::WorldDef d = arena();
   d.turtles.push_back(body("t", {100, 100}, 0));
   CHECK_THROWS_WITH(WorldServer(d, {program("wandr")}, base_registry()),
-                    Catch::Contains("controller 'wandr' is not registered; known: script"));
+                    Catch::Equals("turtle 't': controller 'wandr' is not registered; known: script"));
+  // A close misspelling of a registered name is suggested (fewer than 3 edits), a far one not.
+  Registry r = base_registry();
+  r.add("wander", [](Turtle&, const Params&) {});
+  CHECK(r.not_registered("wandr") == "controller 'wandr' is not registered; known: script, wander; did you mean 'wander'?");
+  CHECK(r.not_registered("scirpt") == "controller 'scirpt' is not registered; known: script, wander; did you mean 'script'?");
+  CHECK(r.not_registered("spiral") == "controller 'spiral' is not registered; known: script, wander");
+  CHECK_THROWS_WITH(r.require("wandr", "--controllers"),
+                    "--controllers: controller 'wandr' is not registered; known: script, wander; did you mean 'wander'?");
+  CHECK_NOTHROW(r.require("wander"));
 }
 
 TEST_CASE("runs are deterministic", "[runtime][determinism]") {

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "turtlegas/world/draw_walker.hpp"
+#include "turtlegas/world/scenario.hpp"
 #include "turtlegas/world/world_file.hpp"
 
 namespace tw = turtlegas::world;

@@ -54,6 +54,10 @@ TEST_CASE("the game key", "[world][tag]") {
   CHECK_THAT(error_of(world_with(R"({"kind": "tag", "no_tag_back": -1})")), Catch::StartsWith("w.json: /game/no_tag_back:"));
   CHECK_THAT(error_of(world_with(R"({"kind": "tag", "no_tag_bak": 1})")),
              Catch::StartsWith("w.json: /game/no_tag_bak: unknown key"));
+  // A JSON pointer (RFC 6901), as everywhere in world files: `/` and `~` in a key are escaped.
+  CHECK(error_of(world_with(R"({"kind": "tag", "a/b~": 1})")) ==
+        "w.json: /game/a~1b~0: unknown key \"a/b~\" in game (known keys: kind, it, no_tag_back; keys starting with x- "
+        "are ignored)");
   CHECK_THAT(error_of(world_with(R"({"kind": "tag"})", 1)), Catch::Contains("tag needs at least two turtles"));
   CHECK_THAT(error_of(world_with(R"([])")), Catch::StartsWith("w.json: /game: game must be a JSON object"));
 }

@@ -8,6 +8,7 @@
 
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/world/expect.hpp"
+#include "turtlegas/world/scenario.hpp"
 #include "turtlegas/world/world_file.hpp"
 
 using namespace turtlegas;
@@ -137,6 +138,9 @@ TEST_CASE("bad expect lists are load errors at their JSON path") {
   load_error(R"({"mode": "fast"})", "/expect/1/mode", "mode must be \"exact\", \"step\" or \"both\"");
   load_error(R"({"energy": "conserved"})", "/expect/1", "energy needs \"tolerance\"");
   load_error(R"(3)", "/expect/1", "an expectation must be a JSON object");
+  // Paths are JSON pointers (RFC 6901), as the loader's are: `/` and `~` in a key are escaped.
+  load_error(R"({"count": "touch", "min": 1, "m/x~": 3})", "/expect/1/m~1x~0", "unknown key \"m/x~\" in a \"count\"");
+  load_error(R"({"a/b": 1})", "/expect/1/a~1b", "unknown assertion key \"a/b\"");
 }
 
 TEST_CASE("the kinds table") {

@@ -16,6 +16,13 @@ namespace turtlegas::turtle::detail {
 /// Both are caught by a signal handler on an alternate stack, which jumps back to the resume()
 /// that started the slice; the fiber is then abandoned (its stack is leaked, never unwound) and
 /// resume() reports what happened.
+///
+/// One simulation thread per process: the running slice, its guard page and the watchdog's view
+/// of it are process-wide (fiber.cpp), and the busy-loop signal goes to the thread that last
+/// resumed a fiber. Every WorldServer of a process must therefore run its programs on one thread
+/// (a network server gives all its worlds one simulation thread or strand, and its sessions other
+/// threads). Worlds on several threads would first need thread_local slice state and a watchdog
+/// per thread.
 class Fiber {
  public:
   enum class Outcome {

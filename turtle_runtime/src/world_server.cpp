@@ -1,33 +1,26 @@
 // SPDX-License-Identifier: MIT
+// The scheduler: the control step of world_server.hpp (interrupts, the game's referee, programs in
+// world-file order), a program's turn on its fiber, the end of a command, and running to a time.
 #include "turtlegas/turtle/world_server.hpp"
 
-#include <algorithm>
-#include <cmath>
-#include <numbers>
-#include <optional>
-#include <sstream>
+#include <cstdint>
+#include <exception>
+#include <memory>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include <spdlog/spdlog.h>
 
+#include "agent.hpp"
 #include "fiber.hpp"
-#include "mt64.hpp"
+#include "server_impl.hpp"
+#include "turtlegas/sim/angles.hpp"
+#include "turtlegas/turtle/event_names.hpp"
 #include "turtlegas/turtle/game.hpp"
 
 namespace turtlegas::turtle {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-double wrap_degrees(double a) {
-  // Within two turns either way (bearings, arcs), one or two exact steps of 360 give fmod's
-  // answer bit for bit (the differences are exact by Sterbenz's lemma); fmod only beyond.
-  if (a >= 0.0 && a < 360.0) return a;
-  if (a >= 360.0 && a < 720.0) return a - 360.0;
-  if (a < 0.0 && a > -360.0) return a + 360.0;
-  a = std::fmod(a, 360.0);
-  return a < 0 ? a + 360.0 : a;
-}
 
 // FNV-1a: a stable hash, so that per-turtle random streams do not depend on the library.
 std::uint64_t fnv1a(const std::string& s) {
@@ -39,274 +32,7 @@ std::uint64_t fnv1a(const std::string& s) {
   return h;
 }
 
-std::string kind_word(sim::EventKind k) {
-  switch (k) {
-    case sim::EventKind::turtle_wall: return "wall";
-    case sim::EventKind::turtle_wall_end: return "wall-end";
-    case sim::EventKind::turtle_turtle: return "turtle";
-    case sim::EventKind::turtle_ball: return "ball";
-    default: return "?";
-  }
-}
-
 }  // namespace
-
-// ---------------------------------------------------------------------------------------------
-// Sensors, registry, the script controller
-
-std::vector<SensorArc> default_sensors() {
-  return {{"front", -45, 45}, {"right", 45, 135}, {"back", 135, 225}, {"left", 225, 315}};
-}
-
-std::vector<SensorArc> equal_sensors(int n) {
-  if (n < 1) throw std::invalid_argument("a turtle needs at least one sensor (got " + std::to_string(n) + ")");
-  std::vector<SensorArc> arcs;
-  const double w = 360.0 / n;
-  for (int k = 0; k < n; ++k) arcs.push_back({"s" + std::to_string(k), k * w - w / 2, k * w + w / 2});
-  return arcs;
-}
-
-bool Touch::fired(const std::string& sensor_name) const {
-  if (!sensor_names) return false;
-  for (std::size_t k = 0; k < sensor_names->size(); ++k)
-    if ((*sensor_names)[k] == sensor_name) return fired(k);
-  return false;
-}
-
-void Registry::add(std::string name, Controller controller, std::string summary) {
-  entries_[std::move(name)] = {std::move(controller), std::move(summary)};
-}
-
-const Controller* Registry::find(const std::string& name) const {
-  auto it = entries_.find(name);
-  return it == entries_.end() ? nullptr : &it->second.first;
-}
-
-std::vector<std::string> Registry::names() const {
-  std::vector<std::string> out;
-  for (const auto& [name, entry] : entries_) out.push_back(name);
-  return out;
-}
-
-const std::string& Registry::summary(const std::string& name) const {
-  static const std::string none;
-  auto it = entries_.find(name);
-  return it == entries_.end() ? none : it->second.second;
-}
-
-void script_controller(Turtle& t, const Params& p) {
-  const nlohmann::json& commands = p.json().contains("commands") ? p.json().at("commands") : nlohmann::json::array();
-  if (!commands.is_array()) throw std::invalid_argument("params.commands must be a list of [command, amount]");
-  for (std::size_t k = 0; k < commands.size(); ++k) {
-    const nlohmann::json& c = commands[k];
-    const std::string where = "params.commands[" + std::to_string(k) + "]";
-    if (!c.is_array() || c.empty() || !c[0].is_string())
-      throw std::invalid_argument(where + " must be [command, amount], e.g. [\"forward\", 100]");
-    const std::string name = c[0].get<std::string>();
-    if (name == "pendown" && c.size() == 2 && c[1].is_string()) {
-      const std::string mode = c[1].get<std::string>();
-      if (mode != "wall" && mode != "line")
-        throw std::invalid_argument(where + ": a pen mode is \"line\" or \"wall\", got \"" + mode + "\"");
-      t.pen_down(mode == "wall" ? PenMode::wall : PenMode::line);
-      continue;
-    }
-    if (name == "pendown") { t.pen_down(); continue; }
-    if (name == "penup") { t.pen_up(); continue; }
-    if (c.size() != 2 || !c[1].is_number())
-      throw std::invalid_argument(where + ": '" + name + "' needs one number, e.g. [\"" + name + "\", 100]");
-    const double amount = c[1].get<double>();
-    if (name == "forward") t.forward(amount);
-    else if (name == "back") t.back(amount);
-    else if (name == "left") t.left(amount);
-    else if (name == "right") t.right(amount);
-    else if (name == "wait") t.wait(amount);
-    else
-      throw std::invalid_argument(where + ": unknown command '" + name +
-                                  "'; known: forward, back, left, right, wait, pendown, penup");
-  }
-}
-
-Registry base_registry() {
-  Registry r;
-  r.add("script", script_controller, "runs params.commands, a fixed list of [command, amount]");
-  return r;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Agents: the runtime's side of each turtle
-
-// Laid out hot first: at 10^4 turtles every resume starts with cache misses, so what the scheduler
-// and a resumed program touch at each turn sits in the first few cache lines (see prefetch()).
-class alignas(64) Agent {
- public:
-  Agent() = default;
-  Agent(const Agent&) = delete;
-  Agent& operator=(const Agent&) = delete;
-  // A program suspended mid-command is unwound first, while everything it may still use is alive.
-  ~Agent() { fiber.reset(); }
-
-  WorldServer::Impl* server = nullptr;
-  std::size_t index = 0;
-  std::optional<detail::Fiber> fiber;
-  // The handshake with the scheduler.
-  std::optional<sim::TurtleCommand> command;  // issued by the program, taken by the scheduler
-  bool started = false;
-  bool finished = false;
-  bool waiting = false;    // suspended in issue(), for finish_command() to answer
-  bool lays_wall = false;  // the command waited on lays a wall (the pen in wall mode, a move)
-  sim::TurtleCommand::Kind waiting_on = sim::TurtleCommand::Kind::stop;
-  bool pen_down = false;
-  bool it = false;                            // the game's role, as Turtle::it() reports it
-  PenMode pen_mode = PenMode::line;
-  double odometer = 0.0;
-  Result answer;                              // finish_command()'s, taken by issue() on resuming
-  std::vector<Touch> inbox;                   // touches to deliver when the program resumes
-  std::vector<Message> messages;              // messages to deliver when the program resumes
-  std::function<void(const Touch&)> handler;
-  std::function<void(const Message&)> message_handler;
-  std::vector<sim::TurtleContact> in_contact;  // contacts in force (touching() makes their Touch)
-  std::vector<sim::Vec2> trail;
-  detail::Mt64 rng;  // uniform(); its index (first) is hot, its 2.5 KB of state is not
-
-  // Cold: set up once, or used rarely.
-  std::string id;
-  TurtleProgram program;
-  Controller controller;
-  Params params;
-  std::vector<std::string> sensor_names;      // what Touch::sensor_names points to
-  std::size_t walls_laid = 0;                 // k of the next `<id>-w<k>`
-  std::string fault;
-  sim::Vec2 stroke_start;                     // where the wall pen's stroke began
-
-  Result issue(sim::TurtleCommand c);
-  /// The touch and message handlers, on the program's stack (they may issue commands).
-  [[gnu::noinline]] void deliver();
-  [[noreturn, gnu::noinline, gnu::cold]] void not_own_program() const;
-  Touch make_touch(const sim::TurtleContact& c) const;
-  /// Cache hint: the hot lines above (everything up to and including the generator's index).
-  void prefetch() const {
-    const char* p = reinterpret_cast<const char*>(this);
-    const char* end = reinterpret_cast<const char*>(&rng) + sizeof(std::size_t);
-    for (; p < end; p += 64) __builtin_prefetch(p);
-  }
-  /// Cache hint, once prefetch() has brought the index: the state word uniform() reads next.
-  void prefetch_rng() const { __builtin_prefetch(rng.next_address()); }
-  /// Cache hint for make_touch(), in two stages: the agent and where its sensor arcs are listed,
-  /// then (once those have arrived) the arcs themselves.
-  void prefetch_for_touch() const {
-    prefetch();
-    __builtin_prefetch(&program.sensors);
-  }
-  void prefetch_sensors() const { __builtin_prefetch(program.sensors.data()); }
-};
-
-class WorldServer::Impl : public GameHost {
- public:
-  sim::WorldDef def;
-  sim::World world;
-  ServerOptions options;
-  std::vector<std::unique_ptr<Agent>> agents;
-  std::vector<sim::Event> sim_log;
-  std::vector<LogEvent>* log = nullptr;
-  std::unique_ptr<Game> game;
-  std::vector<std::uint32_t> idle;  // control_step's candidates, kept for their capacity
-  std::uint64_t step = 0;        // index of the next control boundary
-  bool boundary_done = false;    // whether the programs have run at boundary `step`
-
-  Impl(sim::WorldDef d, ServerOptions o) : def(std::move(d)), world(def, o.mode), options(o) {}
-
-  double boundary_time(std::uint64_t k) const { return static_cast<double>(k) * def.dt; }
-  void control_step();
-  void run_program(Agent& a);
-  void finish_command(Agent& a);
-  void drain_sim_events();
-  void lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to);
-  bool id_taken(const std::string& id) const;
-  void emit(LogEvent e) {
-    if (log) log->push_back(std::move(e));
-  }
-  std::string other_id(sim::EventKind kind, std::uint32_t other) const {
-    switch (kind) {
-      case sim::EventKind::turtle_turtle: return def.turtles[other].id;
-      case sim::EventKind::turtle_ball: return def.balls[other].id;
-      default: return world.walls()[other].id;
-    }
-  }
-  std::uint64_t sensors_for(const Agent& a, double bearing) const;
-
-  // GameHost: what a game may do.
-  std::size_t turtle_count() const override { return agents.size(); }
-  const std::string& turtle_id(std::size_t i) const override { return agents.at(i)->id; }
-  void send(std::size_t i, Message m) override {
-    Agent& a = *agents.at(i);
-    if (!a.finished) a.messages.push_back(std::move(m));
-  }
-  void set_it(std::size_t i, bool it) override { agents.at(i)->it = it; }
-  void log_event(LogEvent e) override { emit(std::move(e)); }
-};
-
-std::uint64_t WorldServer::Impl::sensors_for(const Agent& a, double bearing) const {
-  std::uint64_t fired = 0;
-  for (std::size_t k = 0; k < a.program.sensors.size(); ++k) {
-    const SensorArc& s = a.program.sensors[k];
-    const double span = s.to - s.from;
-    if (wrap_degrees(bearing - s.from) < (span >= 360.0 ? 360.0 : wrap_degrees(span))) fired |= std::uint64_t{1} << k;
-  }
-  return fired;
-}
-
-Touch Agent::make_touch(const sim::TurtleContact& c) const {
-  // The contact point lies against the normal (which points from the obstacle to the turtle).
-  const sim::Vec2 d = -c.normal;
-  const double heading_deg = server->world.turtle(index).heading / kDeg;
-  Touch t;
-  t.bearing = wrap_degrees(std::atan2(d.x, d.y) / kDeg - heading_deg);
-  t.sensors = server->sensors_for(*this, t.bearing);
-  t.sensor_names = &sensor_names;
-  t.what = server->other_id(c.kind, c.other);
-  t.kind = kind_word(c.kind);
-  t.t = c.t;
-  return t;
-}
-
-void Agent::not_own_program() const {
-  throw std::logic_error("turtle '" + id + "': commands must be issued from its own program");
-}
-
-// A command's whole round trip on the program's stack is kept shallow: every line of stack the
-// program touches between two commands is a cache miss at each resume once there are thousands of
-// turtles. So the scheduler does the bookkeeping of a finished command on its own (warm) stack
-// before resuming (WorldServer::Impl::finish_command), and this side only hands the answer back,
-// running the handlers out of line when there is something for them.
-Result Agent::issue(sim::TurtleCommand c) {
-  if (!fiber || detail::Fiber::current() != &*fiber) [[unlikely]] not_own_program();
-  command = c;
-  waiting_on = c.kind;
-  waiting = true;
-  // The wall pen lays the stroke this command drives, in the pen mode it was issued in.
-  lays_wall = pen_down && pen_mode == PenMode::wall && c.kind == sim::TurtleCommand::Kind::move;
-  if (lays_wall) stroke_start = server->world.turtle(index).pos;
-  fiber->suspend();
-  // Resumed by the scheduler: the command has ended. The answer is taken first, since a handler's
-  // own command leaves the next one; then interrupts, then messages.
-  Result r = std::move(answer);
-  if (!inbox.empty() || !messages.empty()) [[unlikely]] deliver();
-  return r;
-}
-
-void Agent::deliver() {
-  std::vector<Touch> delivered;
-  delivered.swap(inbox);
-  if (handler)
-    for (const Touch& t : delivered) handler(t);
-  // Hand the buffer back for the next touches (unless a handler's own command refilled the inbox).
-  delivered.clear();
-  if (inbox.empty()) inbox.swap(delivered);
-  std::vector<Message> letters;
-  letters.swap(messages);
-  if (message_handler)
-    for (const Message& m : letters) message_handler(m);
-}
 
 void WorldServer::Impl::finish_command(Agent& a) {
   // The end of the command the program waits on, worked out before it resumes (see issue()).
@@ -315,132 +41,10 @@ void WorldServer::Impl::finish_command(Agent& a) {
   if (a.waiting_on == sim::TurtleCommand::Kind::move) a.odometer += s.done;
   if (a.pen_down) a.trail.push_back(s.pos);
   if (a.lays_wall && s.pos != a.stroke_start) lay_wall(a, a.stroke_start, s.pos);
-  const double done = a.waiting_on == sim::TurtleCommand::Kind::turn ? s.done / kDeg : s.done;
+  const double done = a.waiting_on == sim::TurtleCommand::Kind::turn ? sim::to_degrees(s.done) : s.done;
   // A touch that cut the command short is the first of those delivered on resuming.
   a.answer = s.touched && !a.inbox.empty() ? Result(done, a.inbox.front()) : Result(done, std::nullopt);
 }
-
-// ---------------------------------------------------------------------------------------------
-// The controller API
-
-Result Turtle::forward(double distance) { return agent_->issue({sim::TurtleCommand::Kind::move, distance}); }
-Result Turtle::back(double distance) { return agent_->issue({sim::TurtleCommand::Kind::move, -distance}); }
-Result Turtle::right(double degrees) { return agent_->issue({sim::TurtleCommand::Kind::turn, degrees * kDeg}); }
-Result Turtle::left(double degrees) { return agent_->issue({sim::TurtleCommand::Kind::turn, -degrees * kDeg}); }
-Result Turtle::wait(double seconds) { return agent_->issue({sim::TurtleCommand::Kind::wait, seconds}); }
-void Turtle::yield() { agent_->issue({sim::TurtleCommand::Kind::stop, 0.0}); }
-void Turtle::pen_up() { agent_->pen_down = false; }
-void Turtle::pen_down(PenMode mode) {
-  if (mode == PenMode::wall && !agent_->program.builder)
-    throw std::logic_error("turtle '" + agent_->id +
-                           "' may not lay walls: give it \"builder\": true (or \"pen\": \"wall\") in the world file, "
-                           "so that the world server can give it a collision category of its own");
-  if (!agent_->pen_down) agent_->trail.push_back(agent_->server->world.turtle(agent_->index).pos);
-  agent_->pen_down = true;
-  agent_->pen_mode = mode;
-}
-PenMode Turtle::pen_mode() const { return agent_->pen_mode; }
-bool Turtle::pen_is_down() const { return agent_->pen_down; }
-void Turtle::on_touch(std::function<void(const Touch&)> handler) { agent_->handler = std::move(handler); }
-void Turtle::on_message(std::function<void(const Message&)> handler) { agent_->message_handler = std::move(handler); }
-bool Turtle::it() const { return agent_->it; }
-double Turtle::odometer() const { return agent_->odometer; }
-double Turtle::heading() const { return wrap_degrees(agent_->server->world.turtle(agent_->index).heading / kDeg); }
-std::optional<sim::Vec2> Turtle::position() const {
-  if (!agent_->program.gps) return std::nullopt;
-  return agent_->server->world.turtle(agent_->index).pos;
-}
-double Turtle::time() const { return agent_->server->world.time(); }
-const std::string& Turtle::id() const { return agent_->id; }
-double Turtle::uniform() { return static_cast<double>(agent_->rng() >> 11) * 0x1.0p-53; }
-void Turtle::log(const std::string& message) { spdlog::info("turtle '{}' t={:.6g}: {}", agent_->id, time(), message); }
-
-std::vector<Touch> Turtle::touching() const {
-  // Contacts in force, with their sensors worked out for the heading the turtle has now.
-  std::vector<Touch> out;
-  const double heading_deg = agent_->server->world.turtle(agent_->index).heading / kDeg;
-  for (const sim::TurtleContact& c : agent_->in_contact) {
-    Touch t;
-    const sim::Vec2 d = -c.normal;
-    t.bearing = wrap_degrees(std::atan2(d.x, d.y) / kDeg - heading_deg);
-    t.sensors = agent_->server->sensors_for(*agent_, t.bearing);
-    t.sensor_names = &agent_->sensor_names;
-    t.what = agent_->server->other_id(c.kind, c.other);
-    t.kind = kind_word(c.kind);
-    t.t = c.t;
-    out.push_back(std::move(t));
-  }
-  return out;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Wall-laying turtles
-
-sim::WorldDef with_builder_layers(sim::WorldDef def, const std::vector<TurtleProgram>& programs) {
-  std::uint32_t used = 0;
-  for (const auto& w : def.walls) used |= w.layers.category;
-  for (const auto& b : def.balls) used |= b.layers.category;
-  for (const auto& t : def.turtles) used |= t.layers.category;
-  const std::size_t n = std::min(programs.size(), def.turtles.size());
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!programs[k].builder) continue;
-    // Free bits from the top down, away from the world file's named categories (bit 0 upwards).
-    int bit = 31;
-    while (bit >= 0 && ((used >> bit) & 1u) != 0) --bit;
-    if (bit < 0)
-      throw std::invalid_argument("turtle '" + def.turtles[k].id +
-                                  "' lays walls but no collision category is free for it (32 in use); use fewer "
-                                  "category names or fewer builder turtles");
-    const std::uint32_t own = std::uint32_t{1} << bit;
-    used |= own;
-    sim::TurtleDef& builder = def.turtles[k];
-    // Whoever collided with the builder's categories collides with its private one too, so moving
-    // it there changes nothing but its own walls (whose mask leaves `own` out).
-    const std::uint32_t was = builder.layers.category;
-    auto widen = [&](sim::Layers& l) {
-      if ((l.mask & was) != 0) l.mask |= own;
-    };
-    for (auto& w : def.walls) widen(w.layers);
-    for (auto& b : def.balls) widen(b.layers);
-    for (std::size_t j = 0; j < def.turtles.size(); ++j)
-      if (j != k) widen(def.turtles[j].layers);
-    builder.layers.category = own;
-  }
-  return def;
-}
-
-bool WorldServer::Impl::id_taken(const std::string& id) const {
-  for (const auto& w : world.walls())
-    if (w.id == id) return true;
-  for (const auto& b : def.balls)
-    if (b.id == id) return true;
-  for (const auto& t : def.turtles)
-    if (t.id == id) return true;
-  return false;
-}
-
-void WorldServer::Impl::lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to) {
-  const double now = world.time();
-  sim::WallDef w;
-  do w.id = a.id + "-w" + std::to_string(a.walls_laid++);
-  while (id_taken(w.id));
-  w.from = from;
-  w.to = to;
-  // In the default category, colliding with everything except the builder's private category.
-  w.layers.category = 1;
-  w.layers.mask = ~def.turtles[a.index].layers.category;
-  try {
-    world.add_wall(w);
-  } catch (const std::invalid_argument& e) {
-    spdlog::warn("turtle '{}' t={:.6g}: wall {} not laid: {}", a.id, now, w.id, e.what());
-    emit({now, "wall-refused", a.id, w.id, {}, 0.0, e.what()});
-    return;
-  }
-  emit({now, "wall-drawn", a.id, w.id, {}, 0.0, {}});
-}
-
-// ---------------------------------------------------------------------------------------------
-// The scheduler
 
 WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> programs, const Registry& registry,
                          ServerOptions options)
@@ -454,18 +58,14 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
     a->index = k;
     a->id = def.turtles[k].id;
     a->program = std::move(programs[k]);
-    const Controller* c = registry.find(a->program.controller);
-    if (!c) {
-      std::string known;
-      for (const auto& n : registry.names()) known += (known.empty() ? "" : ", ") + n;
-      throw std::invalid_argument("turtle '" + a->id + "': controller '" + a->program.controller +
-                                  "' is not registered; known: " + known);
-    }
+    const Controller* controller = registry.find(a->program.controller);
+    if (!controller)  // Registry::require's message; its context built only when it is needed
+      throw std::invalid_argument("turtle '" + a->id + "': " + registry.not_registered(a->program.controller));
     if (a->program.sensors.empty() || a->program.sensors.size() > 64)
       throw std::invalid_argument("turtle '" + a->id + "' needs 1 to 64 sensors (has " +
                                   std::to_string(a->program.sensors.size()) + ")");
     for (const SensorArc& arc : a->program.sensors) a->sensor_names.push_back(arc.name);
-    a->controller = *c;
+    a->controller = *controller;
     a->params = Params(a->program.params);
     a->pen_down = a->program.pen_down || a->program.pen_walls;
     if (a->program.pen_walls) {
@@ -598,23 +198,9 @@ void WorldServer::Impl::control_step() {
 void WorldServer::Impl::drain_sim_events() {
   if (log)
     for (const sim::Event& e : sim_log) {
-      LogEvent out{e.t, std::string(sim::to_string(e.kind)), {}, {}, {}, 0.0, {}};
-      switch (e.kind) {
-        case sim::EventKind::ball_ball:
-          out.a = def.balls[e.a].id;
-          out.b = def.balls[e.b].id;
-          break;
-        case sim::EventKind::ball_wall:
-        case sim::EventKind::ball_wall_end:
-          out.a = def.balls[e.a].id;
-          out.b = world.walls()[e.b].id;
-          break;
-        case sim::EventKind::exit: out.a = e.b == 1 ? def.turtles[e.a].id : def.balls[e.a].id; break;
-        default:
-          out.a = def.turtles[e.a].id;
-          out.b = other_id(e.kind, e.b);
-      }
-      emit(std::move(out));
+      const EventIds ids = name_event(e, names());
+      emit({e.t, std::string(sim::to_string(e.kind)), std::string(ids.a), ids.b ? std::string(*ids.b) : std::string(),
+            {}, 0.0, {}});
     }
   sim_log.clear();
 }

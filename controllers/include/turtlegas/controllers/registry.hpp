@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
-#include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/turtle/registry.hpp"
 
 namespace turtlegas::controllers {
 

@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "turtlegas/sim/world.hpp"
+#include "turtlegas/turtle/log_event.hpp"
 #include "turtlegas/turtle/turtle.hpp"
-#include "turtlegas/turtle/world_server.hpp"
 
 namespace turtlegas::turtle {
 

@@ -18,18 +18,21 @@
 //      touches something stops at the contact point at the exact contact time; its command ends
 //      there and the interrupt waits for the next step.
 // Pacing (wall clock) never enters: the same world, seed and programs give the same event log.
+// Threads: every WorldServer of a process runs its programs on one thread (the fibers' fault
+// handling is process-wide; see src/fiber.hpp).
 #pragma once
 
-#include <cstdint>
-#include <functional>
-#include <map>
+#include <cstddef>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "turtlegas/sim/world.hpp"
+#include "turtlegas/turtle/log_event.hpp"
+#include "turtlegas/turtle/registry.hpp"
 #include "turtlegas/turtle/turtle.hpp"
 
 namespace turtlegas::turtle {
@@ -60,25 +63,6 @@ struct TurtleProgram {
   bool gps = false;  ///< whether the program may read its global position
 };
 
-/// Controllers by name. The runtime knows `script`; controllers/ adds the rest.
-class Registry {
- public:
-  void add(std::string name, Controller controller, std::string summary = {});
-  const Controller* find(const std::string& name) const;
-  std::vector<std::string> names() const;
-  const std::string& summary(const std::string& name) const;
-
- private:
-  std::map<std::string, std::pair<Controller, std::string>> entries_;
-};
-
-/// The built-in `script` controller: runs `params.commands`, a list of [name, amount] pairs
-/// (forward, back, left, right, wait; pendown and penup take no amount).
-void script_controller(Turtle& t, const Params& p);
-
-/// A registry holding `script` only.
-Registry base_registry();
-
 /// The scene the world server runs: `def` with every builder turtle (programs[k].builder) moved
 /// into a collision category of its own, a free bit from the top down, and that bit added to the
 /// mask of every wall, ball and turtle that collided with the turtle's old categories. The walls a
@@ -92,17 +76,6 @@ struct ServerOptions {
   /// Wall-clock seconds a program may run without issuing a command before the run is stopped as a
   /// busy loop. Wall clock, not simulated time: it only ever ends a run, never changes one.
   double program_budget = 2.0;
-};
-
-/// One line of the run's event log, with ids resolved; `touch` events carry sensors and bearing.
-struct LogEvent {
-  double t = 0.0;
-  std::string kind;
-  std::string a;
-  std::string b;
-  std::vector<std::string> sensors;  ///< touch only
-  double bearing = 0.0;              ///< touch only, degrees
-  std::string message;               ///< `fault` events: what went wrong
 };
 
 /// The busy-loop stop: a program ran past its budget without issuing a command.

@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: MIT
+// What the turtlegas commands share: exit codes, the bad-input error, loading a world file, building
+// the World or the world server for it, and the words and numbers of their summaries.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "turtlegas/sim/mode_names.hpp"
+#include "turtlegas/sim/world.hpp"
+#include "turtlegas/sim/world_def.hpp"
+#include "turtlegas/turtle/registry.hpp"
+#include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/world/scene.hpp"
+
+namespace turtlegas::apps {
+
+// design.md, "Command line": 0 success, 2 bad input (world file or arguments), 1 anything else.
+constexpr int exit_ok = 0;
+constexpr int exit_failure = 1;
+constexpr int exit_bad_input = 2;
+
+/// A problem with the command line or the world file: exit code 2.
+struct BadInput : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// The scene of a world file; a bad file is BadInput.
+world::Scene load(const std::string& file, const turtle::Registry& registry);
+
+/// As make_world, for a scene with turtles: the server also checks controllers and sensors.
+std::unique_ptr<turtle::WorldServer> make_server(const world::Scene& scene, const turtle::Registry& registry,
+                                                 const turtle::ServerOptions& options, const std::string& file);
+
+/// The engine rejects a scene it cannot run (a cell size against the memo's rule, say) with
+/// std::invalid_argument: that is the world file's fault, so exit code 2.
+template <class Def>  // const sim::WorldDef& or sim::WorldDef&&
+sim::World make_world(Def&& def, sim::Mode mode, const std::string& file) {
+  try {
+    return sim::World(std::forward<Def>(def), mode);
+  } catch (const std::invalid_argument& e) {
+    throw BadInput(file + ": " + std::string(sim::to_string(mode)) + " mode: " + e.what());
+  }
+}
+
+/// "3 balls, 1 wall (+4 arena walls), 2 turtles".
+std::string count_summary(const sim::WorldDef& def, std::size_t balls);
+/// "none", "walls" or "periodic".
+const char* boundary_name(sim::Boundary b);
+/// Six significant digits, for summaries.
+std::string fmt(double v);
+/// "wander x3, script": each controller the scene uses and how many turtles run it, in file order.
+std::string controller_summary(const world::Scene& scene);
+
+}  // namespace turtlegas::apps

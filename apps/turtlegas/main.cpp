@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: MIT
+// The turtlegas command-line program: `turtlegas run`, `check`, `controllers`, `test` and `tag`,
+// one file each (see design.md, "Command line", for the contract they keep). This file parses the
+// command line and hands over.
+#include <exception>
+#include <string>
+#include <vector>
+#if defined(__GLIBC__)  // known once a library header is in
+#include <malloc.h>     // mallopt
+#endif
+
+#include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "check_command.hpp"
+#include "cli_common.hpp"
+#include "controllers_command.hpp"
+#include "plugins.hpp"
+#include "run_command.hpp"
+#include "tag_command.hpp"
+#include "test_command.hpp"
+#include "turtlegas/controllers/registry.hpp"
+
+namespace turtlegas::apps {
+namespace {
+
+int run(int argc, char** argv) {
+#if defined(__GLIBC__)
+  // Arrays above 128 KiB come from mmap and go back to the system when freed. glibc otherwise
+  // raises this threshold after the first large free, and the loader's freed arrays would stay
+  // resident as holes in the heap under the engine's (see docs/performance.md, "Memory").
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+#endif
+  auto log = spdlog::stderr_color_st("turtlegas");
+  log->set_pattern("%^%l%$: %v");
+  spdlog::set_default_logger(log);
+
+  CLI::App app{"turtlegas: a 2-D gas of discs and walls, and turtles with touch sensors (after MIT AI Memo 272)"};
+  app.require_subcommand(1);
+
+  std::vector<std::string> plugins;
+  const char* plugin_help = "Load controllers from this shared-library plugin (repeatable)";
+  RunCommandLine run_line;  // `turtlegas run` (run_command.hpp)
+  add_run_command(app, run_line, plugins, plugin_help);
+
+  std::string check_world;
+  CLI::App* check = app.add_subcommand("check", "Load and validate a world file, and build it in both modes");
+  check->add_option("world", check_world, "World file (format turtlegas-world/1)")->required();
+  check->add_option("--plugin", plugins, plugin_help);
+
+  CLI::App* list = app.add_subcommand("controllers", "List the controllers world files can name, with their params");
+  list->add_option("--plugin", plugins, plugin_help);
+
+  TestOptions test_opt;  // `turtlegas test` (test_command.hpp)
+  CLI::App* test = add_test_command(app, test_opt);
+  test->add_option("--plugin", plugins, plugin_help);
+
+  TagCommandOptions tag_opt;  // `turtlegas tag` (tag_command.hpp)
+  CLI::App* tag = add_tag_command(app, tag_opt);
+  tag->add_option("--plugin", plugins, plugin_help);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? exit_ok : exit_bad_input;
+  }
+
+  try {
+    turtle::Registry registry = controllers::builtin_registry();
+    load_plugins(plugins, registry);
+    if (*list) return controllers_command(registry);
+    if (*check) return check_command(check_world, registry);
+    if (*test) return test_command(test_opt, registry);
+    if (*tag) return run_tag_command(tag_opt, registry);
+    return run_command(run_line.options(), registry);
+  } catch (const BadInput& e) {
+    spdlog::error("{}", e.what());
+    return exit_bad_input;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return exit_failure;
+  }
+}
+
+}  // namespace
+}  // namespace turtlegas::apps
+
+int main(int argc, char** argv) { return turtlegas::apps::run(argc, argv); }

@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: MIT
+#include "tag_command.hpp"
+
+#include <cstdio>
+#include <optional>
+#include <stdexcept>
+#include <vector>
+
+#include "atomic_file.hpp"
+#include "cli_common.hpp"
+
+#include "turtlegas/sim/mode_names.hpp"
+#include "turtlegas/world/tag_tournament.hpp"
+
+namespace turtlegas::apps {
+
+CLI::App* add_tag_command(CLI::App& app, TagCommandOptions& options) {
+  CLI::App* tag = app.add_subcommand("tag", "Play a blindfold-tag tournament between controllers on a world");
+  tag->add_option("world", options.world, "World file with two or more turtles (its \"game\" sets the rules)")
+      ->required();
+  tag->add_option("--controllers", options.controllers, "Comma-separated controller names, e.g. tag_chaser,tag_evader")
+      ->required();
+  tag->add_option("--rounds", options.rounds, "Rounds to play, each with its own seed")->capture_default_str();
+  tag->add_option("--until", options.until, "Simulated seconds per round")->capture_default_str();
+  tag->add_option("--json", options.json_out, "Write the ranking and every round's score here (JSON)");
+  tag->add_option("--mode", options.mode, "exact (event-driven) or step (the memo's fixed steps)")
+      ->check(CLI::IsMember(sim::mode_names))
+      ->capture_default_str();
+  return tag;
+}
+
+int run_tag_command(const TagCommandOptions& options, const turtle::Registry& registry) {
+  world::TournamentOptions t;
+  std::string name;
+  for (char ch : options.controllers + ",") {
+    if (ch != ',') {
+      name += ch;
+    } else if (!name.empty()) {
+      t.controllers.push_back(name);
+      name.clear();
+    }
+  }
+  t.rounds = options.rounds;
+  t.until = options.until;
+  t.server.mode = sim::mode_from_string(options.mode).value_or(sim::Mode::exact);  // CLI11 checked it
+
+  // Opened before the rounds are played, so a bad path costs nothing; renamed into place only
+  // when written whole.
+  std::optional<AtomicFile> json_file;
+  if (!options.json_out.empty()) json_file.emplace(options.json_out, "--json");
+  const world::Scene scene = load(options.world, registry);
+  world::TournamentResult result;
+  try {
+    result = world::run_tag_tournament(scene, options.world, t, registry);
+  } catch (const std::invalid_argument& e) {
+    throw BadInput(e.what());
+  }
+  std::printf("%s: %zu rounds of %g s, %zu turtles\n", options.world.c_str(), t.rounds, t.until,
+              scene.def.turtles.size());
+  std::fputs(world::ranking_table(result).c_str(), stdout);
+  if (json_file) {
+    json_file->stream() << world::to_json(result).dump(2) << '\n';
+    json_file->commit();
+  }
+  return 0;
+}
+
+}  // namespace turtlegas::apps

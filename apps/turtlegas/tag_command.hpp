@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: MIT
+// `turtlegas tag`: a blindfold-tag tournament between controllers (docs/controllers.md).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "turtlegas/turtle/registry.hpp"
+
+namespace turtlegas::apps {
+
+struct TagCommandOptions {
+  std::string world;
+  std::string controllers;  ///< comma-separated
+  std::size_t rounds = 20;
+  double until = 60.0;
+  std::string json_out;
+  std::string mode = "exact";
+};
+
+/// Adds the `tag` subcommand, its options bound to `options`.
+CLI::App* add_tag_command(CLI::App& app, TagCommandOptions& options);
+
+/// Plays the tournament, prints the ranking and writes the JSON. Throws BadInput for bad input.
+int run_tag_command(const TagCommandOptions& options, const turtle::Registry& registry);
+
+}  // namespace turtlegas::apps

@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+// The statistics file (design.md, "--stats-json"): one JSON object of a run's counts and figures
+// (collisions, events, wall_seconds, energy_start, energy_end, max_overlap, and more).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <ostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "turtlegas/sim/world.hpp"
+#include "turtlegas/sim/world_def.hpp"
+
+namespace turtlegas::formats {
+
+/// What a run adds up besides what the World knows (its Stats, walls and cell size).
+struct RunFigures {
+  std::string world;             ///< the world file, as given
+  std::string name;              ///< the scene's name
+  sim::Mode mode = sim::Mode::exact;
+  double until = 0.0;            ///< seconds
+  double dt = 0.0;               ///< seconds
+  std::uint64_t seed = 0;
+  std::size_t balls = 0;         ///< at the start
+  std::size_t balls_alive = 0;   ///< at the end
+  std::size_t turtles = 0;
+  std::size_t turtles_finished = 0;
+  std::uint64_t touches = 0;
+  std::uint64_t faults = 0;
+  double wall_seconds = 0.0;
+  double energy_start = 0.0;
+  double energy_end = 0.0;
+  double max_overlap = 0.0;           ///< world units
+  double max_overlap_relative = 0.0;  ///< of the smaller radius
+  /// Collisions per wall-clock second (0 for a run that took no measurable time).
+  double collisions_per_second(const sim::Stats& st) const {
+    return wall_seconds > 0.0 ? static_cast<double>(st.collisions()) / wall_seconds : 0.0;
+  }
+};
+
+/// The statistics object of a run that ended in `world`.
+nlohmann::json stats_json(const RunFigures& run, const sim::World& world);
+
+/// stats_json, indented by two, and a newline.
+void write_stats(std::ostream& out, const RunFigures& run, const sim::World& world);
+
+}  // namespace turtlegas::formats

@@ -1,0 +1,187 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/formats/svg_snapshot.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <ostream>
+
+#include "turtlegas/sim/angles.hpp"
+
+namespace turtlegas::formats {
+namespace {
+
+/// Six significant digits: a pixel is far coarser, and the file stays small.
+std::string fmt(double v) {
+  std::array<char, 32> buf{};
+  std::snprintf(buf.data(), buf.size(), "%.6g", v);
+  return buf.data();
+}
+
+std::string xml_escape(std::string_view s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+/// Viridis at five stops: perceptually even and readable in grey.
+constexpr std::array<std::array<int, 3>, 5> palette = {{
+    {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
+
+/// Turtles and their trails: Tableau 10, distinct hues that stand out from the viridis balls.
+constexpr std::array<const char*, 10> turtle_colours = {"#4e79a7", "#f28e2b", "#e15759", "#76b7b2", "#59a14f",
+                                                         "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac"};
+
+std::string colour(double u) {
+  u = std::clamp(u, 0.0, 1.0) * (palette.size() - 1);
+  const auto k = std::min(static_cast<std::size_t>(u), palette.size() - 2);
+  const double f = u - static_cast<double>(k);
+  std::array<char, 8> buf{};
+  int rgb[3];
+  for (int c = 0; c < 3; ++c) rgb[c] = static_cast<int>(std::lround(palette[k][c] + f * (palette[k + 1][c] - palette[k][c])));
+  std::snprintf(buf.data(), buf.size(), "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
+  return buf.data();
+}
+
+}  // namespace
+
+Snapshot snapshot_of(const sim::WorldDef& def) {
+  Snapshot s;
+  s.title = def.name;
+  s.arena = def.arena;
+  s.walls = def.walls;
+  if (def.arena.boundary == sim::Boundary::walls)
+    for (auto& w : sim::arena_walls(def.arena)) s.walls.push_back(std::move(w));
+  s.balls.reserve(def.balls.size());
+  for (const auto& b : def.balls) s.balls.push_back({b.pos, b.vel, b.radius});
+  for (const auto& t : def.turtles) s.turtles.push_back({t.id, t.pos, t.heading, t.radius, {}, false});
+  return s;
+}
+
+Snapshot snapshot_of(const turtle::WorldServer& server, const sim::WorldDef& def) {
+  Snapshot s = snapshot_of(server.world(), def);
+  for (std::size_t i = 0; i < s.turtles.size() && i < server.turtle_count(); ++i) {
+    turtle::WorldServer::TurtleInfo info = server.turtle(i);
+    s.turtles[i].trail = std::move(info.trail);
+    s.turtles[i].fault = !info.fault.empty();
+  }
+  return s;
+}
+
+void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
+  const double aw = snap.arena.width, ah = snap.arena.height;
+  const double scale = width_px / std::max(aw, ah);
+  const double margin = 12.0, title_h = 30.0, legend_w = 90.0;
+  const double w = aw * scale + 2 * margin + legend_w;
+  const double h = std::max(ah * scale, 160.0) + title_h + 2 * margin;
+  const double top = title_h + margin;
+
+  // Colours span 0 to the 99th-percentile speed, so one fast outlier does not wash out the rest.
+  std::vector<double> speeds;
+  speeds.reserve(snap.balls.size());
+  for (const auto& b : snap.balls) speeds.push_back(sim::norm(b.vel));
+  double v_max = 0.0;
+  if (!speeds.empty()) {
+    const auto k = static_cast<std::ptrdiff_t>((speeds.size() - 1) * 99 / 100);
+    std::vector<double> sorted = speeds;
+    std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
+    v_max = sorted[static_cast<std::size_t>(k)];
+  }
+  const double v_scale = v_max > 0.0 ? v_max : 1.0;
+
+  const std::string title = xml_escape(snap.title.empty() ? std::string("turtlegas") : snap.title);
+  out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << fmt(w) << "\" height=\"" << fmt(h)
+      << "\" viewBox=\"0 0 " << fmt(w) << ' ' << fmt(h) << "\" font-family=\"sans-serif\">\n"
+      << "<title>" << title << " at t = " << fmt(snap.time) << " s</title>\n"
+      << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+      << "<text x=\"" << fmt(margin) << "\" y=\"" << fmt(margin + 14) << "\" font-size=\"16\">" << title
+      << " — t = " << fmt(snap.time) << " s, " << snap.balls.size() << " balls";
+  if (!snap.turtles.empty()) out << ", " << snap.turtles.size() << " turtle" << (snap.turtles.size() == 1 ? "" : "s");
+  out << "</text>\n";
+
+  // World coordinates inside the group: +y up, one world unit = scale pixels.
+  out << "<g transform=\"translate(" << fmt(margin) << ' ' << fmt(top + ah * scale) << ") scale(" << fmt(scale)
+      << ' ' << fmt(-scale) << ")\">\n"
+      << "<rect x=\"0\" y=\"0\" width=\"" << fmt(aw) << "\" height=\"" << fmt(ah)
+      << "\" fill=\"#f7f7f7\" stroke=\"#999\" stroke-width=\"1\" vector-effect=\"non-scaling-stroke\"/>\n";
+  // Moving walls where they are at the snapshot's time; walls not there just now dashed and pale.
+  for (const auto& wall : snap.walls) {
+    const sim::WallKey pose = sim::wall_pose(wall, snap.time);
+    const bool there = sim::wall_visible(wall, snap.time);
+    out << "<line x1=\"" << fmt(pose.from.x) << "\" y1=\"" << fmt(pose.from.y) << "\" x2=\"" << fmt(pose.to.x)
+        << "\" y2=\"" << fmt(pose.to.y) << (there ? "\" stroke=\"#222\"" : "\" stroke=\"#bbb\" stroke-dasharray=\"4 3\"")
+        << " stroke-width=\"2\" stroke-linecap=\"round\" vector-effect=\"non-scaling-stroke\"/>\n";
+  }
+  for (std::size_t i = 0; i < snap.balls.size(); ++i) {
+    const auto& b = snap.balls[i];
+    out << "<circle cx=\"" << fmt(b.pos.x) << "\" cy=\"" << fmt(b.pos.y) << "\" r=\"" << fmt(b.radius)
+        << "\" fill=\"" << colour(speeds[i] / v_scale) << "\"/>\n";
+  }
+  // Trails under the turtles, so a turtle is never hidden by its own path.
+  for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
+    const auto& t = snap.turtles[i];
+    if (t.trail.size() < 2) continue;
+    out << "<polyline class=\"trail\" fill=\"none\" stroke=\"" << turtle_colours[i % turtle_colours.size()]
+        << "\" stroke-width=\"1.5\" stroke-linejoin=\"round\" vector-effect=\"non-scaling-stroke\" points=\"";
+    for (std::size_t k = 0; k < t.trail.size(); ++k)
+      out << (k == 0 ? "" : " ") << fmt(t.trail[k].x) << ',' << fmt(t.trail[k].y);
+    out << "\"/>\n";
+  }
+  for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
+    const auto& t = snap.turtles[i];
+    const sim::Vec2 tip = t.pos + t.radius * sim::heading_unit(t.heading);
+    out << "<circle class=\"turtle\" cx=\"" << fmt(t.pos.x) << "\" cy=\"" << fmt(t.pos.y) << "\" r=\"" << fmt(t.radius)
+        << "\" fill=\"" << turtle_colours[i % turtle_colours.size()]
+        << "\" fill-opacity=\"0.8\" stroke=\"#222\" stroke-width=\"1\" vector-effect=\"non-scaling-stroke\"/>\n"
+        << "<line class=\"heading\" x1=\"" << fmt(t.pos.x) << "\" y1=\"" << fmt(t.pos.y) << "\" x2=\"" << fmt(tip.x)
+        << "\" y2=\"" << fmt(tip.y)
+        << "\" stroke=\"#222\" stroke-width=\"2\" stroke-linecap=\"round\" vector-effect=\"non-scaling-stroke\"/>\n";
+    if (t.fault) {
+      const double d = t.radius * 0.7;
+      out << "<path class=\"fault\" d=\"M" << fmt(t.pos.x - d) << ',' << fmt(t.pos.y - d) << " L" << fmt(t.pos.x + d)
+          << ',' << fmt(t.pos.y + d) << " M" << fmt(t.pos.x - d) << ',' << fmt(t.pos.y + d) << " L" << fmt(t.pos.x + d)
+          << ',' << fmt(t.pos.y - d)
+          << "\" stroke=\"#c00\" stroke-width=\"2\" vector-effect=\"non-scaling-stroke\"/>\n";
+    }
+  }
+  out << "</g>\n";
+  // Labels in pixel coordinates (outside the flipped group, so the text is upright), beside each
+  // turtle's upper right.
+  for (const auto& t : snap.turtles) {
+    const double px = margin + (t.pos.x + t.radius) * scale + 2.0, py = top + (ah - t.pos.y - t.radius) * scale;
+    out << "<text class=\"turtle-id\" x=\"" << fmt(px) << "\" y=\"" << fmt(py) << "\" font-size=\"11\">"
+        << xml_escape(t.id) << "</text>\n";
+  }
+
+  // Legend: a vertical colour bar from 0 (bottom) to v_max (top); only when there are balls.
+  if (snap.balls.empty()) {
+    out << "</svg>\n";
+    return;
+  }
+  const double lx = margin + aw * scale + 24.0, ly = top + 16.0, lh = 120.0;
+  out << "<defs><linearGradient id=\"speed\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">";
+  for (std::size_t k = 0; k < palette.size(); ++k) {
+    const double u = static_cast<double>(k) / (palette.size() - 1);
+    out << "<stop offset=\"" << fmt(u) << "\" stop-color=\"" << colour(u) << "\"/>";
+  }
+  out << "</linearGradient></defs>\n"
+      << "<text x=\"" << fmt(lx - 8) << "\" y=\"" << fmt(ly - 6) << "\" font-size=\"12\">speed</text>\n"
+      << "<rect x=\"" << fmt(lx) << "\" y=\"" << fmt(ly) << "\" width=\"14\" height=\"" << fmt(lh)
+      << "\" fill=\"url(#speed)\" stroke=\"#999\"/>\n"
+      << "<text x=\"" << fmt(lx + 18) << "\" y=\"" << fmt(ly + 10) << "\" font-size=\"11\">&#8805; " << fmt(v_max)
+      << "</text>\n"
+      << "<text x=\"" << fmt(lx + 18) << "\" y=\"" << fmt(ly + lh) << "\" font-size=\"11\">0</text>\n"
+      << "</svg>\n";
+}
+
+}  // namespace turtlegas::formats

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: MIT
+// The one event namer: which body each index of a sim::Event (and of a turtle's contact) names.
+// The world server names its log with it, and the event-log writer (formats/) names the bare
+// engine's events with it, so both logs say the same thing of the same event.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+#include "turtlegas/sim/events.hpp"
+
+namespace turtlegas::turtle {
+
+/// The ids of an event's bodies: `a`, and `b` unless the kind has no second body (an exit).
+struct EventIds {
+  std::string_view a;
+  std::optional<std::string_view> b;
+};
+
+/// Where the ids come from. `Names` has ball(i), wall(i) and turtle(i), each returning the id of
+/// body i (WorldDef::balls / World::walls() / WorldDef::turtles order) as something a
+/// std::string_view can be made from; it is a template parameter so that naming a million events
+/// costs no indirect call.
+template <class Names>
+std::string_view other_body(sim::EventKind kind, std::uint32_t index, const Names& names) {
+  // A turtle's partner: what a turtle event's b, and a turtle contact's `other`, index.
+  switch (kind) {
+    case sim::EventKind::turtle_turtle: return names.turtle(index);
+    case sim::EventKind::turtle_ball: return names.ball(index);
+    default: return names.wall(index);
+  }
+}
+
+/// The ids of event e (see sim::EventKind for what a and b index).
+template <class Names>
+EventIds name_event(const sim::Event& e, const Names& names) {
+  switch (e.kind) {
+    case sim::EventKind::ball_ball: return {names.ball(e.a), names.ball(e.b)};
+    case sim::EventKind::ball_wall:
+    case sim::EventKind::ball_wall_end: return {names.ball(e.a), names.wall(e.b)};
+    // b only says what kind of body left: 1 a turtle, 0 a ball (events.hpp).
+    case sim::EventKind::exit: return {e.b == 1 ? names.turtle(e.a) : names.ball(e.a), std::nullopt};
+    default: return {names.turtle(e.a), other_body(e.kind, e.b, names)};
+  }
+}
+
+}  // namespace turtlegas::turtle

@@ -1,0 +1,175 @@
+// SPDX-License-Identifier: MIT
+// The loader's turtles: bodies, programs, sensor arcs, and the `script` controller's commands
+// checked before the run against the runtime's table (turtle/script.hpp).
+#include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "reader.hpp"
+#include "turtlegas/sim/angles.hpp"
+#include "turtlegas/sim/suggest.hpp"
+#include "turtlegas/turtle/script.hpp"
+
+namespace turtlegas::world::detail {
+
+void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
+                          std::vector<turtle::TurtleProgram>& programs) {
+  const std::string path = "/turtles";
+  expect_array(v, path, "turtles");
+  turtles.reserve(v.size());
+  programs.reserve(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::string p = at(path, i);
+    const json& t = v[i];
+    expect_object(t, p, "a turtle");
+    check_keys(t, p, "a turtle",
+               {"id", "pos", "heading", "radius", "speed", "turn_rate", "controller", "params", "sensors", "pen", "gps",
+                "bounce", "category", "collides_with", "builder"});
+    sim::TurtleDef body;
+    turtle::TurtleProgram program;
+    body.id = id(t, p, "a turtle");
+    body.pos = vec2(require(t, p, "pos", "a turtle"), at(p, "pos"));
+    body.layers = layers(t, p);
+    // Angles are degrees in the file and radians inside: converted here, once. The heading is
+    // wrapped into [0, 360) first so that a state written back reads like the file.
+    double heading = 0.0;
+    if (const json* x = find(t, "heading")) heading = number(*x, at(p, "heading"));
+    body.heading = sim::to_radians(sim::wrap_degrees(heading));
+    body.radius = 10.0;
+    if (const json* x = find(t, "radius")) body.radius = positive(*x, at(p, "radius"), "radius");
+    body.speed = 30.0;
+    if (const json* x = find(t, "speed")) body.speed = positive(*x, at(p, "speed"), "speed (units/s)");
+    double turn_rate = 90.0;
+    if (const json* x = find(t, "turn_rate")) turn_rate = positive(*x, at(p, "turn_rate"), "turn_rate (degrees/s)");
+    body.turn_rate = sim::to_radians(turn_rate);
+    if (const json* x = find(t, "bounce")) {
+      body.bounce = number(*x, at(p, "bounce"));
+      if (!(body.bounce >= 0.0 && body.bounce <= 1.0))
+        fail(at(p, "bounce"), "bounce must be in [0, 1] (got " + num(body.bounce) +
+                                  "); leave it out for the memo's dead stop at a contact");
+    }
+
+    if (const json* x = find(t, "controller")) {
+      program.controller = string(*x, at(p, "controller"));
+      if (registry_ && !registry_->find(program.controller))
+        fail(at(p, "controller"), registry_->not_registered(program.controller));
+    }
+    if (const json* x = find(t, "params")) {
+      expect_object(*x, at(p, "params"), "params");
+      program.params = *x;
+    }
+    if (program.controller == "script") check_script(program.params, at(p, "params"));
+    if (const json* x = find(t, "sensors")) program.sensors = read_sensors(*x, at(p, "sensors"));
+    if (const json* x = find(t, "pen")) {
+      const std::string pp = at(p, "pen");
+      if (x->is_boolean()) {
+        program.pen_down = x->get<bool>();
+      } else if (x->is_string() && (*x == "up" || *x == "down" || *x == "wall")) {
+        program.pen_down = *x != "up";
+        program.pen_walls = *x == "wall";
+      } else {
+        fail(pp, "pen must be \"up\", \"down\", \"wall\" (down, laying walls), true (down) or false (up), got " +
+                     (x->is_string() ? "\"" + x->get<std::string>() + "\"" : json_kind(*x)));
+      }
+    }
+    // A turtle that may lay walls gets a private collision category in the world server; it must
+    // be known before the run. A wall pen or a script with ["pendown", "wall"] says so itself.
+    program.builder = program.pen_walls;
+    if (program.controller == "script")
+      if (const json* cs = find(program.params, "commands"); cs && cs->is_array())
+        for (const json& c : *cs)
+          if (c.is_array() && c.size() == 2 && c[0] == "pendown" && c[1] == "wall") program.builder = true;
+    if (const json* x = find(t, "builder")) {
+      const bool b = boolean(*x, at(p, "builder"));
+      if (!b && program.builder)
+        fail(at(p, "builder"), "builder is false but this turtle lays walls (its pen is \"wall\" or its script has "
+                               "[\"pendown\", \"wall\"]); remove \"builder\"");
+      program.builder = b;
+    }
+    if (const json* x = find(t, "gps")) program.gps = boolean(*x, at(p, "gps"));
+    turtles.push_back(std::move(body));
+    programs.push_back(std::move(program));
+  }
+}
+
+std::vector<turtle::SensorArc> Reader::read_sensors(const json& v, const std::string& path) const {
+  constexpr std::uint64_t max_sensors = 64;  // the runtime reports fired sensors as a 64-bit mask
+  if (v.is_number()) {
+    const std::uint64_t n = natural(v, path);
+    if (n < 1 || n > max_sensors)
+      fail(path, "a sensor count must be from 1 to " + std::to_string(max_sensors) + " (got " + std::to_string(n) + ")");
+    return turtle::equal_sensors(static_cast<int>(n));
+  }
+  const std::string shape =
+      "sensors must be a count (4: four equal arcs) or a list of arcs "
+      "[{\"name\": \"front\", \"from\": -45, \"to\": 45}, ...], got ";
+  if (!v.is_array()) fail(path, shape + json_kind(v));
+  if (v.empty()) fail(path, "a turtle needs at least one sensor; leave \"sensors\" out for the default four");
+  if (v.size() > max_sensors) fail(path, "at most " + std::to_string(max_sensors) + " sensors (got " + std::to_string(v.size()) + ")");
+  std::vector<turtle::SensorArc> arcs;
+  std::set<std::string> names;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const std::string p = at(path, k);
+    const json& a = v[k];
+    expect_object(a, p, "a sensor arc");
+    check_keys(a, p, "a sensor arc", {"name", "from", "to"});
+    turtle::SensorArc arc;
+    arc.name = string(require(a, p, "name", "a sensor arc"), at(p, "name"));
+    if (arc.name.empty()) fail(at(p, "name"), "a sensor's name must not be empty");
+    if (!names.insert(arc.name).second) fail(at(p, "name"), "duplicate sensor name \"" + arc.name + "\"");
+    arc.from = number(require(a, p, "from", "a sensor arc"), at(p, "from"));
+    arc.to = number(require(a, p, "to", "a sensor arc"), at(p, "to"));
+    // Degrees clockwise from the heading, [from, to): an arc through the heading has a negative from.
+    if (!(arc.from < arc.to) || arc.to - arc.from > 360.0)
+      fail(p, "sensor \"" + arc.name + "\" covers [" + num(arc.from) + ", " + num(arc.to) +
+                  ") degrees; need from < to <= from + 360 (clockwise from the heading; an arc through the "
+                  "heading is written with a negative from, e.g. -45 to 45)");
+    arcs.push_back(std::move(arc));
+  }
+  return arcs;
+}
+
+void Reader::check_script(const json& params, const std::string& path) const {
+  // The script controller would only find these at run time, as a fault that stops the turtle; a
+  // typo in a scripted test world should stop the load instead.
+  check_keys(params, path, "the script controller's params", {"commands"});
+  const json* commands = find(params, "commands");
+  if (!commands) return;  // a script turtle without commands stands still: an obstacle
+  const std::string cp = at(path, "commands");
+  if (!commands->is_array())
+    fail(cp, "commands must be a list of [command, amount], e.g. [[\"forward\", 100], [\"right\", 90]], got " +
+                 json_kind(*commands));
+  const std::string known = sim::join_names(turtle::script_command_names());
+  for (std::size_t k = 0; k < commands->size(); ++k) {
+    const std::string p = at(cp, k);
+    const json& c = (*commands)[k];
+    if (!c.is_array() || c.empty() || !c[0].is_string())
+      fail(p, "a command must be [command, amount], e.g. [\"forward\", 100], got " + c.dump());
+    const std::string name = c[0].get<std::string>();
+    const turtle::ScriptCommand* command = turtle::find_script_command(name);
+    if (!command) fail(at(p, 0), "unknown command '" + name + "'; known: " + known);
+    if (name == "pendown" && c.size() == 2 && c[1].is_string()) {
+      if (c[1] != "wall" && c[1] != "line")
+        fail(at(p, 1), "a pen mode is \"line\" (draws the path) or \"wall\" (lays walls), got " + c[1].dump());
+      continue;
+    }
+    if (name == "pendown" || name == "penup") {
+      if (c.size() != 1)
+        fail(p, "'" + name + "' takes no amount: [\"" + name + "\"]" +
+                    (name == "pendown" ? " (or a pen mode: [\"pendown\", \"wall\"])" : ""));
+      continue;
+    }
+    if (c.size() != 2) fail(p, "'" + name + "' needs one number, e.g. [\"" + name + "\", 100], got " + c.dump());
+    const double amount = number(c[1], at(p, 1));
+    if (amount < 0.0)
+      fail(at(p, 1), "'" + name + "' needs an amount >= 0 in " + std::string(turtle::unit_name(command->amount)) + " (got " + num(amount) + ")" +
+                         (name == "forward" ? "; use [\"back\", ...] to go backwards"
+                          : name == "back"  ? "; use [\"forward\", ...] to go forwards"
+                          : name == "left"  ? "; use [\"right\", ...] to turn the other way"
+                          : name == "right" ? "; use [\"left\", ...] to turn the other way"
+                                            : ""));
+  }
+}
+
+}  // namespace turtlegas::world::detail
