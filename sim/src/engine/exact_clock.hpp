@@ -3,7 +3,7 @@
 // times small. (Part of the Engine, whose loop serves these events: included at engine.hpp's end.)
 #pragma once
 
-#include "engine.hpp"
+// (no #include "engine.hpp": this file is the end of engine.hpp, read only from there)
 
 namespace turtlegas::sim::detail {
 namespace {

@@ -4,7 +4,7 @@
 // the collisions inside a step: included at engine.hpp's end.)
 #pragma once
 
-#include "engine.hpp"
+// (no #include "engine.hpp": this file is the end of engine.hpp, read only from there)
 
 namespace turtlegas::sim::detail {
 namespace {
