@@ -51,11 +51,8 @@ BOOST_CONTEXT = ("boost/context/", {"turtle_runtime/src/fiber.cpp"})
 # Loops between units (a header and its .cpp) that are known and owned by work in progress, each as
 # (folder every file of the loop lies in, a file the loop passes through, why and who ends it).
 # Only units count here: a loop of files would not compile, and is never excused.
-KNOWN_LOOPS = [
-    ("sim/", "sim/include/turtlegas/sim/reference.hpp",
-     "the engine measures overlaps with the test oracle reference::overlap; the engine's split "
-     "into sim/src/engine/ moves the measure out of reference.cpp"),
-]
+# (folder, a file of the loop, why): loops that are understood and allowed; none today
+KNOWN_LOOPS = []
 
 SOURCE_EXTENSIONS = (".cpp", ".hpp", ".h", ".cc", ".ipp")
 SKIP_DIRS = {".git", "build", "node_modules", "__pycache__"}
@@ -215,8 +212,9 @@ def find_cycles(graph):
     return cycles
 
 
-def check(root, verbose=False):
+def check(root, verbose=False, known_loops=None):
     """The rule breaks of the tree at root, and a one-line summary."""
+    known_loops = KNOWN_LOOPS if known_loops is None else known_loops
     files = scan(root)
     resolver = Resolver(files)
     problems = []
@@ -283,7 +281,7 @@ def check(root, verbose=False):
         if sum(1 for f in set(cycle + others) if "/include/" in f) < 2:
             continue
         text = loop_text(cycle, others)
-        known = [why for (inside, through, why) in KNOWN_LOOPS
+        known = [why for (inside, through, why) in known_loops
                  if all(f.startswith(inside) for f in cycle + others) and through in cycle + others]
         if known:
             notes.append("known loop, not counted: %s (%s)" % (text, known[0]))
@@ -341,7 +339,7 @@ def self_test():
         "world_files/include/turtlegas/world/world_file.hpp": '#include "turtlegas/world/expect.hpp"\n',
         "world_files/include/turtlegas/world/expect.hpp": "#pragma once\n",
         "world_files/src/expect.cpp": '#include "turtlegas/world/expect.hpp"\n#include "turtlegas/world/world_file.hpp"\n',
-        # the known loop of KNOWN_LOOPS is a note, not a problem
+        # a loop listed as known (the self-test's own list) is a note, not a problem
         "sim/include/turtlegas/sim/reference.hpp": '#include "turtlegas/sim/world.hpp"\n',
         "sim/include/turtlegas/sim/world.hpp": "#pragma once\n",
         "sim/src/world.cpp": '#include "turtlegas/turtle/turtle.hpp"\n#include "turtlegas/sim/world.hpp"\n'
@@ -361,7 +359,8 @@ def self_test():
             failures.append("the clean tree failed: " + "; ".join(problems))
         bad = os.path.join(tmp, "bad")
         write_tree(bad, {**clean, **broken})
-        problems, notes, _ = check(bad)
+        test_loops = [("sim/", "sim/include/turtlegas/sim/reference.hpp", "a loop the self-test allows")]
+        problems, notes, _ = check(bad, known_loops=test_loops)
         if not any("known loop, not counted: sim/include/turtlegas/sim/reference.hpp" in n for n in notes):
             failures.append("the known loop was not noted: " + "; ".join(notes))
         for want in expected:

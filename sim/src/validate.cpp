@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "turtlegas/sim/cover_grid.hpp"
@@ -92,6 +93,37 @@ std::optional<DefProblem> check_keyframes(const WallDef& w, std::size_t i) {
   return std::nullopt;
 }
 
+/// A wall in a periodic arena: both ends inside it (the engine's table wraps bodies, not walls),
+/// and fixed (moving walls are not supported there yet).
+std::optional<DefProblem> check_periodic_wall(const WallDef& w, std::size_t i, const ArenaDef& a) {
+  for (const auto& [field, p] : {std::pair<const char*, Vec2>{"from", w.from}, {"to", w.to}})
+    if (!inside_arena(a, p))
+      return problem(Where::wall, i, field,
+                     wall_name(w, i) + " reaches outside a periodic arena (its end " + field + " " + vec(p) +
+                         " is not in [0, " + num(a.width) + "] x [0, " + num(a.height) +
+                         "]); keep walls inside it");
+  if (!w.keys.empty())
+    return problem(Where::wall, i, "keys",
+                   wall_name(w, i) + " moves: moving walls are not supported in a periodic arena yet; "
+                                     "remove its keys or use boundary \"walls\" or \"none\"");
+  return std::nullopt;
+}
+
+/// Visibility keys: times increasing and >= 0.
+std::optional<DefProblem> check_visibility(const WallDef& w, std::size_t i) {
+  double prev = -1.0;
+  for (std::size_t k = 0; k < w.visibility.size(); ++k) {
+    const double t = w.visibility[k].t;
+    if (!(t > prev) || t < 0.0)
+      return problem(Where::wall, i, "visible",
+                     wall_name(w, i) + " visibility key " + std::to_string(k) +
+                         ": times must increase and be >= 0 (got " + num(t) +
+                         (k > 0 ? " after " + num(prev) : std::string()) + ")");
+    prev = t;
+  }
+  return std::nullopt;
+}
+
 std::optional<DefProblem> check_walls(const WorldDef& def) {
   for (std::size_t i = 0; i < def.walls.size(); ++i) {
     const WallDef& w = def.walls[i];
@@ -102,6 +134,9 @@ std::optional<DefProblem> check_walls(const WorldDef& def) {
     if (w.from == w.to)
       return problem(Where::wall, i, "to", wall_name(w, i) + " has zero length (from and to are both " + vec(w.from) + "); move one end or remove the wall");
     if (auto p = check_keyframes(w, i)) return p;
+    if (def.arena.boundary == Boundary::periodic)
+      if (auto p = check_periodic_wall(w, i, def.arena)) return p;
+    if (auto p = check_visibility(w, i)) return p;
   }
   return std::nullopt;
 }
@@ -370,10 +405,14 @@ std::optional<DefProblem> validate(const WorldDef& def) {
   if (auto p = check_walls(def)) return p;
   if (auto p = check_balls(def)) return p;
   if (auto p = check_turtles(def)) return p;
-  const std::size_t objects = def.walls.size() + def.balls.size() + def.turtles.size();
-  if (objects >= std::numeric_limits<std::uint32_t>::max() / 4)
-    return problem(Where::world, 0, "balls",
-                   "too many objects (" + std::to_string(objects) + "); the engine indexes them with 32 bits");
+  // Bodies, and wall ends (two per wall, the arena's four included), are indexed with 29 bits.
+  const std::size_t bodies = def.balls.size() + def.turtles.size();
+  const std::size_t wall_ends = 2 * (def.walls.size() + arena_ids.size());
+  if (bodies > kMaxObjects || wall_ends > kMaxObjects)
+    return problem(Where::world, 0, bodies > kMaxObjects ? "balls" : "walls",
+                   "too many objects (" + std::to_string(bodies) + " balls and turtles, " + std::to_string(def.walls.size()) +
+                       " walls); the engine indexes them with 29 bits: at most " + std::to_string(kMaxObjects) +
+                       " balls and turtles, and " + std::to_string(kMaxObjects / 2 - arena_ids.size()) + " walls");
   if (auto p = check_ids(def)) return p;
   if (auto p = check_overlaps(def)) return p;
   return std::nullopt;
@@ -399,6 +438,10 @@ WallKey wall_pose(const WallDef& wall, double t) {
     prev = k;
   }
   return {t, prev.from, prev.to};
+}
+
+bool inside_arena(const ArenaDef& arena, Vec2 p) {
+  return !(p.x < 0.0 || p.x > arena.width || p.y < 0.0 || p.y > arena.height);
 }
 
 bool wall_visible(const WallDef& wall, double t) {

@@ -3,7 +3,7 @@
 
 #include <utility>
 
-#include "engine.hpp"
+#include "engine/engine_base.hpp"
 
 namespace turtlegas::sim {
 

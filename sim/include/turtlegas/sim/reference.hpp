@@ -2,7 +2,6 @@
 #pragma once
 
 #include <cstddef>
-#include <functional>
 #include <vector>
 
 #include "turtlegas/sim/events.hpp"
@@ -12,30 +11,6 @@
 
 // Slow, obviously-correct references that tests cross-check the engine against.
 namespace turtlegas::sim::reference {
-
-/// Discs as the overlap check reads them: n of them, each read through these functions (so that
-/// an engine need not copy its million bodies into arrays to be checked).
-struct DiscView {
-  std::size_t n = 0;
-  std::function<Vec2(std::size_t)> pos;
-  std::function<double(std::size_t)> radius;
-  std::function<bool(std::size_t)> alive;
-};
-
-/// Deepest overlap among discs (ball-ball) and between discs and segments, found with a grid of
-/// sorted cell keys built from scratch (independent of the engine's grid; 4 bytes per disc).
-/// Periodic arenas use the minimum image when width/height are > 0. ball_pairs false checks discs
-/// against walls only. With layers given, pairs whose collision layers do not meet are skipped
-/// (they may overlap).
-Overlap overlap(const DiscView& discs, const std::vector<Segment>& walls, double periodic_width = 0.0,
-                double periodic_height = 0.0, bool ball_pairs = true, const std::vector<Layers>* body_layers = nullptr,
-                const std::vector<Layers>* wall_layers = nullptr);
-
-/// The same for discs in arrays.
-Overlap overlap(const std::vector<Vec2>& pos, const std::vector<double>& radius,
-                const std::vector<bool>& alive, const std::vector<Segment>& walls,
-                double periodic_width = 0.0, double periodic_height = 0.0, bool ball_pairs = true,
-                const std::vector<Layers>* body_layers = nullptr, const std::vector<Layers>* wall_layers = nullptr);
 
 /// Exact-mode events up to t_end found by brute force: every pair and every wall checked after
 /// every event, O(N^2) per event, no grid, no event queue. Same contact rules as the engine.

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -135,9 +136,15 @@ struct DefProblem {
   std::string message;    ///< one line, says what is wrong and how to fix it
 };
 
+/// The most bodies (balls and turtles together) a scene may have, and the most wall ends (two per
+/// wall, the arena's four included): the engine packs an object's index in 29 bits.
+inline constexpr std::size_t kMaxObjects = std::size_t{1} << 29;
+
 /// Checks a scene for everything the engine relies on: finite numbers, positive radii and masses,
-/// non-zero-length walls, unique ids, balls inside the arena and not overlapping each other or a
-/// wall, restitution in [0, 1]. Returns the first problem found, if any. O(N) expected time.
+/// non-zero-length walls, keyframes and visibility keys in order, in a periodic arena walls inside
+/// it and fixed, unique ids, balls inside the arena and not overlapping each other or a wall,
+/// restitution in [0, 1], no more than kMaxObjects bodies or wall ends. (The engine's own checks
+/// are those that depend on the mode: the cell size, and what a step may hold.) Returns the first problem found, if any. O(N) expected time.
 std::optional<DefProblem> validate(const WorldDef& def);
 
 /// The arena walls that `Boundary::walls` adds, in the order and with the ids the engine uses.
@@ -146,6 +153,10 @@ std::vector<WallDef> arena_walls(const ArenaDef& arena);
 /// Where a wall is at time t (seconds): its pose interpolated between keyframes as the engine
 /// moves it (each end linearly), the last pose after the last keyframe; from/to if it is fixed.
 WallKey wall_pose(const WallDef& wall, double t);
+
+/// Whether point p lies in the closed rectangle [0, width] x [0, height] of the arena (a periodic
+/// arena's walls must: validate() and World::add_wall check both ends).
+bool inside_arena(const ArenaDef& arena, Vec2 p);
 
 /// Whether a wall is there at time t (its visibility keys; always, if it has none).
 bool wall_visible(const WallDef& wall, double t);

@@ -8,7 +8,7 @@
 
 namespace turtlegas::sim::detail {
 
-/// What World forwards to; one implementation per combination of physics (see engine.cpp).
+/// What World forwards to; one implementation per combination of physics (see engine.hpp; the variants are listed in factory.cpp).
 class EngineBase {
  public:
   virtual ~EngineBase() = default;

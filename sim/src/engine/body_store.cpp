@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: MIT
+#include "body_store.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <new>
+
+namespace turtlegas::sim::detail {
+
+BodyStore::BodyStore(const WorldDef& def, std::vector<BallDef>* release, bool with_layers) {
+  nb_ = static_cast<std::uint32_t>(def.balls.size());
+  const std::size_t n = def.balls.size() + def.turtles.size();
+  // The records first, then (for a consumed scene) free the ball list before anything else per
+  // ball or per cell is allocated. While the scene is alive only what the records need from it
+  // (48 bytes a ball) is written, packed at the records' far end, whose pages alone are touched;
+  // once the scene is gone the records are laid out front to back over it (record i ends before
+  // ball i + 1's packed data begins). So the peak is the scene plus 48 bytes a ball, not plus 128.
+  struct Packed {
+    Vec2 x, v;
+    double r, mass;
+  };
+  static_assert(sizeof(Record) >= sizeof(Packed) && sizeof(Record) % alignof(Packed) == 0);
+  records_.reset(static_cast<Record*>(::operator new(n * sizeof(Record), std::align_val_t{alignof(Record)})));
+  char* const raw = reinterpret_cast<char*>(records_.get());
+  char* const packed = raw + n * (sizeof(Record) - sizeof(Packed));
+  if (with_layers) {
+    layers.resize(n);
+    for (std::uint32_t i = 0; i < nb_; ++i) layers[i] = def.balls[i].layers;
+    for (std::size_t k = 0; k < def.turtles.size(); ++k) layers[nb_ + k] = def.turtles[k].layers;
+    layered = std::any_of(layers.begin(), layers.end(), [](const Layers& l) { return l != Layers{}; });
+  }
+  for (std::uint32_t i = 0; i < nb_; ++i) {
+    const BallDef& d = def.balls[i];
+    new (packed + i * sizeof(Packed)) Packed{d.pos, d.vel, d.radius, d.mass};
+  }
+  if (release) std::vector<BallDef>().swap(*release);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    Packed d{};
+    if (i < nb_) std::memcpy(&d, packed + i * sizeof(Packed), sizeof(Packed));
+    Record* rec = new (raw + i * sizeof(Record)) Record{};
+    rec->body.x = d.x;
+    rec->body.v = d.v;
+    rec->body.r = d.r;
+    rec->mass_or_end = d.mass;
+  }
+  body = {records_.get(), n};
+  mass = {records_.get(), nb_};
+  end = {records_.get(), n};
+  last = {records_.get(), n};
+  pending = {records_.get(), n};
+  for (std::size_t k = 0; k < def.turtles.size(); ++k) {
+    const TurtleDef& d = def.turtles[k];
+    const auto id = static_cast<std::uint32_t>(nb_ + k);
+    body[id].x = d.pos;
+    body[id].r = d.radius;
+    end[id] = kNever;
+  }
+}
+
+}  // namespace turtlegas::sim::detail

@@ -1,0 +1,507 @@
+// SPDX-License-Identifier: MIT
+//
+// The GAS engine. One class template, instantiated once per row of the table of variants
+// (factory.cpp): the flight (straight, or parabolas under gravity), ball-ball collisions on or
+// off, exact or step mode, extras or not. It is chosen when the World is built, so nothing is
+// decided per collision. The engine owns the loop and the two clocks; the rooms it holds do the
+// rest, each receiving what it touches (parts.hpp):
+//   records.hpp, body_store.*  the bodies: one 128-byte record each, columns, cell lists
+//   flights.hpp                how balls fly, and the time-of-impact choice that follows
+//   kick.hpp                   step mode's field, a velocity kick between steps
+//   neighbourhood.hpp          who a body looks at (the memo's table, CellGrid)
+//   interactions.hpp           predict / apply / validate per pair kind
+//   turtle_motion.*            turtles' commands, contacts and state
+//   walls.*, moving_walls.*    walls and their ends; keyframes and visibility
+//   cell_size.*, checks.hpp    the cell-size policy; energy and overlap
+//   exact_clock.hpp            cell crossings, exits, the rebase of internal time
+//   step_clock.hpp             the start and the end of one of the memo's steps
+//
+// Order of work, exact mode (event-driven):
+//   1. Every ball holds one pending prediction: its earliest collision among the objects in its
+//      3x3 cell neighbourhood, and the time it leaves its cell. A calendar queue orders balls by
+//      the earlier of the two. Balls keep their own local time; a ball is moved only when an event
+//      touches it.
+//   2. Pop the earliest ball. A collision whose partner ball has changed course since the
+//      prediction (its collision counter moved on) is stale: re-predict and go on.
+//   3. A collision: bring the ball(s) to the event time, apply the memo's response, bump their
+//      counters, log the event, predict afresh for each.
+//   4. A cell crossing: move the ball to the next cell (wrap it in a periodic arena, remove it
+//      with an `exit` event when it leaves an open arena), look only at the strip of cells that
+//      has just come into its neighbourhood, and keep the earlier of that and its old prediction.
+//
+// Order of work, step mode (the memo's algorithm, AI Memo 272):
+//   1. At the start of a step all balls are at the same time. Balls are listed in the cell of their
+//      centre. Each ball predicts its earliest collision within the step among the objects in the
+//      cells its path can reach (the memo's rule makes that the 3x3 neighbourhood).
+//   2. Take the earliest collision in the step, make it happen, re-predict the balls it changed;
+//      repeat until no collision is left in the step (steps 2 and 3 of exact mode, without cells).
+//   3. Move every ball to the end of the step and apply the field kick (kick.hpp: v += a dt).
+//      Balls outside an open arena exit; a periodic arena wraps them.
+//
+// kExtras: the scene has turtles, collision layers or moving walls; without them none of these
+// costs a thing. Layers are checked on each candidate pair before any time of impact. Moving walls
+// live outside the grid: every prediction checks them, in the wall's frame, up to the next
+// keyframe, and a keyframe makes every body predict again.
+// Turtles are bodies too (ids after the balls', in cell lists of their own): discs of infinite
+// mass that fly straight at the velocity their current command gives, never feel fields, and stop
+// dead at a contact (or bounce, if asked). The end of a command is one more candidate in a
+// turtle's prediction. Commands arrive from the runtime between calls to advance_to.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <concepts>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "../cell_grid.hpp"
+#include "../event_queue.hpp"
+#include "arena.hpp"
+#include "body_store.hpp"
+#include "cell_size.hpp"
+#include "checks.hpp"
+#include "engine_base.hpp"
+#include "flights.hpp"
+#include "interactions.hpp"
+#include "kick.hpp"
+#include "moving_walls.hpp"
+#include "neighbourhood.hpp"
+#include "parts.hpp"
+#include "records.hpp"
+#include "turtle_motion.hpp"
+#include "variant.hpp"
+#include "walls.hpp"
+
+namespace turtlegas::sim::detail {
+namespace {
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+class Engine final : public EngineBase {
+  // Step mode flies straight and kicks between steps: its field is a run-time Kick, never a flight.
+  static_assert(!kStep || std::same_as<F, FreeFlight>, "step mode flies straight (FreeFlight)");
+
+ public:
+  /// Builds the engine for `def`. `release`, when given, is def's own ball list: it is emptied and
+  /// its memory freed as soon as the balls have been copied, before the rest of the engine is
+  /// allocated, so that the scene and the whole engine never take memory at the same time.
+  Engine(const WorldDef& def, std::vector<BallDef>* release);
+
+  void advance_to(double t) override;
+  void set_event_log(std::vector<Event>* log) override { record_.log = log; }
+  double time() const override { return t_base_ + now_; }
+  std::size_t ball_count() const override { return bodies_.balls(); }
+  BallState ball(std::size_t i) const override {
+    const Body& b = bodies_.body[i];
+    const double dt = now_ - b.t;
+    const auto id = static_cast<std::uint32_t>(i);
+    return {motion_.flight().pos(id, b.x, b.v, dt), motion_.flight().vel(id, b.v, dt), b.cell != kNone};
+  }
+  double radius(std::size_t i) const override { return bodies_.body[i].r; }
+  double mass(std::size_t i) const override { return bodies_.mass[i]; }
+  const std::vector<WallDef>& walls() const override { return walls_.defs; }
+  std::size_t turtle_count() const override { return turtles_.size(); }
+  TurtleState turtle(std::size_t k) const override {
+    const std::size_t id = bodies_.balls() + k;
+    return turtles_.state(k, bodies_.body[id], bodies_.end[id], now_);
+  }
+  double turtle_radius(std::size_t k) const override { return bodies_.body[bodies_.balls() + k].r; }
+  void idle_turtles(std::vector<std::uint32_t>& out) const override { turtles_.idle(out); }
+  void prefetch_turtle(std::size_t k) const override {
+    // What turtle(k) and command_turtle(k) read first: the turtle's record (two lines) and its
+    // command state (which may straddle two).
+    if (k >= turtles_.size()) return;
+    const char* rec = reinterpret_cast<const char*>(&bodies_.body[bodies_.balls() + k]);
+    __builtin_prefetch(rec);
+    __builtin_prefetch(rec + 64);
+    const char* run = reinterpret_cast<const char*>(&turtles_.run(k));
+    __builtin_prefetch(run);
+    __builtin_prefetch(run + sizeof(TurtleRun) - 1);
+  }
+  void command_turtle(std::size_t k, const TurtleCommand& command) override;
+  std::size_t add_wall(const WallDef& wall) override;
+  std::vector<TurtleContact> take_turtle_contacts() override { return turtles_.take_contacts(); }
+  double energy() const override {
+    if constexpr (kStep) return detail::energy(look(), kick_);
+    else return detail::energy(look(), motion_.flight());
+  }
+  const Stats& stats() const override { return record_.stats; }
+  Overlap measure_overlap() const override { return detail::measure_overlap<kBallBall>(look(), arena_); }
+  Overlap max_contact_overlap() const override { return record_.max_contact; }
+  double cell_size() const override { return std::min(grid_.cell_w(), grid_.cell_h()); }
+  int cells_x() const override { return grid_.nx(); }
+  int cells_y() const override { return grid_.ny(); }
+  Mode mode() const override { return kStep ? Mode::step : Mode::exact; }
+  double dt() const override { return dt_; }
+
+ private:
+  bool is_turtle(std::uint32_t id) const { return motion_.is_turtle(id); }
+  Look<F, kExtras> look() const { return {bodies_, walls_, schedule_, motion_, now_}; }
+  Parts<F, kStep, kExtras> parts() {
+    return {bodies_, motion_, walls_, schedule_, turtles_, arena_, restitution_, step_, record_, now_, t_base_, dt_};
+  }
+  void sync(std::uint32_t i) { sync_body<F, kStep, kExtras>(bodies_, motion_, step_, i, now_); }
+  void link(std::uint32_t i, std::uint32_t cell) { bodies_.link(i, cell, is_turtle(i)); }
+  void unlink(std::uint32_t i) { bodies_.unlink(i, is_turtle(i)); }
+
+  struct CellXY {
+    int ix, iy;
+  };
+  /// Column and row of a cell (one integer division).
+  CellXY cell_xy(std::uint32_t cell) const {
+    const int c = static_cast<int>(cell), stride = grid_.stride();
+    const int iy = c / stride;
+    return {c - iy * stride, iy};
+  }
+
+  // Predict: body i's earliest collision (neighbourhood.hpp chooses the candidates), and in exact
+  // mode the time it leaves its cell. (ix, iy): the body's cell, where the caller has it.
+  void predict(std::uint32_t i) {
+    const CellXY c = cell_xy(bodies_.body[i].cell);
+    predict(i, c.ix, c.iy);
+  }
+  void predict(std::uint32_t i, int ix, int iy);
+  void predict_crossing(std::uint32_t i) {
+    const CellXY c = cell_xy(bodies_.body[i].cell);
+    predict_crossing(i, c.ix, c.iy);
+  }
+  void predict_crossing(std::uint32_t i, int ix, int iy);
+  /// When a turtle's command ends (kNever for a ball, or a turtle with no command running).
+  double command_end(std::uint32_t i) const {
+    if constexpr (kExtras) return is_turtle(i) ? bodies_.end[i] : kNever;
+    else return kNever;
+  }
+  void schedule(std::uint32_t i) {
+    const Pending& p = bodies_.pending[i];
+    heap_.set(i, std::min(std::min(p.t_coll, p.t_cross), command_end(i)));
+  }
+  void repredict(std::uint32_t i) {
+    const CellXY c = cell_xy(bodies_.body[i].cell);
+    predict(i, c.ix, c.iy);
+    if constexpr (!kStep) predict_crossing(i, c.ix, c.iy);  // crossing times depend on the velocity just changed
+    schedule(i);
+  }
+  /// Body i's course changed outside a collision (a command, a push): predictions made with it
+  /// are stale, and "just collided, cannot meet again" no longer holds.
+  void new_course(std::uint32_t i) {
+    ++bodies_.body[i].count;
+    bodies_.last[i] = LastPartner::none();
+    if constexpr (kStep)
+      step_.dmax = std::max(step_.dmax, step_.travel[i] + path_length(bodies_.body[i].v, dt_ - now_));
+    repredict(i);
+  }
+
+  // Serve: the loop and what it dispatches to.
+  /// Serves events up to internal time `limit`. Returns false when it stopped early to rebase the
+  /// clock (exact mode), so that the caller takes the limit afresh in the new internal time.
+  bool process(double limit);
+  void collide(std::uint32_t i);
+  void served(Changed c) {
+    repredict(c.first);
+    if (c.second != kNone) repredict(c.second);
+  }
+  void end_command(std::uint32_t i);
+  void keyframe();
+
+  // The exact clock (exact_clock.hpp).
+  void cross(std::uint32_t i);
+  /// Body i's centre has left an open arena: it is removed, with an `exit` event.
+  void exit(std::uint32_t i);
+  double rebase();
+
+  // The step clock (step_clock.hpp).
+  void begin_step();
+  void finish_step();
+
+  Motion<F, kExtras> motion_;
+  Kick kick_;  ///< step mode's field
+  Restitution restitution_;
+  Arena arena_;
+  double dt_ = 0.0;
+
+  BodyStore bodies_;
+  Walls walls_;
+  WallSchedule schedule_;
+  Turtles turtles_;
+  CellGrid grid_;
+  double cell_ = 0.0;  ///< the cell side the grid was built for (rebuilt with it when walls are added)
+  EventQueue heap_;
+
+  double now_ = 0.0;     ///< internal time, relative to t_base_
+  double t_base_ = 0.0;  ///< external time of internal time zero
+  std::uint64_t events_since_rebase_ = 0;
+  std::uint64_t rebase_every_ = 0;
+  StepState step_;  ///< step mode only
+
+  EventRecord record_;
+};
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+Engine<F, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<BallDef>* release) {
+  if (auto problem = validate(def)) throw std::invalid_argument(problem->message);
+  const EffectsDef& fx = def.effects;
+  motion_ = Motion<F, kExtras>(def);
+  if constexpr (kStep) kick_ = Kick(fx);
+  restitution_.e = fx.restitution;
+  restitution_.tc = fx.tc;
+  restitution_.inelastic = fx.restitution < 1.0;
+  arena_ = {def.arena.width, def.arena.height, def.arena.boundary};
+  dt_ = def.dt;
+
+  walls_ = Walls(def, kExtras);
+  schedule_ = WallSchedule(walls_);
+  for (const auto& b : def.balls) step_.rmax = std::max(step_.rmax, b.radius);
+  for (const auto& t : def.turtles) step_.rmax = std::max(step_.rmax, t.radius);
+  cell_ = choose_cell_size(def, kStep ? Mode::step : Mode::exact);
+  bodies_ = BodyStore(def, release, kExtras);
+  turtles_ = Turtles(def.turtles);
+  const std::size_t n = bodies_.size();
+
+  grid_ = CellGrid(arena_.width, arena_.height, cell_, arena_.periodic(), walls_.segments, walls_.ends, walls_.moving());
+  if (arena_.periodic() && (grid_.nx() < 3 || grid_.ny() < 3))
+    throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell_) +
+                                "); enlarge the arena or use smaller balls");
+
+  if (restitution_.inelastic) restitution_.last_time.assign(n, -kNever);
+  bodies_.make_lists(static_cast<std::size_t>(grid_.cell_count()), kExtras);
+  heap_.reset(bodies_.nodes(), sizeof(Record), n);
+  if constexpr (kStep) {
+    step_.travel.assign(n, 0.0);
+    step_.stamp.assign(walls_.segments.size() * 9 + walls_.ends.size() * 9, 0);
+  }
+  // Balls, then turtles, each in list order, as the cell lists have always been built.
+  for (std::uint32_t i = 0; i < n; ++i) link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(bodies_.body[i].x)));
+  if constexpr (kExtras) {
+    schedule_.apply_visibility(walls_, now_, t_base_);
+    turtles_.pushed_by.assign(turtles_.size(), kNone);
+    schedule_.aim_all(walls_, t_base_);
+  }
+  rebase_every_ = std::max<std::uint64_t>(4 * n, 4096);
+  if constexpr (kStep) {
+    begin_step();
+  } else {
+    for (std::uint32_t i = 0; i < n; ++i) {
+      predict(i);
+      predict_crossing(i);
+      schedule(i);
+    }
+  }
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::predict(std::uint32_t i, int ix, int iy) {
+  const Body& bi = bodies_.body[i];
+  Pending& p = bodies_.pending[i];
+  // A turtle's command end is not a candidate here: it is kept apart (command_end()), so that a
+  // turtle whose command starts or ends without moving it keeps the collisions predicted for it.
+  p.t_coll = kNever;
+  p.kind = Partner::none;
+  if constexpr (!kStep) look_around<kBallBall>(look(), grid_, i, bi, ix, iy, p);
+  else look_along_step<kBallBall>(look(), grid_, step_, dt_, i, bi, ix, iy, p);
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::predict_crossing(std::uint32_t i, int ix, int iy) {
+  const Body& b = bodies_.body[i];
+  Pending& p = bodies_.pending[i];
+  const CellExit e = motion_.cell_exit(i, b.x, b.v, cell_box(grid_, ix, iy));
+  p.t_cross = now_ + e.t;
+  p.cross_dir = e.dir;
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+bool Engine<F, kBallBall, kStep, kExtras>::process(double limit) {
+  for (;;) {
+    const double next_event = heap_.empty() ? kNever : heap_.top_key();
+    if constexpr (kExtras) {
+      // A moving wall reaching a keyframe changes course: everything predicts again.
+      if (schedule_.next_key <= limit && schedule_.next_key <= next_event) {
+        keyframe();
+        continue;
+      }
+    }
+    if (next_event > limit) break;
+    const std::uint32_t i = heap_.top_id();
+    now_ = heap_.top_key();
+    ++record_.stats.events;
+    // The next events most likely belong to the top's children in the served bucket (or to the
+    // next bucket): start loading their state now, which hides a cache miss or two per event once
+    // the bodies outgrow the cache. (Written out rather than through a callback: GCC 12 drops the
+    // prefetches of a lambda that does nothing else.)
+    for (std::size_t n = 0; n < 2; ++n) {
+      const std::uint32_t k = heap_.next_id(n);
+      if (k == EventQueue::kAbsent) continue;
+      __builtin_prefetch(&bodies_.body[k]);
+      __builtin_prefetch(&bodies_.pending[k]);
+    }
+    const Pending& p = bodies_.pending[i];
+    // A command's end goes first at a tie with a collision or a crossing.
+    if (const double t_end = command_end(i); t_end <= p.t_coll && t_end <= p.t_cross) end_command(i);
+    else if (p.t_coll <= p.t_cross) collide(i);
+    else cross(i);
+    if constexpr (!kStep) {
+      if (++events_since_rebase_ >= rebase_every_) {
+        rebase();
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
+  const Pending p = bodies_.pending[i];
+  switch (p.kind) {
+    case Partner::body:
+      if (bodies_.body[p.partner].count != p.partner_count) {
+        ++record_.stats.stale;
+        sync(i);
+        predict(i);
+        schedule(i);
+        return;
+      }
+      if (is_turtle(i) || is_turtle(p.partner)) served(apply_turtle_body(parts(), i, p.partner));
+      else served(apply_ball_ball(parts(), i, p.partner));
+      return;
+    case Partner::wall: served(apply_wall(parts(), i, p.partner)); return;
+    case Partner::end: served(apply_end(parts(), i, p.partner)); return;
+    case Partner::moving_end: served(apply_moving_end(parts(), i, p.partner)); return;
+    case Partner::none: break;
+  }
+  // A body with nothing pending has an infinite key and is never popped.
+  sync(i);
+  predict(i);
+  schedule(i);
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::end_command(std::uint32_t i) {
+  // A turtle's command (or its coasting after a bounce) has run its course.
+  sync(i);
+  if (!turtles_.finish(i - bodies_.balls(), bodies_.body[i], bodies_.end[i])) {
+    // The disc stood still and stays still: only its key loses the command's end.
+    schedule(i);
+    return;
+  }
+  parts().changed(i);
+  bodies_.last[i] = LastPartner::none();
+  repredict(i);
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, const TurtleCommand& c) {
+  if (k >= turtles_.size()) throw std::out_of_range("command_turtle: no turtle " + std::to_string(k));
+  const auto id = static_cast<std::uint32_t>(bodies_.balls() + k);
+  if (bodies_.body[id].cell == kNone) return;  // it has left the arena
+  sync(id);
+  if (!turtles_.command(k, c, bodies_.body[id], bodies_.end[id], now_)) {
+    // The predictions made with it still hold; only its key takes the command's end.
+    schedule(id);
+    return;
+  }
+  new_course(id);
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::keyframe() {
+  now_ = schedule_.next_key;
+  ++record_.stats.events;
+  schedule_.take_keyframe(walls_, now_, t_base_);
+  const std::uint32_t nb = bodies_.balls();
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    Body& b = bodies_.body[i];
+    if (b.cell == kNone) continue;
+    sync(i);
+    if (is_turtle(i) && turtles_.pushed_by[i - nb] != kNone) {
+      // The push ends with the segment of motion that made it; the turtle stands where it is.
+      b.v = {};
+      turtles_.pushed_by[i - nb] = kNone;
+      ++b.count;
+    }
+    // "Just collided, cannot meet again" does not survive a change of the wall's velocity.
+    const LastPartner last = bodies_.last[i];
+    if (!last.is_none() && (last.kind() == Partner::moving_end ||
+                            (last.kind() == Partner::wall && walls_.mover_of[last.index()] != kNone)))
+      bodies_.last[i] = LastPartner::none();
+    repredict(i);
+  }
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+std::size_t Engine<F, kBallBall, kStep, kExtras>::add_wall(const WallDef& wall) {
+  walls_.check_new(wall, arena_.def());
+  const Segment seg = make_segment(wall.from, wall.to);
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    const Body& b = bodies_.body[i];
+    if (b.cell == kNone) continue;
+    if constexpr (kExtras)
+      if (!bodies_.layers[i].collides_with(wall.layers)) continue;  // it passes through this wall
+    const Vec2 rel = arena_.rel_to_segment(motion_.pos(b, i, now_ - b.t), seg);
+    const double foot = std::clamp(dot(rel, seg.u), 0.0, seg.len);
+    const double gap = norm(rel - foot * seg.u) - b.r;
+    if (gap < 0.0)
+      throw std::invalid_argument("wall '" + wall.id + "' would overlap " + (is_turtle(i) ? "a turtle" : "a ball") +
+                                  " (by " + std::to_string(-gap) + "); lay it clear of bodies");
+  }
+  const std::uint32_t w = walls_.add(wall, kExtras);
+  grid_ = CellGrid(arena_.width, arena_.height, cell_, grid_.periodic(), walls_.segments, walls_.ends,
+                   walls_.moving());  // same cells, new lists
+  if constexpr (kStep) step_.stamp.assign(walls_.segments.size() * 9 + walls_.ends.size() * 9, 0);
+  // Every prediction may now meet the new wall first.
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_.body[i].cell == kNone) continue;
+    sync(i);
+    repredict(i);
+  }
+  return w;
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
+  if (!(t >= time())) throw std::invalid_argument("advance_to: time " + std::to_string(t) + " is before the world's time");
+  if constexpr (kStep) {
+    for (;;) {
+      const double target = t - t_base_;
+      if (target >= dt_) {
+        process(dt_);
+        finish_step();
+        continue;
+      }
+      process(target);
+      now_ = std::max(now_, target);
+      return;
+    }
+  } else {
+    // The limit is always t - t_base_, rounded once. Shifting it along with a rebase would round
+    // twice, and an event at the limit (a turtle's command that ends on a control step) would then
+    // fall before or after the programs run there depending on where the run was cut into calls.
+    while (!process(t - t_base_)) {
+    }
+    now_ = t - t_base_;
+  }
+}
+
+}  // namespace
+}  // namespace turtlegas::sim::detail
+
+#include "exact_clock.hpp"
+#include "step_clock.hpp"
+
+namespace turtlegas::sim::detail {
+
+template <class Flight, bool kBallBall, bool kStep, bool kExtras>
+std::unique_ptr<EngineBase> make_variant(const WorldDef& def, std::vector<BallDef>* release) {
+  return std::make_unique<Engine<Flight, kBallBall, kStep, kExtras>>(def, release);
+}
+
+}  // namespace turtlegas::sim::detail
+
+/// The explicit instantiation of one row of the table in factory.cpp (see variant.hpp).
+#define TURTLEGAS_ENGINE_VARIANT(flight, balls, mode, extras)                                   \
+  namespace turtlegas::sim::detail {                                                             \
+  template std::unique_ptr<EngineBase> make_variant<flight, variant::balls, variant::mode, variant::extras>( \
+      const WorldDef&, std::vector<BallDef>*);                                                   \
+  }

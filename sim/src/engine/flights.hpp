@@ -1,0 +1,194 @@
+// SPDX-License-Identifier: MIT
+// Flights: how a ball moves between events under the scene's field, and the times of impact that
+// motion implies. A flight owns every choice that depends on the motion: where a ball is, when it
+// leaves its cell, which time-of-impact function meets it with another ball, a point, a segment or
+// a deforming segment, whether a pair that has just collided may be skipped, the field's pull
+// along a normal (the rest threshold) and its potential (the energy).
+//
+// Turtles never use a flight: they drive on the floor and always fly straight (Motion, below).
+// Step mode never uses one either: it flies straight and kicks between steps (kick.hpp).
+//
+// Adding a flight: one struct that satisfies `Flight`, the pure functions it calls (toi.hpp, each
+// tested against brute force), and its rows in the table of variants (factory.cpp). A flight that
+// needs something per ball (a charge-to-mass ratio, a species index) keeps it itself, built from
+// the scene in its constructor, and reads it by the ball's index: Record stays 128 bytes for the
+// scenes that do not use it. docs/architecture.md works through an example.
+#pragma once
+
+#include <algorithm>
+#include <concepts>
+#include <cstdint>
+#include <string_view>
+
+#include "records.hpp"
+#include "turtlegas/sim/toi.hpp"
+#include "turtlegas/sim/world_def.hpp"
+
+namespace turtlegas::sim::detail {
+
+/// The cell a body is in, as the times it would leave it are measured against.
+struct CellBox {
+  double x_lo, x_hi, y_lo, y_hi;
+};
+
+/// When a body leaves its cell, and through which side: 0 -x, 1 +x, 2 -y, 3 +y.
+struct CellExit {
+  double t = kNever;
+  std::uint8_t dir = 0;
+};
+
+/// The earlier of two axis exits (x first at a tie).
+inline CellExit earlier_exit(AxisExit ex, AxisExit ey) {
+  if (ex.t <= ey.t) return {ex.t, static_cast<std::uint8_t>(ex.upper ? 1 : 0)};
+  return {ey.t, static_cast<std::uint8_t>(ey.upper ? 3 : 2)};
+}
+
+/// A straight line's exit from [lo, hi] along one axis.
+inline AxisExit straight_exit(double x, double v, double lo, double hi) {
+  if (v > 0.0) return {std::max(0.0, (hi - x) / v), true};
+  if (v < 0.0) return {std::max(0.0, (lo - x) / v), false};
+  return {};
+}
+
+/// What every flight provides. `ball` is a ball's index (flights that need per-ball parameters
+/// read them by it); times of impact are relative to now, kNever for none, and need not look past
+/// `t_max` (the prediction's horizon: the earliest candidate so far).
+template <class F>
+concept Flight = std::constructible_from<F, const WorldDef&> &&
+    requires(const F f, const WorldDef& def, std::uint32_t ball, std::uint32_t other, Vec2 x, Vec2 v, double dt,
+             double sigma, double t_max, const Segment& s, Vec2 d0, Vec2 w, const CellBox& box) {
+  { F::kName } -> std::convertible_to<std::string_view>;
+  /// Whether this flight is exact for the scene (its effects, and the balls' own parameters: a
+  /// charged flight is not needed when no ball is charged). The factory takes the first row of its
+  /// table whose flight fits.
+  { F::fits(def) } -> std::same_as<bool>;
+  /// Where the ball is, and how fast it goes, dt after being at x with velocity v.
+  { f.pos(ball, x, v, dt) } -> std::same_as<Vec2>;
+  { f.vel(ball, v, dt) } -> std::same_as<Vec2>;
+  /// When the ball, at x with velocity v, leaves the cell `box`.
+  { f.cell_exit(ball, x, v, box) } -> std::same_as<CellExit>;
+  /// Two balls, `other` at x and v relative to `ball`: when their distance falls to sigma.
+  { f.toi_balls(ball, other, x, v, sigma, t_max) } -> std::same_as<double>;
+  /// The ball at x relative to a point that flies straight, v relative to it: when their distance
+  /// falls to sigma (a wall end, a moving wall's end, a turtle's centre).
+  { f.toi_point(ball, x, v, sigma, t_max) } -> std::same_as<double>;
+  /// The ball at x relative to segment s's first end, v relative to the segment (which may
+  /// translate): when it touches the segment's interior.
+  { f.toi_segment(ball, x, v, s, sigma) } -> std::same_as<double>;
+  /// The same for a segment whose ends move apart (d0 + w t from its first end).
+  { f.toi_deforming_segment(ball, x, v, d0, w, sigma, t_max) } -> std::same_as<double>;
+  /// Whether the ball flies straight, and so whether its motion relative to something that flies
+  /// straight is a straight line: then a pair that has just collided cannot meet again before
+  /// either changes course, and the prediction skips it (LastPartner).
+  { f.straight(ball) } -> std::same_as<bool>;
+  /// The same question for two balls' relative motion.
+  { f.straight_pair(ball, other) } -> std::same_as<bool>;
+  /// The field's acceleration along the unit normal n of the ball flying at v (the rest threshold
+  /// when it bounces off an obstacle; a magnetic force would depend on v).
+  { f.normal_accel(ball, v, x) } -> std::same_as<double>;
+  /// The ball's potential energy per unit mass at x (energy()).
+  { f.potential(ball, x) } -> std::same_as<double>;
+};
+
+/// Straight-line flight: no field acts between events.
+struct FreeFlight {
+  static constexpr std::string_view kName = "free";
+  static bool fits(const WorldDef& def) { return def.effects.gravity.x == 0.0 && def.effects.gravity.y == 0.0; }
+  FreeFlight() = default;
+  explicit FreeFlight(const WorldDef&) {}
+
+  Vec2 pos(std::uint32_t, Vec2 x, Vec2 v, double dt) const { return x + dt * v; }
+  Vec2 vel(std::uint32_t, Vec2 v, double) const { return v; }
+  CellExit cell_exit(std::uint32_t, Vec2 x, Vec2 v, const CellBox& b) const {
+    return earlier_exit(straight_exit(x.x, v.x, b.x_lo, b.x_hi), straight_exit(x.y, v.y, b.y_lo, b.y_hi));
+  }
+  double toi_balls(std::uint32_t, std::uint32_t, Vec2 r, Vec2 v, double sigma, double) const {
+    return toi_disc_disc(r, v, sigma);
+  }
+  double toi_point(std::uint32_t, Vec2 rel, Vec2 v, double sigma, double) const { return toi_disc_point(rel, v, sigma); }
+  double toi_segment(std::uint32_t, Vec2 rel, Vec2 v, const Segment& s, double radius) const {
+    return toi_disc_segment(rel, v, Vec2{}, s, radius);
+  }
+  double toi_deforming_segment(std::uint32_t, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const {
+    return toi_disc_deforming_segment(rel, v, Vec2{}, d0, w, radius, t_max);
+  }
+  static constexpr bool straight(std::uint32_t) { return true; }
+  static constexpr bool straight_pair(std::uint32_t, std::uint32_t) { return true; }
+  static constexpr double normal_accel(std::uint32_t, Vec2, Vec2) { return 0.0; }
+  static constexpr double potential(std::uint32_t, Vec2) { return 0.0; }
+};
+
+/// Parabolic flight under a uniform acceleration shared by all balls (gravity).
+struct GravityFlight {
+  static constexpr std::string_view kName = "gravity";
+  static bool fits(const WorldDef&) { return true; }
+  GravityFlight() = default;
+  explicit GravityFlight(const WorldDef& def) : a(def.effects.gravity) {}
+
+  Vec2 a{};
+  Vec2 pos(std::uint32_t, Vec2 x, Vec2 v, double dt) const { return x + dt * v + (0.5 * dt * dt) * a; }
+  Vec2 vel(std::uint32_t, Vec2 v, double dt) const { return v + dt * a; }
+  CellExit cell_exit(std::uint32_t, Vec2 x, Vec2 v, const CellBox& b) const {
+    return earlier_exit(axis_exit(x.x, v.x, a.x, b.x_lo, b.x_hi), axis_exit(x.y, v.y, a.y, b.y_lo, b.y_hi));
+  }
+  /// Both balls fall alike, so their relative motion is a straight line.
+  double toi_balls(std::uint32_t, std::uint32_t, Vec2 r, Vec2 v, double sigma, double) const {
+    return toi_disc_disc(r, v, sigma);
+  }
+  double toi_point(std::uint32_t, Vec2 rel, Vec2 v, double sigma, double t_max) const {
+    return toi_disc_point_accel(rel, v, a, sigma, t_max);
+  }
+  double toi_segment(std::uint32_t, Vec2 rel, Vec2 v, const Segment& s, double radius) const {
+    return toi_disc_segment(rel, v, a, s, radius);
+  }
+  double toi_deforming_segment(std::uint32_t, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const {
+    return toi_disc_deforming_segment(rel, v, a, d0, w, radius, t_max);
+  }
+  static constexpr bool straight(std::uint32_t) { return false; }
+  static constexpr bool straight_pair(std::uint32_t, std::uint32_t) { return true; }
+  double normal_accel(std::uint32_t, Vec2, Vec2 n) const { return dot(a, n); }
+  double potential(std::uint32_t, Vec2 x) const { return -dot(a, x); }
+};
+
+static_assert(Flight<FreeFlight> && Flight<GravityFlight>);
+
+/// How every body flies: balls by the scene's flight, turtles (ids from `balls` on, kExtras only)
+/// always in straight lines. The one place where motion tells balls and turtles apart.
+template <Flight F, bool kExtras>
+class Motion {
+ public:
+  Motion() = default;
+  explicit Motion(const WorldDef& def) : flight_(def), balls_(static_cast<std::uint32_t>(def.balls.size())) {}
+
+  const F& flight() const { return flight_; }
+  bool is_turtle(std::uint32_t id) const { return kExtras && id >= balls_; }
+  /// Whether body id's motion relative to something that flies straight is a straight line.
+  bool straight(std::uint32_t id) const { return is_turtle(id) || flight_.straight(id); }
+
+  Vec2 pos(const Body& b, std::uint32_t id, double dt) const {
+    return is_turtle(id) ? b.x + dt * b.v : flight_.pos(id, b.x, b.v, dt);
+  }
+  Vec2 vel(const Body& b, std::uint32_t id, double dt) const { return is_turtle(id) ? b.v : flight_.vel(id, b.v, dt); }
+  CellExit cell_exit(std::uint32_t id, Vec2 x, Vec2 v, const CellBox& b) const {
+    if (is_turtle(id))
+      return earlier_exit(straight_exit(x.x, v.x, b.x_lo, b.x_hi), straight_exit(x.y, v.y, b.y_lo, b.y_hi));
+    return flight_.cell_exit(id, x, v, b);
+  }
+  /// Body id (a ball or a turtle) at rel from a point that flies straight, v relative to it.
+  double toi_point(std::uint32_t id, Vec2 rel, Vec2 v, double sigma, double t_max) const {
+    return is_turtle(id) ? toi_disc_point(rel, v, sigma) : flight_.toi_point(id, rel, v, sigma, t_max);
+  }
+  double toi_segment(std::uint32_t id, Vec2 rel, Vec2 v, const Segment& s, double radius) const {
+    return is_turtle(id) ? toi_disc_segment(rel, v, Vec2{}, s, radius) : flight_.toi_segment(id, rel, v, s, radius);
+  }
+  double toi_deforming_segment(std::uint32_t id, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const {
+    return is_turtle(id) ? toi_disc_deforming_segment(rel, v, Vec2{}, d0, w, radius, t_max)
+                         : flight_.toi_deforming_segment(id, rel, v, d0, w, radius, t_max);
+  }
+
+ private:
+  F flight_;
+  std::uint32_t balls_ = 0;
+};
+
+}  // namespace turtlegas::sim::detail

@@ -1,0 +1,297 @@
+// SPDX-License-Identifier: MIT
+// Interactions, one section per pair kind: ball-ball, turtle-body (a turtle with a ball or
+// another turtle), body-wall, body-wall end, and moving walls (their interior and their two
+// ends). Each has
+//   - predict: the time of impact of one candidate pair, offered to the body's Pending (it reads
+//     a Look; the flight chooses the time-of-impact function and whether the pair's last
+//     collision rules it out);
+//   - apply: the response at the contact, with its record (it receives Parts; it returns the
+//     bodies whose course changed, which the engine then predicts afresh);
+//   - validate: how deep the contact was when it happened (EventRecord::note_contact), the
+//     engine's running check on its own times of impact.
+// The neighbourhood scans (neighbourhood.hpp) decide which candidates each body looks at.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "parts.hpp"
+#include "turtlegas/sim/toi.hpp"
+
+namespace turtlegas::sim::detail {
+namespace {
+
+/// The bodies an event changed, to be predicted afresh in this order.
+struct Changed {
+  std::uint32_t first;
+  std::uint32_t second = kNone;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Ball-ball
+
+/// Ball i (at its own time, now) and ball j seen through `shift` (a periodic image).
+template <Flight F, bool kExtras>
+[[gnu::always_inline]] inline void predict_ball_ball(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi,
+                                                     std::uint32_t j, Vec2 shift, Pending& p) {
+  if (j == i || !l.meets(i, j)) return;
+  const Body& bj = l.bodies.body[j];
+  const double dtj = l.now - bj.t;
+  const F& f = l.motion.flight();
+  const Vec2 r = f.pos(j, bj.x, bj.v, dtj) + shift - bi.x;
+  const Vec2 v = f.vel(j, bj.v, dtj) - bi.v;
+  const double t = l.now + f.toi_balls(i, j, r, v, bi.r + bj.r, p.t_coll - l.now);
+  if (t < p.t_coll) {
+    // Checked only for a winner: most candidates miss, and last[j] is a cache miss.
+    if (f.straight_pair(i, j) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
+        l.bodies.last[j] == LastPartner::of(Partner::body, i))
+      return;
+    p.take(t, Partner::body, j, bj.count);
+  }
+}
+
+template <Flight Fl, bool kStep, bool kExtras>
+Changed apply_ball_ball(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, std::uint32_t j) {
+  w.sync(i);
+  w.sync(j);
+  Body& a = w.bodies.body[i];
+  Body& b = w.bodies.body[j];
+  const Vec2 F = w.arena.min_image(b.x - a.x);
+  const double sigma = a.r + b.r;
+  w.record.note_contact(sigma - norm(F), std::min(a.r, b.r));
+  const double e = w.restitution.for_pair(i, j, w.now);
+  respond_disc_disc(a.v, b.v, w.bodies.mass[i], w.bodies.mass[j], F, e);
+  ++w.record.stats.ball_ball;
+  w.note(EventKind::ball_ball, i, j);
+  w.changed(i);
+  w.changed(j);
+  w.bodies.last[i] = LastPartner::of(Partner::body, j);
+  w.bodies.last[j] = LastPartner::of(Partner::body, i);
+  return {i, j};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Turtle-body: a turtle (a disc of infinite mass that flies straight) with a ball or a turtle
+
+/// Turtle j, seen from body i (a ball or a turtle).
+template <Flight F, bool kExtras>
+[[gnu::always_inline]] inline void predict_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift,
+                    Pending& p) {
+  if (j == i || !l.meets(i, j)) return;
+  const Body& bj = l.bodies.body[j];
+  const Vec2 rel = bi.x - (bj.x + (l.now - bj.t) * bj.v + shift);
+  const Vec2 v = bi.v - bj.v;
+  const double t = l.now + l.motion.toi_point(i, rel, v, bi.r + bj.r, p.t_coll - l.now);
+  if (t < p.t_coll) {
+    if (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
+        l.bodies.last[j] == LastPartner::of(Partner::body, i))
+      return;
+    p.take(t, Partner::body, j, bj.count);
+  }
+}
+
+/// Ball j (which may fall), seen from turtle i.
+template <Flight F, bool kExtras>
+[[gnu::always_inline]] inline void predict_ball_from_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j,
+                              Vec2 shift, Pending& p) {
+  if (!l.meets(i, j)) return;
+  const Body& bj = l.bodies.body[j];
+  const double dtj = l.now - bj.t;
+  const F& f = l.motion.flight();
+  const Vec2 rel = f.pos(j, bj.x, bj.v, dtj) + shift - bi.x;
+  const Vec2 v = f.vel(j, bj.v, dtj) - bi.v;
+  const double t = l.now + f.toi_point(j, rel, v, bi.r + bj.r, p.t_coll - l.now);
+  if (t < p.t_coll) {
+    if (f.straight(j) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
+        l.bodies.last[j] == LastPartner::of(Partner::body, i))
+      return;
+    p.take(t, Partner::body, j, bj.count);
+  }
+}
+
+template <Flight Fl, bool kStep, bool kExtras>
+Changed apply_turtle_body(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, std::uint32_t j) {
+  w.sync(i);
+  w.sync(j);
+  const std::uint32_t nb = w.bodies.balls();
+  // Name the pair (turtle, other) with the turtle first.
+  const std::uint32_t t = w.is_turtle(i) ? i : j;
+  const std::uint32_t o = t == i ? j : i;
+  Body& bt = w.bodies.body[t];
+  Body& bo = w.bodies.body[o];
+  const Vec2 F = w.arena.min_image(bo.x - bt.x);  // from the turtle to the other body
+  const double dist = norm(F);
+  w.record.note_contact(bt.r + bo.r - dist, std::min(bt.r, bo.r));
+  const Vec2 n = F / dist;
+  if (!w.is_turtle(o)) {
+    // The turtle stops dead (or bounces) at the contact first; the ball then bounces off it as
+    // off a wall of infinite mass moving at the turtle's new velocity. (Against the old velocity,
+    // a ball that caught up with a turtle from behind would keep closing on it once it stopped.)
+    w.touch(t, EventKind::turtle_ball, o, -n);
+    const Vec2 rel = bo.v - bt.v;
+    if (dot(rel, n) < 0.0) bo.v = bt.v + w.bounce(o, rel, n);
+    ++w.record.stats.turtle_ball;
+    w.note(EventKind::turtle_ball, t - nb, o);
+  } else {
+    ++w.record.stats.turtle_turtle;
+    w.note(EventKind::turtle_turtle, t - nb, o - nb);
+    w.touch(t, EventKind::turtle_turtle, o - nb, -n);
+    w.touch(o, EventKind::turtle_turtle, t - nb, n);
+  }
+  w.changed(t);
+  w.changed(o);
+  w.bodies.last[t] = LastPartner::of(Partner::body, o);
+  w.bodies.last[o] = LastPartner::of(Partner::body, t);
+  return {t, o};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Body-wall: a fixed wall's interior (a moving wall's is predicted with the moving walls, below,
+// and applied here)
+
+template <Flight F, bool kExtras>
+[[gnu::always_inline]] inline void predict_wall(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t w, Vec2 shift,
+                  Pending& p) {
+  if (!l.meets_wall(i, w) || (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::wall, w))) return;
+  const Segment& s = l.walls.segments[w];
+  // Relative to the wall's first end, so walls far from the origin lose nothing.
+  const double t = l.now + l.motion.toi_segment(i, bi.x - (s.p1 + shift), bi.v, s, bi.r);
+  if (t < p.t_coll) p.take(t, Partner::wall, w);
+}
+
+template <Flight Fl, bool kStep, bool kExtras>
+Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t w) {
+  p.sync(i);
+  Body& a = p.bodies.body[i];
+  const std::uint32_t mi = p.walls.mover_of[w];
+  const Segment s = mi == kNone ? p.walls.segments[w] : p.schedule.movers[mi].segment_at(p.walls.segments[w], p.now);
+  // The velocity of the wall's material point at the contact: the ends' velocities interpolated
+  // at the foot (the same for every point of a translating wall).
+  Vec2 u{};
+  if (mi != kNone) {
+    const Mover& m = p.schedule.movers[mi];
+    u = m.u;
+    if (!m.rigid()) u += std::clamp(dot(a.x - s.p1, s.u) / s.len, 0.0, 1.0) * m.w;
+  }
+  const double d = dot(p.arena.rel_to_segment(a.x, s), s.n);
+  const Vec2 n = d >= 0.0 ? s.n : -s.n;
+  p.record.note_contact(a.r - std::abs(d), a.r);
+  if (p.is_turtle(i)) {
+    ++p.record.stats.turtle_wall;
+    p.note(EventKind::turtle_wall, i - p.bodies.balls(), w);
+    p.touch(i, EventKind::turtle_wall, w, n);
+    if (dot(u, n) > 0.0) {
+      // A moving wall pushing a turtle carries it along at its normal speed (both have
+      // infinite mass), until the wall's next keyframe. A turning or stretching wall's push
+      // changes along the way, so it knocks the turtle off instead, at twice its normal speed
+      // (an elastic bounce off the wall), which the wall can only catch up with by speeding up.
+      a.v = (p.schedule.movers[mi].rigid() ? 1.0 : 2.0) * dot(u, n) * n;
+      p.turtles.pushed_by[i - p.bodies.balls()] = mi;
+    }
+  } else {
+    a.v = u + p.bounce(i, a.v - u, n);
+    ++p.record.stats.ball_wall;
+    p.note(EventKind::ball_wall, i, w);
+  }
+  p.changed(i);
+  p.bodies.last[i] = LastPartner::of(Partner::wall, w);
+  return {i};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Body-wall end: a fixed wall's end point, one per distinct point
+
+template <Flight F, bool kExtras>
+[[gnu::always_inline]] inline void predict_end(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift,
+                 Pending& p) {
+  if (!l.meets_end(i, e) || (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::end, e))) return;
+  const Vec2 rel = bi.x - (l.walls.ends[e].p + shift);
+  const double t = l.now + l.motion.toi_point(i, rel, bi.v, bi.r, p.t_coll - l.now);
+  if (t < p.t_coll) p.take(t, Partner::end, e);
+}
+
+template <Flight Fl, bool kStep, bool kExtras>
+Changed apply_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t e) {
+  p.sync(i);
+  Body& a = p.bodies.body[i];
+  const WallEnd& end = p.walls.ends[e];
+  const Vec2 F = p.arena.min_image(a.x - end.p);
+  const double dist = norm(F);
+  p.record.note_contact(a.r - dist, a.r);
+  if (p.is_turtle(i)) {
+    ++p.record.stats.turtle_wall_end;
+    p.note(EventKind::turtle_wall_end, i - p.bodies.balls(), end.wall);
+    p.touch(i, EventKind::turtle_wall_end, end.wall, F / dist);
+  } else {
+    a.v = p.bounce(i, a.v, F / dist);
+    ++p.record.stats.ball_wall_end;
+    p.note(EventKind::ball_wall_end, i, end.wall);
+  }
+  p.changed(i);
+  p.bodies.last[i] = LastPartner::of(Partner::end, e);
+  return {i};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Moving walls: outside the table, checked by every prediction up to the next keyframe (which
+// makes every body predict again), in the wall's frame, where a body flies with v - u. A contact
+// with the interior is applied as a wall's (apply_wall); the ends are `moving_end` partners,
+// numbered 2 mover + (0: first end, 1: second).
+
+template <Flight F, bool kExtras>
+[[gnu::always_inline]] inline void predict_mover(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t mi, Pending& p) {
+  const Mover& m = l.schedule.movers[mi];
+  const std::uint32_t w = m.wall;
+  if (!l.meets_wall(i, w)) return;
+  const Segment& s = l.walls.segments[w];
+  const Vec2 p1 = m.p1_at(l.now);
+  const Vec2 v = bi.v - m.u;
+  const double horizon = std::min(p.t_coll, l.schedule.next_key);
+  const LastPartner last = l.bodies.last[i];
+  double t_wall = kNever;
+  if (!m.rigid()) {
+    // Turning or stretching: no straight-line argument rules out meeting the same wall again.
+    t_wall = l.now + l.motion.toi_deforming_segment(i, bi.x - p1, v, m.d_at(l.now), m.w, bi.r, horizon - l.now);
+  } else if (!(l.motion.straight(i) && last == LastPartner::of(Partner::wall, w))) {
+    t_wall = l.now + l.motion.toi_segment(i, bi.x - p1, v, s, bi.r);
+  }
+  if (t_wall < p.t_coll && t_wall <= horizon) p.take(t_wall, Partner::wall, w);
+  for (std::uint32_t which = 0; which < 2; ++which) {
+    const std::uint32_t code = 2 * mi + which;
+    if (l.motion.straight(i) && last == LastPartner::of(Partner::moving_end, code)) continue;
+    // Each end moves in a straight line, so its contacts have the closed forms of a fixed point.
+    const Vec2 e = m.end_at(s, which == 1, l.now);
+    const Vec2 ve = which == 0 ? v : v - m.w;  // the body's velocity relative to that end
+    const double t = l.now + l.motion.toi_point(i, bi.x - e, ve, bi.r, horizon - l.now);
+    if (t < p.t_coll && t <= horizon) p.take(t, Partner::moving_end, code);
+  }
+}
+
+template <Flight Fl, bool kStep, bool kExtras>
+Changed apply_moving_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t code) {
+  p.sync(i);
+  Body& a = p.bodies.body[i];
+  const Mover& m = p.schedule.movers[code / 2];
+  const bool second = code % 2 == 1;
+  const Vec2 e = m.end_at(p.walls.segments[m.wall], second, p.now);
+  const Vec2 ue = m.end_velocity(second);
+  const Vec2 F = a.x - e;
+  const double dist = norm(F);
+  p.record.note_contact(a.r - dist, a.r);
+  if (p.is_turtle(i)) {
+    ++p.record.stats.turtle_wall_end;
+    p.note(EventKind::turtle_wall_end, i - p.bodies.balls(), m.wall);
+    p.touch(i, EventKind::turtle_wall_end, m.wall, F / dist);
+  } else {
+    a.v = ue + p.bounce(i, a.v - ue, F / dist);
+    ++p.record.stats.ball_wall_end;
+    p.note(EventKind::ball_wall_end, i, m.wall);
+  }
+  p.changed(i);
+  p.bodies.last[i] = LastPartner::of(Partner::moving_end, code);
+  return {i};
+}
+
+}  // namespace
+}  // namespace turtlegas::sim::detail

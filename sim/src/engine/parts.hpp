@@ -1,0 +1,160 @@
+// SPDX-License-Identifier: MIT
+// What the rooms see of each other. The interactions and the neighbourhood scans do not reach
+// into the engine: a prediction receives a Look (everything it reads, all const), an event's
+// response receives Parts (the rooms it changes, by reference). Both are built by the engine for
+// each call and cost nothing once inlined. Here too are the small rooms that only they share: the
+// restitution law, step mode's path lengths, and the record of what happened.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "arena.hpp"
+#include "body_store.hpp"
+#include "flights.hpp"
+#include "moving_walls.hpp"
+#include "turtle_motion.hpp"
+#include "turtlegas/sim/events.hpp"
+#include "turtlegas/sim/world.hpp"
+#include "walls.hpp"
+
+namespace turtlegas::sim::detail {
+
+/// The length of a straight path at speed |v| for dt.
+inline double path_length(Vec2 v, double dt) { return norm(v) * dt; }
+
+/// The memo's restitution ("2 replaced by 1 + e"), with the TC rule and the rest threshold.
+struct Restitution {
+  double e = 1.0;
+  double tc = 0.0;
+  bool inelastic = false;
+  std::vector<double> last_time;  ///< per body, when it last changed course (only when e < 1)
+
+  /// The TC rule (Luding & McNamara): a ball that collided less than tc ago collides elastically,
+  /// so a cluster cannot collapse into infinitely many collisions in finite time.
+  double for_ball(std::uint32_t i, double now) const { return now - last_time[i] < tc ? 1.0 : e; }
+  double for_pair(std::uint32_t i, std::uint32_t j, double now) const {
+    double out = e;
+    if (inelastic) out = std::max(for_ball(i, now), for_ball(j, now));
+    return out;
+  }
+  /// A ball's velocity v relative to an obstacle after bouncing off it; n is the unit contact
+  /// normal pointing from the obstacle to the ball, a_n the field's acceleration of the ball along
+  /// it. Walls take the plain restitution: the TC rule is for ball clusters; a ball pressed onto
+  /// a wall is kept from collapsing by the rest threshold.
+  Vec2 bounce(Vec2 v, Vec2 n, double a_n) const {
+    const double w = -dot(v, n);
+    double w_out = e * w;
+    // The rest threshold: a ball pressed onto the obstacle by the field leaves it at least fast
+    // enough to stay away for tc. Without it an inelastic ball would bounce infinitely often before
+    // coming to rest, and a ball at rest would sink.
+    if (a_n < 0.0) w_out = std::max(w_out, -a_n * tc / 2.0);
+    return v + (w + w_out) * n;
+  }
+};
+
+/// Step mode's bookkeeping of one step: how far bodies have gone, and the marks that keep a ring
+/// scan from looking at a wall twice.
+struct StepState {
+  std::uint64_t index = 0;      ///< steps done
+  double rmax = 0.0;            ///< the largest radius
+  double dmax = 0.0;            ///< the largest path length of any body in this step
+  std::vector<double> travel;   ///< per body: path length so far in this step
+  std::vector<std::uint32_t> stamp;  ///< de-duplicates walls and ends in ring scans
+  std::uint32_t scan = 0;
+};
+
+/// What the engine reports: its counts, the deepest contact seen, and the event log.
+struct EventRecord {
+  Stats stats;
+  Overlap max_contact;
+  std::vector<Event>* log = nullptr;
+
+  void note_contact(double depth, double radius) {
+    if (depth > max_contact.depth) max_contact.depth = depth;
+    if (depth / radius > max_contact.relative) max_contact.relative = depth / radius;
+  }
+  void note(double t, EventKind kind, std::uint32_t a, std::uint32_t b) {
+    if (log) log->push_back({t, kind, a, b});
+  }
+};
+
+/// What a prediction reads.
+template <Flight F, bool kExtras>
+struct Look {
+  const BodyStore& bodies;
+  const Walls& walls;
+  const WallSchedule& schedule;
+  const Motion<F, kExtras>& motion;
+  double now;
+
+  bool is_turtle(std::uint32_t id) const { return motion.is_turtle(id); }
+  /// Collision layers: whether two bodies, or a body and a wall or wall end, can touch at all.
+  bool meets(std::uint32_t i, std::uint32_t j) const {
+    // Bodies' layers are fixed at construction; when all are the defaults (which meet), the pair
+    // test reads neither (with many turtles layers[j] is a cache miss per candidate).
+    if constexpr (kExtras) return !bodies.layered || bodies.layers[i].collides_with(bodies.layers[j]);
+    else return true;
+  }
+  bool meets_wall(std::uint32_t i, std::uint32_t w) const {
+    if constexpr (kExtras) return bodies.layers[i].collides_with(walls.layers[w]);
+    else return true;
+  }
+  bool meets_end(std::uint32_t i, std::uint32_t e) const {
+    if constexpr (kExtras) return bodies.layers[i].collides_with(walls.end_layers[e]);
+    else return true;
+  }
+};
+
+/// Brings body i to internal time `now` along its flight (step mode also adds up its path).
+template <Flight F, bool kStep, bool kExtras>
+void sync_body(BodyStore& bodies, const Motion<F, kExtras>& motion, StepState& step, std::uint32_t i, double now) {
+  Body& b = bodies.body[i];
+  const double dt = now - b.t;
+  if constexpr (kStep) step.travel[i] += path_length(b.v, dt);
+  b.x = motion.pos(b, i, dt);
+  b.v = motion.vel(b, i, dt);
+  b.t = now;
+}
+
+/// What an event's response changes, and the clock's reading.
+template <Flight F, bool kStep, bool kExtras>
+struct Parts {
+  BodyStore& bodies;
+  const Motion<F, kExtras>& motion;
+  Walls& walls;
+  WallSchedule& schedule;
+  Turtles& turtles;
+  const Arena& arena;
+  Restitution& restitution;
+  StepState& step;
+  EventRecord& record;
+  double now;     ///< internal time
+  double t_base;  ///< external time of internal zero
+  double dt;      ///< the step (step mode), and the control step turtles coast to
+
+  bool is_turtle(std::uint32_t id) const { return motion.is_turtle(id); }
+  void sync(std::uint32_t i) const { sync_body<F, kStep, kExtras>(bodies, motion, step, i, now); }
+  void note(EventKind kind, std::uint32_t a, std::uint32_t b) const { record.note(t_base + now, kind, a, b); }
+  /// Body i changed course: predictions made with it are stale.
+  void changed(std::uint32_t i) const {
+    ++bodies.body[i].count;
+    if (restitution.inelastic) restitution.last_time[i] = now;
+    if constexpr (kStep) {
+      // The rest of the step is walked at the new speed.
+      step.dmax = std::max(step.dmax, step.travel[i] + path_length(bodies.body[i].v, dt - now));
+    }
+  }
+  /// Body `id`, a turtle, touched `other` (see Turtles::touch).
+  void touch(std::uint32_t id, EventKind kind, std::uint32_t other, Vec2 normal) const {
+    turtles.touch(id - bodies.balls(), bodies.body[id], bodies.end[id], now, t_base, dt, kind, other, normal);
+  }
+  /// The bounce of ball i (at the contact, its velocity not yet changed) off an obstacle, v its
+  /// velocity relative to the obstacle (Restitution::bounce, under the ball's field).
+  Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n) const {
+    return restitution.bounce(v, n, motion.flight().normal_accel(i, bodies.body[i].v, n));
+  }
+};
+
+}  // namespace turtlegas::sim::detail

@@ -1,0 +1,149 @@
+// SPDX-License-Identifier: MIT
+#include "turtle_motion.hpp"
+
+#include <cmath>
+
+namespace turtlegas::sim::detail {
+
+Vec2 heading_vector(double heading) {
+  const double deg = heading * (180.0 / 3.141592653589793);
+  const double quarter = std::round(deg / 90.0);
+  if (std::abs(deg - 90.0 * quarter) < 1e-9) {
+    switch (((static_cast<long long>(quarter) % 4) + 4) % 4) {
+      case 0: return {0.0, 1.0};
+      case 1: return {1.0, 0.0};
+      case 2: return {0.0, -1.0};
+      default: return {-1.0, 0.0};
+    }
+  }
+  return {std::sin(heading), std::cos(heading)};
+}
+
+Turtles::Turtles(const std::vector<TurtleDef>& defs) {
+  run_.resize(defs.size());
+  busy_.assign(defs.size(), 0);
+  for (std::size_t k = 0; k < defs.size(); ++k) {
+    const TurtleDef& d = defs[k];
+    TurtleRun& r = run_[k];
+    r.heading0 = d.heading;
+    r.speed = d.speed;
+    r.turn_rate = d.turn_rate;
+    r.bounce = d.bounce;
+  }
+}
+
+TurtleState Turtles::state(std::size_t k, const Body& b, double end, double now) const {
+  const TurtleRun& r = run_[k];
+  TurtleState s;
+  s.pos = b.x + (now - b.t) * b.v;
+  s.vel = b.v;
+  s.heading = heading_at(k, now, end);
+  s.busy = busy_[k] != 0;
+  s.touched = r.touched;
+  if (s.busy) {
+    const double el = now - r.t_start;
+    s.done = r.kind == TurtleCommand::Kind::move ? r.speed * el
+             : r.kind == TurtleCommand::Kind::turn ? r.turn_rate * el
+                                                   : el;
+  } else {
+    s.done = std::abs(r.amount);
+  }
+  return s;
+}
+
+bool Turtles::command(std::size_t k, const TurtleCommand& c, Body& b, double& end, double now) {
+  TurtleRun& r = run_[k];
+  r.heading0 = heading_at(k, now, end);
+  r.kind = c.kind;
+  r.coasting = false;
+  r.touched = false;
+  r.t_start = now;
+  r.omega = 0.0;
+  r.amount = 0.0;
+  const bool was_at_rest = at_rest(b);
+  b.v = {};
+  bool busy = false;
+  switch (c.kind) {
+    case TurtleCommand::Kind::stop:
+      end = kNever;
+      break;
+    case TurtleCommand::Kind::move: {
+      const double sign = c.amount >= 0.0 ? 1.0 : -1.0;
+      busy = c.amount != 0.0 && r.speed > 0.0;
+      end = busy ? now + std::abs(c.amount) / r.speed : kNever;
+      if (busy) b.v = (sign * r.speed) * heading_vector(r.heading0);
+      r.amount = c.amount;
+      break;
+    }
+    case TurtleCommand::Kind::turn:
+      busy = c.amount != 0.0 && r.turn_rate > 0.0;
+      r.omega = busy ? (c.amount >= 0.0 ? r.turn_rate : -r.turn_rate) : 0.0;
+      end = busy ? now + std::abs(c.amount) / r.turn_rate : kNever;
+      r.amount = c.amount;
+      break;
+    case TurtleCommand::Kind::wait:
+      busy = c.amount > 0.0;
+      end = busy ? now + c.amount : kNever;
+      r.amount = c.amount;
+      break;
+  }
+  busy_[k] = busy ? 1 : 0;
+  // A turn, a wait or a stop from rest: the disc does not move, so the predictions made with it
+  // still hold (its own, kept apart from the command's end, and its neighbours').
+  return !(was_at_rest && at_rest(b));
+}
+
+bool Turtles::finish(std::size_t k, Body& b, double& end) {
+  TurtleRun& r = run_[k];
+  // A completed turn ends exactly where it was told to, not where omega * time rounds to.
+  if (busy_[k] != 0) {
+    if (r.kind == TurtleCommand::Kind::turn) r.heading0 += r.amount;
+    r.amount = std::abs(r.amount);
+  }
+  busy_[k] = 0;
+  r.coasting = false;
+  r.omega = 0.0;
+  end = kNever;
+  // A turn or a wait: the disc stood still and stays still, so every prediction made with it (its
+  // own and its neighbours') still holds.
+  if (at_rest(b)) return false;
+  b.v = {};
+  return true;
+}
+
+void Turtles::touch(std::size_t k, Body& b, double& end, double now, double t_base, double dt, EventKind kind,
+                    std::uint32_t other, Vec2 normal) {
+  TurtleRun& r = run_[k];
+  if (busy_[k] != 0) {
+    busy_[k] = 0;
+    r.touched = true;
+    if (r.kind == TurtleCommand::Kind::turn) r.heading0 = heading_at(k, now, end);
+    r.amount = r.kind == TurtleCommand::Kind::move ? r.speed * (now - r.t_start)
+               : r.kind == TurtleCommand::Kind::turn ? std::abs(r.omega) * (now - r.t_start)
+                                                     : now - r.t_start;
+    r.omega = 0.0;
+    end = kNever;
+  }
+  const double vn = dot(b.v, normal);
+  if (r.bounce >= 0.0 && vn < 0.0) {
+    b.v = b.v - ((1.0 + r.bounce) * vn) * normal;
+    // Coast until the next control step, where the program decides again.
+    const double t_ext = t_base + now;
+    const double next_step = (std::floor(t_ext / dt + 1e-9) + 1.0) * dt;
+    r.coasting = true;
+    end = next_step - t_base;
+  } else {
+    b.v = {};
+    r.coasting = false;
+    end = kNever;
+  }
+  contacts_.push_back({t_base + now, static_cast<std::uint32_t>(k), kind, other, normal});
+}
+
+void Turtles::exit(std::size_t k, Body& b, double& end) {
+  busy_[k] = 0;
+  end = kNever;
+  b.v = {};
+}
+
+}  // namespace turtlegas::sim::detail

@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: MIT
+// Turtles' motion: the command each turtle is running, in the engine's internal time, and what a
+// contact does to it. A turtle's body is in the BodyStore (id balls() + k) and the end of its
+// command in its record (BodyStore::end); these functions receive both.
+#pragma once
+
+#include <cstddef>
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "records.hpp"
+#include "turtlegas/sim/events.hpp"
+#include "turtlegas/sim/vec2.hpp"
+#include "turtlegas/sim/world.hpp"
+
+namespace turtlegas::sim::detail {
+
+/// A turtle's command in progress, in the engine's internal time.
+struct TurtleRun {
+  TurtleCommand::Kind kind = TurtleCommand::Kind::stop;
+  bool coasting = false;  ///< bouncing off after a contact, until the next control step
+  bool touched = false;
+  double amount = 0.0;
+  double t_start = 0.0;  ///< (its end is in the turtle's Record: BodyStore::end)
+  double heading0 = 0.0;  ///< heading at t_start
+  double omega = 0.0;     ///< signed turn rate while turning
+  double speed = 0.0;
+  double turn_rate = 0.0;
+  double bounce = -1.0;
+};
+
+/// The unit vector of a Logo heading (radians; 0 is +y, clockwise). Headings within 1e-9 degrees
+/// of a multiple of 90 give the exact axis: cos(pi/2) is 6e-17, not 0, and a turtle that has
+/// turned to drive along the wall it touches would otherwise "approach" it at 1e-15 units/s and
+/// stop at once.
+Vec2 heading_vector(double heading);
+
+class Turtles {
+ public:
+  Turtles() = default;
+  explicit Turtles(const std::vector<TurtleDef>& defs);
+
+  std::size_t size() const { return run_.size(); }
+  bool busy(std::size_t k) const { return busy_[k] != 0; }
+  void idle(std::vector<std::uint32_t>& out) const {
+    for (std::uint32_t k = 0; k < run_.size(); ++k)
+      if (busy_[k] == 0) out.push_back(k);
+  }
+  /// The start of turtle k's command state (which may straddle two cache lines), to prefetch.
+  const TurtleRun& run(std::size_t k) const { return run_[k]; }
+
+  /// Turtle k's heading at internal time t; `end` is when its command ends.
+  double heading_at(std::size_t k, double t, double end) const {
+    const TurtleRun& r = run_[k];
+    return r.heading0 + r.omega * (std::min(t, end) - r.t_start);
+  }
+  /// What turtle k's program sees (body b, brought to nothing: it is read at `now`).
+  TurtleState state(std::size_t k, const Body& b, double end, double now) const;
+
+  /// Starts command c for turtle k, whose body b has been brought to `now`: sets its velocity and
+  /// `end`. Returns whether the body's course changed (false: it stood still and still does, so
+  /// every prediction made with it holds).
+  bool command(std::size_t k, const TurtleCommand& c, Body& b, double& end, double now);
+  /// Turtle k's command (or its coasting after a bounce) has run its course at `now`. Returns
+  /// whether the body was moving (it now stands still: its course changed).
+  bool finish(std::size_t k, Body& b, double& end);
+  /// Turtle k touched something at internal time `now` (t_base: the external time of internal
+  /// zero; dt: the control step): its command ends there (a dead stop, or a bounce that coasts
+  /// until the next control step), and the contact waits for its touch sensors.
+  void touch(std::size_t k, Body& b, double& end, double now, double t_base, double dt, EventKind kind,
+             std::uint32_t other, Vec2 normal);
+  /// Turtle k has left the arena.
+  void exit(std::size_t k, Body& b, double& end);
+  /// Internal time moves by -shift (a rebase, or the end of a step).
+  void shift_times(double shift) {
+    for (TurtleRun& r : run_) r.t_start -= shift;
+  }
+  std::vector<TurtleContact> take_contacts() {
+    std::vector<TurtleContact> out;
+    out.swap(contacts_);
+    return out;
+  }
+
+  /// Per turtle: the mover (WallSchedule::movers) pushing it, or kNone.
+  std::vector<std::uint32_t> pushed_by;
+
+ private:
+  std::vector<TurtleRun> run_;
+  std::vector<std::uint8_t> busy_;  ///< per turtle: a command is running (apart, so the idle scan reads 1 byte a turtle)
+  std::vector<TurtleContact> contacts_;
+};
+
+/// A turtle standing still (balls under a field are never taken for one: this is for turtles).
+inline bool at_rest(const Body& b) { return b.v.x == 0.0 && b.v.y == 0.0; }
+
+}  // namespace turtlegas::sim::detail

@@ -1,0 +1,114 @@
+// SPDX-License-Identifier: MIT
+// The overlap measure: World::measure_overlap, and through it the CLI's max_overlap and expect's.
+#include "overlap.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+namespace turtlegas::sim::detail {
+namespace {
+
+Vec2 min_image(Vec2 d, double w, double h) {
+  if (w > 0.0) d.x -= w * std::round(d.x / w);
+  if (h > 0.0) d.y -= h * std::round(d.y / h);
+  return d;
+}
+
+double distance_to_segment(Vec2 p, const Segment& s) {
+  const Vec2 rel = p - s.p1;
+  const double foot = std::clamp(dot(rel, s.u), 0.0, s.len);
+  return norm(rel - foot * s.u);
+}
+
+}  // namespace
+
+Overlap deepest_overlap(const DiscView& discs, const std::vector<Segment>& walls, double periodic_width, double periodic_height,
+                        bool ball_pairs, const std::vector<Layers>* body_layers, const std::vector<Layers>* wall_layers) {
+  auto meet = [&](std::size_t i, std::size_t j) { return !body_layers || (*body_layers)[i].collides_with((*body_layers)[j]); };
+  auto meet_wall = [&](std::size_t i, std::size_t w) {
+    return !body_layers || !wall_layers || (*body_layers)[i].collides_with((*wall_layers)[w]);
+  };
+  Overlap worst;
+  auto note = [&](double depth, double r) {
+    if (depth <= 0.0) return;
+    worst.depth = std::max(worst.depth, depth);
+    worst.relative = std::max(worst.relative, depth / r);
+  };
+  const std::size_t n = discs.n;
+  double rmax = 0.0;
+  std::size_t live = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (discs.alive(i)) {
+      rmax = std::max(rmax, discs.radius(i));
+      ++live;
+    }
+  if (rmax == 0.0) return worst;
+
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!discs.alive(i)) continue;
+    const double r = discs.radius(i);
+    for (std::size_t w = 0; w < walls.size(); ++w) {
+      const Segment& s = walls[w];
+      if (!meet_wall(i, w)) continue;
+      Vec2 p = discs.pos(i);
+      if (periodic_width > 0.0) p = s.p1 + min_image(p - s.p1, periodic_width, periodic_height);
+      note(r - distance_to_segment(p, s), r);
+    }
+  }
+  if (!ball_pairs) return worst;
+
+  // Sort by cell of side 2 rmax and compare with the 3x3 neighbouring cells: an independent grid.
+  // Only the disc indices are stored; cells are recomputed from positions when compared.
+  const double cell = 2.0 * rmax;
+  struct Cell {
+    std::int64_t cx, cy;
+    auto operator<=>(const Cell&) const = default;
+  };
+  auto cell_of = [&](std::size_t i) {
+    Vec2 p = discs.pos(i);
+    if (periodic_width > 0.0) p = {p.x - periodic_width * std::floor(p.x / periodic_width),
+                                   p.y - periodic_height * std::floor(p.y / periodic_height)};
+    return Cell{static_cast<std::int64_t>(std::floor(p.x / cell)), static_cast<std::int64_t>(std::floor(p.y / cell))};
+  };
+  std::vector<std::uint32_t> order;
+  order.reserve(live);
+  for (std::size_t i = 0; i < n; ++i)
+    if (discs.alive(i)) order.push_back(static_cast<std::uint32_t>(i));
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const Cell ca = cell_of(a), cb = cell_of(b);
+    return ca != cb ? ca < cb : a < b;
+  });
+  auto check_pair = [&](std::size_t i, std::size_t j) {
+    if (!meet(i, j)) return;
+    const Vec2 d = min_image(discs.pos(j) - discs.pos(i), periodic_width, periodic_height);
+    const double ri = discs.radius(i), rj = discs.radius(j);
+    note(ri + rj - norm(d), std::min(ri, rj));
+  };
+  const std::int64_t ncx = periodic_width > 0.0 ? static_cast<std::int64_t>(std::floor(periodic_width / cell)) : 0;
+  const std::int64_t ncy = periodic_height > 0.0 ? static_cast<std::int64_t>(std::floor(periodic_height / cell)) : 0;
+  const bool brute = periodic_width > 0.0 && (ncx < 3 || ncy < 3);
+  if (brute || order.size() < 64) {
+    for (std::size_t a = 0; a < order.size(); ++a)
+      for (std::size_t b = a + 1; b < order.size(); ++b) check_pair(order[a], order[b]);
+    return worst;
+  }
+  for (const std::uint32_t i : order) {
+    const Cell home = cell_of(i);
+    for (std::int64_t dy = -1; dy <= 1; ++dy)
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        Cell c{home.cx + dx, home.cy + dy};
+        if (periodic_width > 0.0) {
+          // Cells past the last whole one belong to the last; wrap the rest.
+          c.cx = ((c.cx % (ncx + 1)) + (ncx + 1)) % (ncx + 1);
+          c.cy = ((c.cy % (ncy + 1)) + (ncy + 1)) % (ncy + 1);
+        }
+        auto it = std::partition_point(order.begin(), order.end(), [&](std::uint32_t k) { return cell_of(k) < c; });
+        for (; it != order.end() && cell_of(*it) == c; ++it)
+          if (*it > i) check_pair(i, *it);
+      }
+  }
+  return worst;
+}
+
+}  // namespace turtlegas::sim::detail
