@@ -38,6 +38,40 @@ TEST_CASE("a graze at exactly touching distance is not a collision", "[hard]") {
   }
 }
 
+TEST_CASE("touching pairs at 400 orientations, moving along their tangent, never collide in either mode",
+          "[hard]") {
+  // The same graze as above with rounded coordinates: each pair starts at a distance of at least
+  // 1 in doubles (the loader's test), its relative velocity perpendicular to the line of centres
+  // up to rounding. A rounding-sized approach must not count as a collision in step mode, which
+  // moves every ball by x + v dt at each step, any more than in exact mode. (Filed as a step-mode
+  // bug; not reproduced in the split engine, kept as the contract's guard.)
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(420, 420);
+    d.dt = 0.1;
+    std::uint64_t state = 2;
+    auto uniform = [&state] {  // a fixed LCG so the test needs no <random> distribution's behaviour
+      state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+      return static_cast<double>(state >> 11) * 0x1.0p-53;
+    };
+    for (int n = 0; n < 400;) {
+      const double th = 2 * 3.141592653589793 * uniform();
+      const Vec2 o{10 + (n / 20) * 20 + uniform(), 10 + (n % 20) * 20 + uniform()};
+      const Vec2 p{o.x + std::cos(th), o.y + std::sin(th)};
+      if (norm2(p - o) < 1.0) continue;
+      const Vec2 v{-2 * std::sin(th), 2 * std::cos(th)};
+      BallDef a = ball("a" + std::to_string(n), o, v), b = ball("b" + std::to_string(n), p, {-v.x, -v.y});
+      a.radius = b.radius = 0.5;
+      d.balls.push_back(a);
+      d.balls.push_back(b);
+      ++n;
+    }
+    World w(d, mode);
+    w.advance_to(0.5);
+    CHECK(w.stats().ball_ball == 0);
+  }
+}
+
 TEST_CASE("a ball sliding along a wall at exactly its radius never touches it", "[hard]") {
   for (Mode mode : kModes) {
     INFO(name(mode));

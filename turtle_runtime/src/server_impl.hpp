@@ -13,6 +13,7 @@
 #include "agent.hpp"
 #include "sensors.hpp"
 #include "turtlegas/sim/angles.hpp"
+#include "turtlegas/sim/control_steps.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/turtle/event_names.hpp"
 #include "turtlegas/turtle/game.hpp"
@@ -35,7 +36,7 @@ class WorldServer::Impl : public GameHost {
 
   Impl(sim::WorldDef d, ServerOptions o) : def(std::move(d)), world(def, o.mode), options(o) {}
 
-  double boundary_time(std::uint64_t k) const { return static_cast<double>(k) * def.dt; }
+  double boundary_time(std::uint64_t k) const { return sim::control_boundary(k, def.dt); }
   void control_step();
   void run_program(Agent& a);
   void finish_command(Agent& a);

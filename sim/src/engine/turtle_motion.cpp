@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "turtlegas/sim/control_steps.hpp"
+
 namespace turtlegas::sim::detail {
 
 Vec2 heading_vector(double heading) {
@@ -129,7 +131,7 @@ void Turtles::touch(std::size_t k, Body& b, double& end, double now, double t_ba
     b.v = b.v - ((1.0 + r.bounce) * vn) * normal;
     // Coast until the next control step, where the program decides again.
     const double t_ext = t_base + now;
-    const double next_step = (std::floor(t_ext / dt + 1e-9) + 1.0) * dt;
+    const double next_step = control_boundary(next_control_step(t_ext, dt), dt);
     r.coasting = true;
     end = next_step - t_base;
   } else {
