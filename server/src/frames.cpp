@@ -124,11 +124,13 @@ bool FrameKind::wants(std::string_view event_kind) const {
 }
 
 std::string snapshot_text(const turtle::WorldServer& server, const formats::IdTable& ball_ids,
-                          const std::vector<bool>& claimed, const FrameClock& clock, const nlohmann::json& id) {
+                          const std::vector<bool>& claimed, const FrameClock& clock, const nlohmann::json& id,
+                          const nlohmann::json& arena) {
   const sim::World& world = server.world();
   std::string out = "{\"type\": \"snapshot\"";
   if (!id.is_null()) out += ", \"id\": " + id.dump();
   append_clock(out, server, clock);
+  out += ", \"arena\": " + arena.dump();
   out += ", \"walls\": ";
   append_walls(out, server, 0);
   out += ", \"balls\": {\"ids\": [";

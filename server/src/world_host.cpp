@@ -266,6 +266,17 @@ void WorldHost::fan_out_events() {
 void WorldHost::end_world(const std::string& reason) {
   ended_ = reason;
   spdlog::error("the world ended at t={}: {}", fmt(server_->time()), reason);
+  // Changes waiting for a boundary that will not come are answered now.
+  auto refuse = [&](std::uint64_t client, const json& id, const char* request) {
+    auto it = clients_.find(client);
+    if (it == clients_.end()) return;
+    ++it->second.errors;
+    reply_text(it->second, error_text("ended", "the world has ended (" + reason + ") before the change was made", &id, request));
+  };
+  for (const WallChange& w : wall_changes_) refuse(w.client, w.id, "add_wall");
+  for (const Takeover& t : takeovers_) refuse(t.client, t.id, "claim");
+  wall_changes_.clear();
+  takeovers_.clear();
   broadcast_status();
 }
 
@@ -554,7 +565,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     r["format"] = k.binary ? "binary" : "json";
     r["velocities"] = k.velocities;
     reply(c, r);
-    reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr));
+    reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"]));
     return;
   }
   if (type == "unsubscribe") {
@@ -563,7 +574,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     return;
   }
   if (type == "snapshot") {
-    reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), id));
+    reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), id, world_json()["arena"]));
     return;
   }
   if (type == "spawn" || type == "remove" || type == "teleport")
@@ -660,13 +671,13 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     require_live();
     const std::string ex = "{\"type\": \"" + type + "\", \"turtle\": \"t1\"" + (type == "pen" ? ", \"down\": true}" : type == "yield" ? "}" : ", \"amount\": 100}");
     const std::size_t i = turtle_index(m, ex.c_str());
+    const turtle::RemoteCommand cmd = read_command(m, type);  // the message first, then the turtle's state
     Slot& s = slots_[i];
     const std::string& tid = scene_.def.turtles[i].id;
     if (s.owner != c.client->id)
       throw RequestError("not_claimed", "/turtle: claim '" + tid + "' first: {\"type\": \"claim\", \"turtle\": \"" + tid + "\"}", "/turtle");
     if (s.busy)
       throw RequestError("busy", "/turtle: '" + tid + "' has not finished its previous command; wait for its result", "/turtle");
-    const turtle::RemoteCommand cmd = read_command(m, type);
     if (server_->turtle_status(i).finished)
       throw RequestError("refused", "/turtle: '" + tid + "' is parked for good (its program stopped: " + server_->turtle_status(i).fault + ")", "/turtle");
     s.queued = cmd;
@@ -875,7 +886,7 @@ void WorldHost::do_file_requests() {
     if (it != clients_.end()) reply(it->second, ok(json{{"id", f.id}}, "load"));
     broadcast(dump({{"type", "world"}, {"world", world_json()}}));
     for (auto& [cid, c] : clients_)
-      if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr));
+      if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"]));
   }
 }
 

@@ -36,9 +36,11 @@ struct FrameClock {
   nlohmann::json speed;  ///< a number or "max"
 };
 
-/// The snapshot message; `id` echoed when not null. `claimed[i]`: turtle i is claimed.
+/// The snapshot message; `id` echoed when not null. `claimed[i]`: turtle i is claimed; `arena`
+/// the arena's JSON object ({"width", "height", "boundary"}).
 std::string snapshot_text(const turtle::WorldServer& server, const formats::IdTable& ball_ids,
-                          const std::vector<bool>& claimed, const FrameClock& clock, const nlohmann::json& id);
+                          const std::vector<bool>& claimed, const FrameClock& clock, const nlohmann::json& id,
+                          const nlohmann::json& arena);
 
 /// The frames of one subscription kind.
 class FrameStream {
