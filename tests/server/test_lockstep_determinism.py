@@ -5,9 +5,13 @@ follower give the same event log, byte for byte, as controllers/wall_follower.cp
 and the input log the server wrote replays headless (`run --inputs`) to the same log again."""
 
 import os
+import queue
+import subprocess
 import tempfile
+import threading
+import time
 
-from harness import ROOT, Server, check, main, run, world
+from harness import BIN, ROOT, Server, check, main, run, world
 from turtlegas_client import World
 import importlib.util
 
@@ -43,5 +47,67 @@ def test_python_lockstep_equals_cpp_headless():
         check(open(replay_log, "rb").read() != served, "without the inputs the log differs")
 
 
+def wait_paused(w, seconds=30):
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if w.status and w.status["paused"]:
+            return
+        try:
+            n = w.notices.get(timeout=1)
+            if n.get("type") == "status":
+                w.status = n["status"]
+        except queue.Empty:
+            pass
+    check(False, "the world paused")
+
+
+def test_takeover_and_add_wall_replay():
+    """A takeover of a C++ turtle and an added wall are inputs too: the log replays headless."""
+    src = os.path.join(ROOT, "worlds", "wall_follower.json")
+    with tempfile.TemporaryDirectory() as d:
+        served, replay, inputs, plain = (os.path.join(d, n) for n in ("served.jsonl", "replay.jsonl", "inputs.jsonl", "plain.jsonl"))
+        with Server(src, "--speed", "max", "--paused", "--until", 20, "--events", served, "--inputs-out", inputs) as s:
+            w = World.connect("127.0.0.1", s.line_port)
+            w.step(40)
+            wait_paused(w)
+            claim = {}
+            th = threading.Thread(target=lambda: claim.setdefault("t", w.claim("righty", takeover=True)))
+            th.start()  # answered at the next boundary
+            time.sleep(0.2)
+            w.step(1)
+            th.join(timeout=30)
+            righty = claim["t"]
+            pending = threading.Thread(target=lambda: claim.setdefault(
+                "wall", w.request({"type": "add_wall", "wall": {"id": "fence", "from": [20, 380], "to": [120, 380]}})))
+            pending.start()
+            w.resume()
+            World.run_turtles({righty: lambda t: wf.wall_follower(t, right_hand=False)})
+            pending.join(timeout=30)
+            check(claim.get("wall", {}).get("type") == "ok", "the wall was added: %r" % claim.get("wall"))
+            check(s.wait(30) == 0, "serve exits at --until")
+        text = open(inputs).read()
+        check('"takeover": "righty"' in text and '"add_wall"' in text, "the input log has the takeover and the wall")
+        log = open(served, "rb").read()
+        check(b'"takeover"' in log and b'"wall-added"' in log, "the event log has them too")
+        run(["run", src, "--until", 20, "--inputs", inputs, "--events", replay])
+        check(open(replay, "rb").read() == log, "the input log replays headless to the same event log")
+        run(["run", src, "--until", 20, "--events", plain])
+        check(open(plain, "rb").read() != log, "and differs from the run without it")
+
+
+def test_bad_input_logs_are_bad_input():
+    with tempfile.TemporaryDirectory() as d:
+        bad = os.path.join(d, "bad.jsonl")
+        for text, words in (("", "empty"), ('{"format": "other"}\n', "/format"),
+                            ('{"format": "turtlegas-inputs/1"}\n{"step": 0, "turtle": "nobody", "command": "forward", "amount": 1}\n', "nobody"),
+                            ('{"format": "turtlegas-inputs/1"}\n{"step": 0, "turtle": "righty", "command": "fly"}\n', "/command"),
+                            ('{"format": "turtlegas-inputs/1"}\nnot json\n', "bad.jsonl:2")):
+            open(bad, "w").write(text)
+            r = subprocess.run([BIN, "run", world("remote_followers.json"), "--until", "1", "--inputs", bad],
+                               capture_output=True, text=True, timeout=60)
+            check(r.returncode == 2 and words in r.stderr and "bad.jsonl" in r.stderr,
+                  "exit 2 naming the file and the problem (%s): %d %s" % (words, r.returncode, r.stderr))
+
+
 if __name__ == "__main__":
-    main([test_python_lockstep_equals_cpp_headless])
+    main([test_python_lockstep_equals_cpp_headless, test_takeover_and_add_wall_replay, test_bad_input_logs_are_bad_input])
