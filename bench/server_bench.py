@@ -77,6 +77,7 @@ class WsCounter(threading.Thread):
         self.bytes = self.frames = 0
         self.counting = False
         self.stop = False
+        self.binary = False
 
     def run(self):
         while not self.stop:
@@ -89,9 +90,12 @@ class WsCounter(threading.Thread):
             elif n == 127:
                 n = struct.unpack("!Q", self.f.read(8))[0]
             self.f.read(n)
-            if self.counting and h[0] & 0x0F == 2:
+            opcode = h[0] & 0x0F
+            if self.counting and opcode in (0, 2):  # a binary message, or a continuation of one
                 self.bytes += n
-                self.frames += 1
+                self.frames += 1 if (h[0] & 0x80) and (opcode == 2 or self.binary) else 0
+            if opcode in (1, 2):
+                self.binary = opcode == 2
 
 
 def frames_bench(n_balls, viewers, transport, seconds, d):

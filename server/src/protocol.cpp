@@ -147,7 +147,8 @@ json touch_json(const turtle::Touch& touch) {
   if (touch.sensor_names)
     for (std::size_t k = 0; k < touch.sensor_names->size(); ++k)
       if (touch.fired(k)) names.push_back((*touch.sensor_names)[k]);
-  return {{"sensors", names}, {"bits", touch.sensors}, {"bearing", touch.bearing}, {"what", touch.what},
+  const double bearing = touch.bearing == 0.0 ? 0.0 : touch.bearing;  // no "-0.0"
+  return {{"sensors", names}, {"bits", touch.sensors}, {"bearing", bearing}, {"what", touch.what},
           {"kind", touch.kind}, {"t", touch.t}};
 }
 

@@ -19,6 +19,7 @@ WebSocketSession::WebSocketSession(boost::asio::ip::tcp::socket&& socket, WorldH
 void WebSocketSession::run(beast::http::request<beast::http::string_body> req) {
   ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
   ws_.read_message_max(host_.options().limits.max_websocket_read);
+  ws_.auto_fragment(false);  // a frame goes out as one WebSocket frame
   ws_.async_accept(req, [self = std::static_pointer_cast<WebSocketSession>(shared_from_this())](beast::error_code ec) {
     if (ec) return;
     self->opened();
