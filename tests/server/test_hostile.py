@@ -201,5 +201,31 @@ def test_connection_limit():
         check(s.stop() == 0, "stops")
 
 
+def test_claim_limit_and_disconnect_release():
+    with Server(world("remote_followers.json"), "--max-claims", 1, "--speed", "max", "--lockstep-timeout", 5) as s:
+        a = World.connect("127.0.0.1", s.line_port)
+        a.claim("righty")
+        try:
+            a.claim("lefty")
+            check(False, "a second claim is over --max-claims 1")
+        except Exception as e:
+            check(e.reply["code"] == "too_many_claims", "too_many_claims: %r" % e.reply)
+        b = World.connect("127.0.0.1", s.line_port)
+        try:
+            b.claim("righty")
+            check(False, "righty is a's")
+        except Exception as e:
+            check(e.reply["code"] == "claimed", "claimed: %r" % e.reply)
+        t0 = b.ping()["t"]
+        a.close()  # a's turtle is released: the lockstep world does not wait for it
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and b.ping()["t"] <= t0 + 1:
+            time.sleep(0.05)
+        check(b.ping()["t"] > t0 + 1 and not b.status["ended"], "the world goes on without a's turtle")
+        righty = b.claim("righty")
+        check(righty.forward(5).done == 5, "and another connection can claim and drive it")
+        check(s.stop() == 0, "stops")
+
+
 if __name__ == "__main__":
-    main([test_thousand_hostile_messages, test_rate_limit, test_connection_limit])
+    main([test_thousand_hostile_messages, test_rate_limit, test_connection_limit, test_claim_limit_and_disconnect_release])
