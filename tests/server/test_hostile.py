@@ -26,6 +26,8 @@ COMMON = [
     ('{"type": "explode"}', "unknown_type"), ('{"type": "hello", "protocol": "turtlegas/0"}', "bad_protocol"),
     ('{"type": "hello"}', "missing_field"), ('{"type": "ping", "id": {"a": 1}}', "bad_value"),
     ('{"type": "' + "x" * 5000 + '"}', "unknown_type"),
+    ("[" * 30000 + "]" * 30000, "not_object"), ("[" * 30000, "bad_json"),
+    ('{"type": "ping", "id": ' + "[" * 20000 + "]" * 20000 + "}", "bad_value"),
 ]
 NO_HELLO = COMMON + [
     ('{"type": "pause"}', "hello_first"), ('{"type": "claim", "turtle": "t1"}', "hello_first"),
