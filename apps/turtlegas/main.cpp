@@ -18,6 +18,7 @@
 #include "controllers_command.hpp"
 #include "plugins.hpp"
 #include "run_command.hpp"
+#include "serve_command.hpp"
 #include "tag_command.hpp"
 #include "test_command.hpp"
 #include "turtlegas/controllers/registry.hpp"
@@ -60,6 +61,10 @@ int run(int argc, char** argv) {
   CLI::App* tag = add_tag_command(app, tag_opt);
   tag->add_option("--plugin", plugins, plugin_help);
 
+  ServeCommandOptions serve_opt;  // `turtlegas serve` (serve_command.hpp)
+  CLI::App* serve = add_serve_command(app, serve_opt);
+  serve->add_option("--plugin", plugins, plugin_help);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -73,6 +78,7 @@ int run(int argc, char** argv) {
     if (*check) return check_command(check_world, registry);
     if (*test) return test_command(test_opt, registry);
     if (*tag) return run_tag_command(tag_opt, registry);
+    if (*serve) return serve_command(serve_opt, registry);
     return run_command(run_line.options(), registry);
   } catch (const BadInput& e) {
     spdlog::error("{}", e.what());

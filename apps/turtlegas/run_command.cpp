@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
@@ -19,6 +20,7 @@
 #include "atomic_file.hpp"
 #include "cli_common.hpp"
 #include "turtlegas/formats/event_log.hpp"
+#include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/names.hpp"
 #include "turtlegas/formats/state_file.hpp"
 #include "turtlegas/formats/stats_file.hpp"
@@ -154,6 +156,8 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
   run->add_option("--stats-json", opt.stats_json, "Write the run's statistics here (JSON)");
   run->add_option("--svg", opt.svg, "Write an SVG picture of the final state here");
   run->add_option("--plugin", plugins, plugin_help);
+  run->add_option("--inputs", opt.inputs,
+                  "Replay this input log (written by `turtlegas serve --inputs-out`) into the world's remote turtles");
   run->add_option("--stack-kib", opt.stack_kib, "Each turtle program's stack, KiB (a guard page is added)")
       ->capture_default_str();
   run->add_option("--program-budget", opt.program_budget,
@@ -198,7 +202,17 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   // turtles (which then owns the engine).
   std::optional<sim::World> bare;
   std::unique_ptr<turtle::WorldServer> server;
-  if (def.turtles.empty()) {
+  std::shared_ptr<formats::ReplayInput> replay;
+  if (!opt.inputs.empty()) {
+    std::ifstream in(opt.inputs);
+    if (!in) throw BadInput("--inputs: cannot read '" + opt.inputs + "'");
+    try {
+      replay = std::make_shared<formats::ReplayInput>(in, def, opt.inputs);
+    } catch (const std::invalid_argument& e) {
+      throw BadInput(std::string("--inputs: ") + e.what());
+    }
+  }
+  if (def.turtles.empty() && !replay) {
     // The World takes the balls over, so that the scene's copy of them (and their ids' strings)
     // and the engine are never in memory together: a million balls then cost about 170 bytes each
     // rather than 260. def keeps everything else.
@@ -234,6 +248,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     options.mode = mode;
     options.stack_bytes = opt.stack_kib * 1024;
     options.program_budget = opt.program_budget;
+    options.input = replay;
     server = make_server(scene, registry, options, opt.world);
     totals.energy_start = server->world().energy();
     // The log is always kept: touches and faults are counted from it.

@@ -21,6 +21,7 @@ struct RunOptions {
   std::string mode = "exact";
   std::optional<double> dt;
   std::string events, state_out, stats_json, svg;
+  std::string inputs;  ///< an input log to replay (docs/protocol.md, "The input log")
   bool stats = false;
   std::size_t stack_kib = 32;   ///< each turtle program's stack
   double program_budget = 2.0;  ///< wall-clock seconds a program may run without a command

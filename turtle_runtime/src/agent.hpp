@@ -13,6 +13,7 @@
 #include "fiber.hpp"
 #include "mt64.hpp"
 #include "turtlegas/sim/world.hpp"
+#include "turtlegas/turtle/remote.hpp"
 #include "turtlegas/turtle/turtle.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
@@ -37,6 +38,8 @@ class alignas(64) Agent {
   bool finished = false;
   bool waiting = false;    // suspended in issue(), for finish_command() to answer
   bool lays_wall = false;  // the command waited on lays a wall (the pen in wall mode, a move)
+  bool remote = false;       // runs the remote program (remote.hpp, remote.cpp)
+  bool wants_input = false;  // the remote program is suspended in await_remote()
   sim::TurtleCommand::Kind waiting_on = sim::TurtleCommand::Kind::stop;
   bool pen_down = false;
   bool it = false;                            // the game's role, as Turtle::it() reports it
@@ -60,8 +63,12 @@ class alignas(64) Agent {
   std::size_t walls_laid = 0;                 // k of the next `<id>-w<k>`
   std::string fault;
   sim::Vec2 stroke_start;                     // where the wall pen's stroke began
+  std::optional<RemoteCommand> remote_input;  // the InputSource's command, for await_remote()
 
   Result issue(sim::TurtleCommand c);
+  /// The remote program's wait for its next command (remote.cpp): suspends until the scheduler
+  /// has one, delivering touches and messages that arrive meanwhile.
+  RemoteCommand await_remote();
   /// The touch and message handlers, on the program's stack (they may issue commands).
   [[gnu::noinline]] void deliver();
   [[noreturn, gnu::noinline, gnu::cold]] void not_own_program() const;
@@ -83,5 +90,10 @@ class alignas(64) Agent {
   }
   void prefetch_sensors() const { __builtin_prefetch(program.sensors.data()); }
 };
+
+namespace detail {
+/// The remote program (remote.cpp), bound to agent a: what a remote turtle's fiber runs.
+Controller remote_program_for(Agent& a);
+}  // namespace detail
 
 }  // namespace turtlegas::turtle

@@ -76,4 +76,13 @@ void WorldServer::Impl::lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to) {
   emit({now, "wall-drawn", a.id, w.id, {}, 0.0, {}});
 }
 
+void WorldServer::add_wall(const sim::WallDef& wall) {
+  Impl& s = *impl_;
+  if (wall.id.empty()) throw std::invalid_argument("a wall needs an id");
+  if (s.id_taken(wall.id))
+    throw std::invalid_argument("id '" + wall.id + "' is taken; give the wall an id that no wall, ball or turtle has");
+  s.world.add_wall(wall);  // throws std::invalid_argument, changing nothing
+  s.emit({s.world.time(), "wall-added", wall.id, {}, {}, 0.0, {}});
+}
+
 }  // namespace turtlegas::turtle

@@ -17,6 +17,7 @@
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/turtle/event_names.hpp"
 #include "turtlegas/turtle/game.hpp"
+#include "turtlegas/turtle/remote.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
 namespace turtlegas::turtle {
@@ -33,12 +34,23 @@ class WorldServer::Impl : public GameHost {
   std::vector<std::uint32_t> idle;  // control_step's candidates, kept for their capacity
   std::uint64_t step = 0;        // index of the next control boundary
   bool boundary_done = false;    // whether the programs have run at boundary `step`
+  WorldServer* self = nullptr;   // for the InputSource's at_boundary
+  std::vector<RemoteReport> reports;  // the remote programs' reports, until flush_reports()
 
-  Impl(sim::WorldDef d, ServerOptions o) : def(std::move(d)), world(def, o.mode), options(o) {}
+  Impl(sim::WorldDef d, ServerOptions o) : def(std::move(d)), world(def, o.mode), options(std::move(o)) {}
 
   double boundary_time(std::uint64_t k) const { return sim::control_boundary(k, def.dt); }
   void control_step();
   void run_program(Agent& a);
+  /// One turn of a's program; true when it is a remote program to be resumed again at once.
+  bool resume(Agent& a);
+  // Remote turtles (remote.cpp).
+  /// Whether to resume remote agent a now: it has touches or messages to take, or the
+  /// InputSource gave it a command. Flushes the reports first, so a lockstep client has them.
+  bool feed_remote(Agent& a);
+  void flush_reports();
+  /// A report of agent a, with the turtle's state as its program sees it now.
+  RemoteReport report_of(const Agent& a, RemoteReport::Kind kind) const;
   void finish_command(Agent& a);
   void drain_sim_events();
   void lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to);

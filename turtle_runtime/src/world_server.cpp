@@ -18,6 +18,7 @@
 #include "turtlegas/sim/angles.hpp"
 #include "turtlegas/turtle/event_names.hpp"
 #include "turtlegas/turtle/game.hpp"
+#include "turtlegas/turtle/remote.hpp"
 
 namespace turtlegas::turtle {
 namespace {
@@ -58,14 +59,15 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
     a->index = k;
     a->id = def.turtles[k].id;
     a->program = std::move(programs[k]);
-    const Controller* controller = registry.find(a->program.controller);
-    if (!controller)  // Registry::require's message; its context built only when it is needed
+    a->remote = a->program.controller == remote_controller_name;  // the runtime's own program (remote.cpp)
+    const Controller* controller = a->remote ? nullptr : registry.find(a->program.controller);
+    if (!controller && !a->remote)  // Registry::require's message; its context built only when it is needed
       throw std::invalid_argument("turtle '" + a->id + "': " + registry.not_registered(a->program.controller));
     if (a->program.sensors.empty() || a->program.sensors.size() > 64)
       throw std::invalid_argument("turtle '" + a->id + "' needs 1 to 64 sensors (has " +
                                   std::to_string(a->program.sensors.size()) + ")");
     for (const SensorArc& arc : a->program.sensors) a->sensor_names.push_back(arc.name);
-    a->controller = *controller;
+    a->controller = a->remote ? detail::remote_program_for(*a) : *controller;
     a->params = Params(a->program.params);
     a->pen_down = a->program.pen_down || a->program.pen_walls;
     if (a->program.pen_walls) {
@@ -78,6 +80,7 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
     impl_->agents.push_back(std::move(a));
   }
   impl_->world.set_event_log(&impl_->sim_log);
+  impl_->self = this;
 }
 
 WorldServer::~WorldServer() = default;
@@ -94,6 +97,14 @@ void WorldServer::Impl::run_program(Agent& a) {
         options.stack_bytes);
   }
   if (a.waiting) finish_command(a);
+  // A remote program waiting for its next command is resumed only when there is something for it
+  // (remote.cpp); it may take several turns at one boundary (its touches first, pen commands).
+  if (a.wants_input && !feed_remote(a)) [[unlikely]] return;
+  while (resume(a)) {
+  }
+}
+
+bool WorldServer::Impl::resume(Agent& a) {
   const auto outcome = a.fiber->resume(options.program_budget);
   const double now = world.time();
   auto park = [&](const std::string& fault) {
@@ -103,6 +114,11 @@ void WorldServer::Impl::run_program(Agent& a) {
     if (!fault.empty()) {
       spdlog::error("turtle '{}' stopped at t={:.6g}: {}", a.id, now, fault);
       emit({now, "fault", a.id, {}, {}, 0.0, fault});
+      if (a.remote) [[unlikely]] {
+        RemoteReport r = report_of(a, RemoteReport::Kind::fault);
+        r.fault = fault;
+        reports.push_back(std::move(r));
+      }
     }
   };
   switch (outcome) {
@@ -111,8 +127,9 @@ void WorldServer::Impl::run_program(Agent& a) {
         world.command_turtle(a.index, *a.command);
         if (a.command->kind == sim::TurtleCommand::Kind::move && a.command->amount != 0.0) a.in_contact.clear();
         a.command.reset();
+        return false;
       }
-      return;
+      return a.wants_input && feed_remote(a);  // a remote program that took its touches, or ran a pen command
     case detail::Fiber::Outcome::finished:
       if (auto err = a.fiber->error()) {
         std::string what = "its program threw a non-standard exception";
@@ -126,11 +143,11 @@ void WorldServer::Impl::run_program(Agent& a) {
       } else {
         park({});  // the program returned: the turtle stays parked where it is
       }
-      return;
+      return false;
     case detail::Fiber::Outcome::stack_overflow:
       park("its program overflowed its stack (" + std::to_string(options.stack_bytes / 1024) +
            " KiB); deep recursion or large locals? raise the stack size with --stack-kib");
-      return;
+      return false;
     case detail::Fiber::Outcome::over_budget:
       a.finished = true;
       a.fault = "busy loop";
@@ -139,9 +156,12 @@ void WorldServer::Impl::run_program(Agent& a) {
                           " s of wall time without issuing a command (a busy loop?); the run stops at t=" +
                           std::to_string(now));
   }
+  return false;
 }
 
 void WorldServer::Impl::control_step() {
+  // 0. The host's changes to the world, at this boundary.
+  if (options.input) options.input->at_boundary(*self, step);
   // 1. Contacts of the previous step become interrupts.
   const double now = world.time();
   const std::vector<sim::TurtleContact> contacts = world.take_turtle_contacts();
@@ -193,6 +213,7 @@ void WorldServer::Impl::control_step() {
     if (a.finished) continue;
     run_program(a);
   }
+  flush_reports();
 }
 
 void WorldServer::Impl::drain_sim_events() {
@@ -227,6 +248,7 @@ void WorldServer::run_until(double t) {
 }
 
 double WorldServer::time() const { return impl_->world.time(); }
+std::uint64_t WorldServer::step() const { return impl_->step; }
 const sim::World& WorldServer::world() const { return impl_->world; }
 void WorldServer::set_event_log(std::vector<LogEvent>* log) { impl_->log = log; }
 void WorldServer::set_game(std::unique_ptr<Game> game) {
@@ -238,11 +260,29 @@ const Game* WorldServer::game() const { return impl_->game.get(); }
 std::size_t WorldServer::turtle_count() const { return impl_->agents.size(); }
 
 WorldServer::TurtleInfo WorldServer::turtle(std::size_t i) const {
-  const Agent& a = *impl_->agents[i];
-  TurtleInfo info{a.id, impl_->world.turtle(i), a.pen_down, a.finished, a.fault, a.trail};
-  if (a.pen_down) info.trail.push_back(info.state.pos);
+  TurtleInfo info = turtle_status(i);
+  info.trail = impl_->agents[i]->trail;
+  if (info.pen_down) info.trail.push_back(info.state.pos);
   return info;
 }
+
+WorldServer::TurtleInfo WorldServer::turtle_status(std::size_t i) const {
+  const Agent& a = *impl_->agents.at(i);
+  TurtleInfo info{a.id, impl_->world.turtle(i), a.pen_down, a.finished, a.fault, {}};
+  info.pen_mode = a.pen_mode;
+  info.it = a.it;
+  info.remote = a.remote;
+  return info;
+}
+
+std::vector<sim::Vec2> WorldServer::trail_since(std::size_t i, std::size_t from) const {
+  const std::vector<sim::Vec2>& trail = impl_->agents.at(i)->trail;
+  if (from >= trail.size()) return {};
+  return {trail.begin() + static_cast<std::ptrdiff_t>(from), trail.end()};
+}
+
+std::size_t WorldServer::trail_size(std::size_t i) const { return impl_->agents.at(i)->trail.size(); }
+const std::string& WorldServer::controller(std::size_t i) const { return impl_->agents.at(i)->program.controller; }
 
 std::size_t WorldServer::stack_reservation() const {
   for (const auto& a : impl_->agents)

@@ -9,6 +9,7 @@
 #include "reader.hpp"
 #include "turtlegas/sim/angles.hpp"
 #include "turtlegas/sim/suggest.hpp"
+#include "turtlegas/turtle/remote.hpp"
 #include "turtlegas/turtle/script.hpp"
 
 namespace turtlegas::world::detail {
@@ -52,7 +53,8 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
 
     if (const json* x = find(t, "controller")) {
       program.controller = string(*x, at(p, "controller"));
-      if (registry_ && !registry_->find(program.controller))
+      // "remote" is the runtime's own program (turtle/remote.hpp), in no registry.
+      if (registry_ && program.controller != turtle::remote_controller_name && !registry_->find(program.controller))
         fail(at(p, "controller"), registry_->not_registered(program.controller));
     }
     if (const json* x = find(t, "params")) {

@@ -3,6 +3,8 @@
 // coroutines between physics steps.
 //
 // Order of one control step, at t = k dt (AI Memo 272, "On simulating turtles"):
+//   0. If ServerOptions::input is set, its at_boundary(k) runs first: the host's changes to the
+//      world (add_wall, make_remote) happen here, at a boundary, so that they are part of the run.
 //   1. Contacts that involved turtles during the previous step become touch interrupts.
 //   1a. If the world has a game (set_game), its referee sees those contacts and may change roles
 //      (Turtle::it()), queue messages for programs and log events (a `tag`), all at t.
@@ -17,12 +19,16 @@
 //   3. The physics advances every body to (k+1) dt, earliest collision first. A turtle that
 //      touches something stops at the contact point at the exact contact time; its command ends
 //      there and the interrupt waits for the next step.
+// A remote turtle (controller "remote", remote.hpp) is a program like the others whose commands
+// come from ServerOptions::input, asked for in step 2 at its turn.
 // Pacing (wall clock) never enters: the same world, seed and programs give the same event log.
 // Threads: every WorldServer of a process runs its programs on one thread (the fibers' fault
 // handling is process-wide; see src/fiber.hpp).
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -70,12 +76,21 @@ struct TurtleProgram {
 /// Throws std::invalid_argument when no bit is free.
 sim::WorldDef with_builder_layers(sim::WorldDef def, const std::vector<TurtleProgram>& programs);
 
+class InputSource;   // remote.hpp
+struct RemoteReport;  // remote.hpp
+
 struct ServerOptions {
   sim::Mode mode = sim::Mode::exact;
   std::size_t stack_bytes = 32 * 1024;  ///< each program's stack, plus a guard page
   /// Wall-clock seconds a program may run without issuing a command before the run is stopped as a
   /// busy loop. Wall clock, not simulated time: it only ever ends a run, never changes one.
   double program_budget = 2.0;
+  /// Where remote turtles' commands come from, and the hook for changes at boundaries
+  /// (remote.hpp). None: remote turtles stand still.
+  std::shared_ptr<InputSource> input;
+  /// Where remote turtles' programs report touches, messages, results and faults (remote.hpp),
+  /// called from inside run_until before each InputSource::next and at the end of each step.
+  std::function<void(const RemoteReport&)> remote_reports;
 };
 
 /// The busy-loop stop: a program ran past its budget without issuing a command.
@@ -95,9 +110,13 @@ class WorldServer {
   WorldServer(const WorldServer&) = delete;
   WorldServer& operator=(const WorldServer&) = delete;
 
-  /// Runs control steps until time t (seconds). Throws BusyLoopError if a program hangs.
+  /// Runs control steps until time t (seconds). Throws BusyLoopError if a program hangs, and
+  /// whatever the InputSource throws; after an exception the server must not be run further.
   void run_until(double t);
   double time() const;
+  /// The index of the control boundary last reached (time() == step() * dt there; run_until(t)
+  /// runs the programs of a boundary at t, and the physics stops at t).
+  std::uint64_t step() const;
   const sim::World& world() const;
 
   /// When set, events are appended to *log (nullptr stops).
@@ -117,9 +136,33 @@ class WorldServer {
     bool finished = false;  ///< the program returned (the turtle is parked)
     std::string fault;      ///< non-empty when the program failed (threw, overflowed its stack)
     std::vector<sim::Vec2> trail;  ///< pen-down path, in world units
+    PenMode pen_mode = PenMode::line;
+    bool it = false;      ///< "it" in the world's game
+    bool remote = false;  ///< runs the remote program (remote.hpp)
   };
   std::size_t turtle_count() const;
+  /// Turtle i with its whole trail (and the live tip, its position, when the pen is down).
   TurtleInfo turtle(std::size_t i) const;
+  /// Turtle i without its trail (TurtleInfo::trail empty): for frames, which send trails by parts.
+  TurtleInfo turtle_status(std::size_t i) const;
+  /// The pen-down path's committed points (those a command's end or a pen_down added) from index
+  /// `from` on; without the live tip. Empty when from >= trail_size(i).
+  std::vector<sim::Vec2> trail_since(std::size_t i, std::size_t from) const;
+  std::size_t trail_size(std::size_t i) const;
+  /// The controller turtle i runs now ("remote" once make_remote made it so).
+  const std::string& controller(std::size_t i) const;
+  bool is_remote(std::size_t i) const;
+
+  /// Changes for an InputSource's at_boundary (remote.hpp), at the current boundary:
+  /// Adds a wall now, as sim::World::add_wall does, and logs a `wall-added` event. Throws
+  /// std::invalid_argument, changing nothing, for an id that is taken or a wall the engine
+  /// refuses (zero length, outside a periodic arena, overlapping a body).
+  void add_wall(const sim::WallDef& wall);
+  /// Detaches turtle i's program (a command it was running stops now) and gives the turtle the
+  /// remote program from this boundary on; logs a `takeover` event. Touches and messages not yet
+  /// delivered go to the remote program. Throws std::logic_error if the turtle is remote already
+  /// or when not called from InputSource::at_boundary.
+  void make_remote(std::size_t i);
   /// Bytes of program stack actually reserved per turtle (stack plus guard page).
   std::size_t stack_reservation() const;
 

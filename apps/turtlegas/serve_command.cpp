@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: MIT
+#include "serve_command.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+#include "cli_common.hpp"
+#include "turtlegas/server/serve.hpp"
+#include "turtlegas/sim/mode_names.hpp"
+
+namespace turtlegas::apps {
+
+CLI::App* add_serve_command(CLI::App& app, ServeCommandOptions& opt) {
+  CLI::App* s = app.add_subcommand("serve", "Run a world in real time and serve it on the network (docs/protocol.md)");
+  s->add_option("world", opt.world, "World file (format turtlegas-world/1)")->required();
+  s->add_option("--bind", opt.bind, "Address to listen on; other than loopback needs --token")->capture_default_str();
+  s->add_option("--port", opt.port, "HTTP and WebSocket port (0: any free port)")->capture_default_str();
+  s->add_option("--line-port", opt.line_port, "TCP-lines port (default: --port + 1; any free port when --port is 0)");
+  s->add_option("--speed", opt.speed, "Simulated seconds per wall second, 0.01 to 1000, or max")->capture_default_str();
+  s->add_flag("--paused", opt.paused, "Start paused");
+  s->add_option("--token", opt.token, "Token that control messages and claims need");
+  s->add_option("--until", opt.until, "Stop at this simulated time, as on SIGINT");
+  s->add_option("--events", opt.events, "Write the event log here (JSON lines, as `run --events`)");
+  s->add_option("--inputs-out", opt.inputs_out, "Write the input log here (replay with `run --inputs`)");
+  s->add_option("--save-dir", opt.save_dir, "The only directory save and load may touch");
+  s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the source tree's server/web)");
+  s->add_option("--max-clients", opt.max_clients, "Connections at most (WebSocket and TCP lines)")->capture_default_str();
+  s->add_option("--max-claims", opt.max_claims, "Claimed turtles per connection at most")->capture_default_str();
+  s->add_option("--max-message", opt.max_message, "Bytes per message at most")->capture_default_str();
+  s->add_option("--max-rate", opt.max_rate, "Messages per second per connection at most")->capture_default_str();
+  s->add_option("--lockstep-timeout", opt.lockstep_timeout,
+                "Wall seconds a lockstep world waits for a claimed turtle's command before it ends")
+      ->capture_default_str();
+  s->add_option("--mode", opt.mode, "exact (event-driven) or step (the memo's fixed steps)")
+      ->check(CLI::IsMember(sim::mode_names))
+      ->capture_default_str();
+  s->add_flag("--realtime", opt.realtime, "Remote turtles never hold the world up (default: lockstep)");
+  s->add_option("--stack-kib", opt.stack_kib, "Each turtle program's stack, KiB")->capture_default_str();
+  s->add_option("--program-budget", opt.program_budget,
+                "Wall-clock seconds a turtle program may run without issuing a command before its world ends")
+      ->capture_default_str();
+  return s;
+}
+
+int serve_command(const ServeCommandOptions& opt, const turtle::Registry& registry) {
+  server::ServeOptions so;
+  so.bind = opt.bind;
+  if (opt.port > 65535) throw BadInput("--port must be from 0 to 65535 (got " + std::to_string(opt.port) + ")");
+  so.port = static_cast<unsigned short>(opt.port);
+  if (opt.line_port) {
+    if (*opt.line_port > 65535) throw BadInput("--line-port must be from 0 to 65535");
+    so.line_port = static_cast<unsigned short>(*opt.line_port);
+  }
+  so.web_root = opt.web_root;
+
+  server::HostOptions& h = so.host;
+  if (opt.speed == "max") {
+    h.speed = 0.0;
+  } else {
+    try {
+      std::size_t used = 0;
+      h.speed = std::stod(opt.speed, &used);
+      if (used != opt.speed.size()) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      throw BadInput("--speed must be a number from 0.01 to 1000, or max (got '" + opt.speed + "')");
+    }
+    if (!(h.speed >= 0.01 && h.speed <= 1000.0))
+      throw BadInput("--speed must be from 0.01 to 1000, or max (got " + opt.speed + ")");
+  }
+  if (opt.until && (!std::isfinite(*opt.until) || *opt.until < 0.0))
+    throw BadInput("--until must be a finite time >= 0 in seconds");
+  if (!(opt.lockstep_timeout > 0.0 && std::isfinite(opt.lockstep_timeout)))
+    throw BadInput("--lockstep-timeout must be a finite number of seconds > 0");
+  if (!(opt.max_rate > 0.0)) throw BadInput("--max-rate must be > 0");
+  if (opt.max_message < 64) throw BadInput("--max-message must be at least 64 bytes");
+  if (opt.max_clients < 1) throw BadInput("--max-clients must be at least 1");
+  if (opt.stack_kib < 16 || opt.stack_kib > 1024 * 1024) throw BadInput("--stack-kib must be from 16 to 1048576");
+  if (!(opt.program_budget > 0.0 && std::isfinite(opt.program_budget))) throw BadInput("--program-budget must be > 0");
+  h.world_file = opt.world;
+  h.mode = sim::mode_from_string(opt.mode).value_or(sim::Mode::exact);
+  h.realtime = opt.realtime;
+  h.paused = opt.paused;
+  h.until = opt.until;
+  h.events_path = opt.events;
+  h.inputs_path = opt.inputs_out;
+  if (!opt.save_dir.empty()) {
+    std::error_code fe;
+    if (!std::filesystem::is_directory(opt.save_dir, fe))
+      throw BadInput("--save-dir: '" + opt.save_dir + "' is not a directory; create it first");
+    h.save_dir = std::filesystem::canonical(opt.save_dir, fe);
+  }
+  if (!opt.token.empty()) h.token = opt.token;
+  h.lockstep_timeout = opt.lockstep_timeout;
+  h.stack_bytes = opt.stack_kib * 1024;
+  h.program_budget = opt.program_budget;
+  h.limits.max_clients = opt.max_clients;
+  h.limits.max_claims = opt.max_claims;
+  h.limits.max_message = opt.max_message;
+  h.limits.max_rate = opt.max_rate;
+  if (h.limits.max_websocket_read < opt.max_message) h.limits.max_websocket_read = opt.max_message;
+
+  world::Scene scene = load(opt.world, registry);
+  {
+    std::ifstream in(opt.world, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    h.world_text = text.str();
+  }
+  try {
+    return server::serve(std::move(so), registry, std::move(scene));
+  } catch (const std::invalid_argument& e) {
+    throw BadInput(e.what());
+  }
+}
+
+}  // namespace turtlegas::apps

@@ -1,0 +1,476 @@
+# SPDX-License-Identifier: MIT
+"""A client for `turtlegas serve` (docs/protocol.md), Python 3 standard library only.
+
+It reads like the C++ controller API:
+
+    world = World.connect("127.0.0.1", 8081)          # TCP lines (or World.connect_ws(url))
+    t = world.claim("t1")
+    r = t.forward(100)
+    if r.touched:
+        t.right(90)
+
+Each command blocks until its result comes back. Touches and messages that arrive before a
+result are handed to the turtle's on_touch / on_message handlers (in the calling thread, just
+before the command returns), as a C++ program's handlers see them. Several turtles can be driven
+from one connection, each from its own thread (`World.run_turtles`), which a lockstep world needs
+when one client drives two turtles.
+"""
+
+import base64
+import json
+import os
+import queue
+import socket
+import struct
+import threading
+
+PROTOCOL = "turtlegas/1"
+
+
+class ServerError(Exception):
+    """An error reply: .code, .message, .field, .reply (the whole message)."""
+
+    def __init__(self, reply):
+        self.reply = reply
+        self.code = reply.get("code")
+        self.field = reply.get("field")
+        super().__init__("%s: %s" % (self.code, reply.get("message")))
+
+
+class Closed(Exception):
+    """The server closed the connection (its world stopped: .bye is its last message, if any)."""
+
+    def __init__(self, bye=None):
+        self.bye = bye
+        super().__init__("connection closed" + (" (%s)" % bye.get("reason") if bye else ""))
+
+
+class Touch:
+    def __init__(self, d):
+        self.sensors = list(d.get("sensors", []))
+        self.bits = d.get("bits", 0)
+        self.bearing = d.get("bearing", 0.0)
+        self.what = d.get("what", "")
+        self.kind = d.get("kind", "")
+        self.t = d.get("t", 0.0)
+
+    def fired(self, name):
+        return name in self.sensors
+
+    front = property(lambda self: self.fired("front"))
+    right = property(lambda self: self.fired("right"))
+    back = property(lambda self: self.fired("back"))
+    left = property(lambda self: self.fired("left"))
+
+    def __repr__(self):
+        return "Touch(%s %r %s bearing=%g t=%g)" % (self.kind, self.what, self.sensors, self.bearing, self.t)
+
+
+class Result:
+    """What a command did, as Result in turtle.hpp: done, touched, touch; and where and when."""
+
+    def __init__(self, d):
+        self.reply = d
+        self.done = d.get("done", 0.0)
+        self.touched = bool(d.get("touched"))
+        self.touch = Touch(d["touch"]) if self.touched else None
+        self.t = d.get("t")
+        self.step = d.get("step")
+        self.state = d.get("state", {})
+
+    def __repr__(self):
+        return "Result(done=%g, touched=%s, t=%g)" % (self.done, self.touched, self.t)
+
+
+# ---- transports ---------------------------------------------------------------------------------
+
+class _Lines:
+    def __init__(self, host, port, timeout):
+        self.sock = socket.create_connection((host, port), timeout=timeout)
+        self.sock.settimeout(None)
+        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.file = self.sock.makefile("rb")
+
+    def send(self, text):
+        self.sock.sendall(text.encode("utf-8") + b"\n")
+
+    def receive(self):
+        line = self.file.readline()
+        if not line:
+            return None
+        return line.decode("utf-8")
+
+    def close(self):
+        try:
+            self.sock.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
+        self.sock.close()
+
+
+class _WebSocket:
+    """A minimal RFC 6455 client: masked text frames out; text, binary, ping, close in."""
+
+    def __init__(self, host, port, path, timeout):
+        self.sock = socket.create_connection((host, port), timeout=timeout)
+        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        key = base64.b64encode(os.urandom(16)).decode()
+        self.sock.sendall(("GET %s HTTP/1.1\r\nHost: %s:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                           "Sec-WebSocket-Key: %s\r\nSec-WebSocket-Version: 13\r\n\r\n" % (path, host, port, key)).encode())
+        self.file = self.sock.makefile("rb")
+        status = self.file.readline()
+        if b" 101 " not in status:
+            raise ConnectionError("WebSocket upgrade refused: %r" % status)
+        while self.file.readline() not in (b"\r\n", b""):
+            pass
+        self.sock.settimeout(None)
+        self.lock = threading.Lock()
+
+    def _frame(self, opcode, payload):
+        head = bytes([0x80 | opcode])
+        n = len(payload)
+        if n < 126:
+            head += bytes([0x80 | n])
+        elif n < 65536:
+            head += bytes([0x80 | 126]) + struct.pack("!H", n)
+        else:
+            head += bytes([0x80 | 127]) + struct.pack("!Q", n)
+        mask = os.urandom(4)
+        masked = bytes(b ^ mask[i % 4] for i, b in enumerate(payload)) if n < 4096 else _mask(payload, mask)
+        with self.lock:
+            self.sock.sendall(head + mask + masked)
+
+    def send(self, text):
+        self._frame(0x1, text.encode("utf-8"))
+
+    def send_raw(self, opcode, payload):
+        self._frame(opcode, payload)
+
+    def _read(self, n):
+        data = self.file.read(n)
+        if data is None or len(data) < n:
+            raise EOFError
+        return data
+
+    def receive(self):
+        """The next text message (str) or binary message (bytes); None at the end."""
+        try:
+            message = b""
+            while True:
+                b0, b1 = self._read(2)
+                opcode, n = b0 & 0x0F, b1 & 0x7F
+                if n == 126:
+                    n = struct.unpack("!H", self._read(2))[0]
+                elif n == 127:
+                    n = struct.unpack("!Q", self._read(8))[0]
+                payload = self._read(n)
+                if opcode == 0x8:
+                    return None
+                if opcode == 0x9:
+                    self._frame(0xA, payload)
+                    continue
+                if opcode == 0xA:
+                    continue
+                if opcode in (0x1, 0x2):
+                    kind = opcode
+                message += payload
+                if b0 & 0x80:
+                    return message.decode("utf-8") if kind == 0x1 else message
+        except (EOFError, OSError, ValueError):
+            return None
+
+    def close(self):
+        try:
+            self._frame(0x8, struct.pack("!H", 1000))
+        except OSError:
+            pass
+        self.sock.close()
+
+
+def _mask(payload, mask):
+    m = int.from_bytes(mask * ((len(payload) + 3) // 4), "little")
+    p = int.from_bytes(payload + b"\0" * ((4 - len(payload) % 4) % 4), "little")
+    return (p ^ m).to_bytes(len(payload) + (4 - len(payload) % 4) % 4, "little")[:len(payload)]
+
+
+def decode_binary_frame(data):
+    """A binary frame (docs/protocol.md, "Binary frames") as a dict."""
+    if data[:4] != b"TGF1":
+        raise ValueError("not a turtlegas binary frame")
+    version, flags, seq, n, m, tail = struct.unpack_from("<HHIIII", data, 4)
+    t, wall, step = struct.unpack_from("<ddQ", data, 24)
+    off = 48
+    pos = struct.unpack_from("<%df" % (2 * n), data, off)
+    off += 8 * n
+    vel = None
+    if flags & 2:
+        vel = struct.unpack_from("<%df" % (2 * n), data, off)
+        off += 8 * n
+    turtles = struct.unpack_from("<%df" % (3 * m), data, off)
+    off += 12 * m
+    tflags = struct.unpack_from("<%dI" % m, data, off)
+    off += 4 * m
+    rest = json.loads(data[off:off + tail].decode("utf-8"))
+    return {"version": version, "paused": bool(flags & 1), "seq": seq, "t": t, "wall": wall, "step": step,
+            "pos": pos, "vel": vel, "turtles": turtles, "turtle_flags": tflags, "tail": rest,
+            "size": off + tail}
+
+
+# ---- the world ----------------------------------------------------------------------------------
+
+class World:
+    """One connection to a served world. Thread-safe: any thread may send and wait."""
+
+    def __init__(self, transport, token=None):
+        self._t = transport
+        self._lock = threading.Lock()
+        self._next_id = 0
+        self._waiting = {}        # id -> queue of the reply
+        self._turtles = {}        # turtle id -> RemoteTurtle
+        self._closed = False
+        self.bye = None
+        self.status = None
+        self.frames = queue.Queue()   # frames and snapshots, when subscribed (newest last)
+        self.notices = queue.Queue()  # status, world and unsolicited errors
+        self._reader = threading.Thread(target=self._read_loop, daemon=True)
+        self._reader.start()
+        hello = {"type": "hello", "protocol": PROTOCOL}
+        if token is not None:
+            hello["token"] = token
+        self.welcome = self.request(hello)
+        self.status = self.welcome.get("status")
+
+    @classmethod
+    def connect(cls, host="127.0.0.1", port=8081, token=None, timeout=10.0):
+        """Over TCP lines (the server's --line-port)."""
+        return cls(_Lines(host, port, timeout), token)
+
+    @classmethod
+    def connect_ws(cls, host="127.0.0.1", port=8080, token=None, timeout=10.0, path="/ws"):
+        """Over the WebSocket at ws://host:port/ws."""
+        return cls(_WebSocket(host, port, path, timeout), token)
+
+    # -- plumbing --
+    def _read_loop(self):
+        while True:
+            text = self._t.receive()
+            if text is None:
+                break
+            if isinstance(text, bytes):
+                self.frames.put(decode_binary_frame(text))
+                continue
+            try:
+                m = json.loads(text)
+            except ValueError:
+                continue
+            kind = m.get("type")
+            if kind == "bye":
+                self.bye = m
+                continue
+            if kind in ("frame", "snapshot") and "id" not in m:
+                self.frames.put(m)
+                continue
+            if kind in ("touch", "message", "fault") and "id" not in m:
+                t = self._turtles.get(m.get("turtle"))
+                if t is not None:
+                    t._inbox.put(m)
+                continue
+            if kind == "status":
+                self.status = m.get("status")
+            with self._lock:
+                q = self._waiting.pop(m.get("id"), None) if "id" in m else None
+            if q is not None:
+                q.put(m)
+            else:
+                self.notices.put(m)
+        with self._lock:
+            self._closed = True
+            waiting, self._waiting = self._waiting, {}
+        for q in waiting.values():
+            q.put(None)
+
+    def send(self, message):
+        """Sends a message as is (no id added); returns nothing."""
+        self._t.send(json.dumps(message))
+
+    def request(self, message, timeout=None):
+        """Sends `message` with a fresh id and returns the reply; raises ServerError on an error
+        reply, Closed when the server closes first."""
+        q = queue.Queue()
+        with self._lock:
+            if self._closed:
+                raise Closed(self.bye)
+            self._next_id += 1
+            rid = self._next_id
+            self._waiting[rid] = q
+        m = dict(message)
+        m["id"] = rid
+        self._t.send(json.dumps(m))
+        try:
+            reply = q.get(timeout=timeout)
+        except queue.Empty:
+            with self._lock:
+                self._waiting.pop(rid, None)
+            raise TimeoutError("no reply to %s within %s s" % (message.get("type"), timeout))
+        if reply is None:
+            raise Closed(self.bye)
+        if reply.get("type") == "error":
+            raise ServerError(reply)
+        return reply
+
+    def close(self):
+        self._t.close()
+        self._reader.join(timeout=5)
+
+    # -- the API --
+    def claim(self, turtle, takeover=False):
+        msg = {"type": "claim", "turtle": turtle}
+        if takeover:
+            msg["takeover"] = True
+        reply = self.request(msg)
+        t = RemoteTurtle(self, turtle, reply.get("sensors", []))
+        self._turtles[turtle] = t
+        return t
+
+    def release(self, turtle):
+        self._turtles.pop(turtle, None)
+        return self.request({"type": "release", "turtle": turtle})
+
+    def pause(self):
+        return self.request({"type": "pause"})
+
+    def resume(self):
+        return self.request({"type": "resume"})
+
+    def step(self, steps=1):
+        return self.request({"type": "step", "steps": steps})
+
+    def speed(self, factor):
+        return self.request({"type": "speed", "factor": factor})
+
+    def run_until(self, t):
+        return self.request({"type": "run_until", "t": t})
+
+    def add_wall(self, wall_id, start, end):
+        return self.request({"type": "add_wall", "wall": {"id": wall_id, "from": list(start), "to": list(end)}})
+
+    def save(self, file):
+        return self.request({"type": "save", "file": file})
+
+    def load(self, file):
+        return self.request({"type": "load", "file": file})
+
+    def subscribe(self, rate=30, events=(), fmt="json", velocities=True):
+        ev = events if isinstance(events, str) else list(events)
+        return self.request({"type": "subscribe", "rate": rate, "events": ev, "format": fmt, "velocities": velocities})
+
+    def snapshot(self):
+        return self.request({"type": "snapshot"})
+
+    def stats(self):
+        return self.request({"type": "stats"})
+
+    def ping(self):
+        return self.request({"type": "ping"})
+
+    @staticmethod
+    def run_turtles(programs):
+        """Runs each `program(turtle)` of {turtle: program} in a thread of its own; returns when
+        all have ended (Closed, the server's stop, ends them quietly). Returns their exceptions."""
+        errors = {}
+
+        def body(t, p):
+            try:
+                p(t)
+            except Closed:
+                pass
+            except BaseException as e:  # reported to the caller
+                errors[t.id] = e
+
+        threads = [threading.Thread(target=body, args=(t, p), daemon=True) for t, p in programs.items()]
+        for th in threads:
+            th.start()
+        for th in threads:
+            th.join()
+        return errors
+
+
+class RemoteTurtle:
+    """A claimed turtle. Its commands block until their result, like the C++ Turtle's."""
+
+    def __init__(self, world, turtle_id, sensors):
+        self.world = world
+        self.id = turtle_id
+        self.sensors = sensors
+        self._inbox = queue.Queue()
+        self.touches = []    # every touch interrupt, in order
+        self.messages = []   # every message, in order
+        self.fault = None
+        self.state = {}
+        self._on_touch = None
+        self._on_message = None
+
+    def on_touch(self, handler):
+        self._on_touch = handler
+
+    def on_message(self, handler):
+        self._on_message = handler
+
+    def _deliver(self):
+        while True:
+            try:
+                m = self._inbox.get_nowait()
+            except queue.Empty:
+                return
+            if m["type"] == "touch":
+                touch = Touch(m["touch"])
+                self.touches.append(touch)
+                if self._on_touch:
+                    self._on_touch(touch)
+            elif m["type"] == "message":
+                self.messages.append(m)
+                if self._on_message:
+                    self._on_message(m["data"])
+            elif m["type"] == "fault":
+                self.fault = m["message"]
+
+    def _command(self, message):
+        message["turtle"] = self.id
+        try:
+            reply = self.world.request(message)
+        finally:
+            self._deliver()
+        self.state = reply.get("state", {})
+        return Result(reply)
+
+    def forward(self, amount):
+        return self._command({"type": "forward", "amount": amount})
+
+    def back(self, amount):
+        return self._command({"type": "back", "amount": amount})
+
+    def left(self, degrees):
+        return self._command({"type": "left", "amount": degrees})
+
+    def right(self, degrees):
+        return self._command({"type": "right", "amount": degrees})
+
+    def wait(self, seconds):
+        return self._command({"type": "wait", "amount": seconds})
+
+    def yield_(self):
+        return self._command({"type": "yield"})
+
+    def pen_up(self):
+        return self._command({"type": "pen", "down": False})
+
+    def pen_down(self, mode="line"):
+        return self._command({"type": "pen", "down": True, "mode": mode})
+
+    @property
+    def heading(self):
+        return self.state.get("heading")
+
+    @property
+    def odometer(self):
+        return self.state.get("odometer")

@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/formats/input_log.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+#include "turtlegas/formats/json_text.hpp"
+
+namespace turtlegas::formats {
+namespace {
+
+void append_step(std::string& out, std::uint64_t step) {
+  out += "{\"step\": ";
+  out += std::to_string(step);
+}
+
+void append_point(std::string& out, sim::Vec2 p) {
+  out += '[';
+  append_number(out, p.x);
+  out += ", ";
+  append_number(out, p.y);
+  out += ']';
+}
+
+}  // namespace
+
+std::string input_header_line(std::string_view world_name, double dt) {
+  std::string out = "{\"format\": ";
+  append_json_string(out, input_log_format);
+  out += ", \"world\": ";
+  append_json_string(out, world_name);
+  out += ", \"dt\": ";
+  append_number(out, dt);
+  out += "}\n";
+  return out;
+}
+
+std::string input_command_line(std::uint64_t step, std::string_view turtle, const turtle::RemoteCommand& c) {
+  std::string out;
+  append_step(out, step);
+  out += ", \"turtle\": ";
+  append_json_string(out, turtle);
+  out += ", \"command\": ";
+  append_json_string(out, turtle::to_string(c.kind));
+  if (turtle::takes_amount(c.kind)) {
+    out += ", \"amount\": ";
+    append_number(out, c.amount);
+  }
+  if (c.kind == turtle::RemoteCommand::Kind::pen_down)
+    out += c.pen == turtle::PenMode::wall ? ", \"mode\": \"wall\"" : ", \"mode\": \"line\"";
+  out += "}\n";
+  return out;
+}
+
+std::string input_takeover_line(std::uint64_t step, std::string_view turtle) {
+  std::string out;
+  append_step(out, step);
+  out += ", \"takeover\": ";
+  append_json_string(out, turtle);
+  out += "}\n";
+  return out;
+}
+
+std::string input_wall_line(std::uint64_t step, const sim::WallDef& wall) {
+  std::string out;
+  append_step(out, step);
+  out += ", \"add_wall\": {\"id\": ";
+  append_json_string(out, wall.id);
+  out += ", \"from\": ";
+  append_point(out, wall.from);
+  out += ", \"to\": ";
+  append_point(out, wall.to);
+  out += "}}\n";
+  return out;
+}
+
+ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string file) : file_(std::move(file)) {
+  for (const sim::TurtleDef& t : def.turtles) turtle_ids_.push_back(t.id);
+  commands_.resize(turtle_ids_.size());
+  auto index_of = [&](const std::string& id, std::size_t line, const char* key) {
+    for (std::size_t i = 0; i < turtle_ids_.size(); ++i)
+      if (turtle_ids_[i] == id) return i;
+    throw std::invalid_argument(file_ + ":" + std::to_string(line) + ": /" + key + ": no turtle '" + id +
+                                "' in the world; replay the log with the world it was recorded with");
+  };
+  std::string text;
+  std::size_t line = 0;
+  bool header = false;
+  std::uint64_t last_step = 0;
+  while (std::getline(in, text)) {
+    ++line;
+    if (text.empty()) continue;
+    auto fail = [&](const std::string& why) {
+      throw std::invalid_argument(file_ + ":" + std::to_string(line) + ": " + why);
+    };
+    const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+    if (!j.is_object()) fail("not a JSON object; an input log has one object per line (docs/protocol.md)");
+    if (!header) {
+      if (j.value("format", std::string()) != input_log_format)
+        fail("/format: the first line must be {\"format\": \"turtlegas-inputs/1\", ...}");
+      header = true;
+      continue;
+    }
+    const auto s = j.find("step");
+    if (s == j.end() || !s->is_number_unsigned()) fail("/step: a step number >= 0 is needed on every line");
+    const std::uint64_t step = s->get<std::uint64_t>();
+    if (step < last_step) fail("/step: steps must not decrease (" + std::to_string(step) + " after " + std::to_string(last_step) + ")");
+    last_step = step;
+    try {
+      if (j.contains("turtle")) {
+        const std::size_t i = index_of(j.at("turtle").get<std::string>(), line, "turtle");
+        const auto kind = turtle::remote_command_kind(j.at("command").get<std::string>());
+        if (!kind) fail("/command: not a command (forward, back, left, right, wait, yield, pen_up, pen_down)");
+        turtle::RemoteCommand c;
+        c.kind = *kind;
+        if (turtle::takes_amount(c.kind)) {
+          c.amount = j.at("amount").get<double>();
+          if (!std::isfinite(c.amount) || c.amount < 0.0) fail("/amount: must be finite and >= 0");
+        }
+        if (c.kind == turtle::RemoteCommand::Kind::pen_down)
+          c.pen = j.value("mode", std::string("line")) == "wall" ? turtle::PenMode::wall : turtle::PenMode::line;
+        commands_[i].push_back({step, c});
+      } else if (j.contains("takeover")) {
+        changes_.push_back({step, index_of(j.at("takeover").get<std::string>(), line, "takeover"), {}});
+      } else if (j.contains("add_wall")) {
+        const nlohmann::json& w = j.at("add_wall");
+        Change c;
+        c.step = step;
+        c.wall.id = w.at("id").get<std::string>();
+        c.wall.from = {w.at("from").at(0).get<double>(), w.at("from").at(1).get<double>()};
+        c.wall.to = {w.at("to").at(0).get<double>(), w.at("to").at(1).get<double>()};
+        changes_.push_back(std::move(c));
+      } else {
+        fail("a line needs \"turtle\" (a command), \"takeover\" or \"add_wall\"");
+      }
+    } catch (const nlohmann::json::exception& e) {
+      fail(std::string("a field is missing or has the wrong type: ") + e.what());
+    }
+  }
+  if (!header) throw std::invalid_argument(file_ + ": empty; an input log starts with {\"format\": \"turtlegas-inputs/1\", ...}");
+}
+
+void ReplayInput::at_boundary(turtle::WorldServer& server, std::uint64_t step) {
+  while (!changes_.empty() && changes_.front().step <= step) {
+    Change c = std::move(changes_.front());
+    changes_.pop_front();
+    if (c.step < step)
+      throw std::runtime_error(file_ + ": the change recorded at step " + std::to_string(c.step) +
+                               " was not reached at that step; is this the log of this world?");
+    if (c.takeover) server.make_remote(*c.takeover);
+    else server.add_wall(c.wall);
+  }
+}
+
+std::optional<turtle::RemoteCommand> ReplayInput::next(std::uint64_t step, std::size_t turtle) {
+  if (turtle >= commands_.size()) return std::nullopt;
+  std::deque<Command>& q = commands_[turtle];
+  if (q.empty() || q.front().step > step) return std::nullopt;
+  if (q.front().step < step)
+    throw std::runtime_error(file_ + ": turtle '" + turtle_ids_[turtle] + "' was not idle at step " +
+                             std::to_string(q.front().step) + " where the log gives it a command; is this the log of this world?");
+  const turtle::RemoteCommand c = q.front().command;
+  q.pop_front();
+  return c;
+}
+
+}  // namespace turtlegas::formats

@@ -1,0 +1,191 @@
+// SPDX-License-Identifier: MIT
+// The world host: owns the one WorldServer and runs it on the simulation thread (run()), paced
+// by the wall clock; every connection's messages come in through one inbox and are handled on
+// that thread, at control boundaries or while a lockstep boundary waits for a remote command
+// (docs/protocol.md). Nothing a client does can block the simulation except lockstep waiting,
+// which --lockstep-timeout bounds. Replies and frames leave as shared immutable buffers through
+// Client (client.hpp), whose sends are posted to the I/O threads.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "turtlegas/formats/event_log.hpp"
+#include "turtlegas/formats/names.hpp"
+#include "turtlegas/server/client.hpp"
+#include "turtlegas/server/frames.hpp"
+#include "turtlegas/server/limits.hpp"
+#include "turtlegas/sim/world_def.hpp"
+#include "turtlegas/turtle/registry.hpp"
+#include "turtlegas/turtle/remote.hpp"
+#include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/world/scene.hpp"
+
+namespace turtlegas::server {
+
+struct HostOptions {
+  std::string world_file;   ///< as given, for messages
+  std::string world_text;   ///< GET /api/world
+  sim::Mode mode = sim::Mode::exact;
+  bool realtime = false;    ///< remote turtles never hold the world up
+  double speed = 1.0;       ///< simulated seconds per wall second; 0: as fast as possible
+  bool paused = false;
+  std::optional<double> until;   ///< stop (as on SIGINT) at this simulated time
+  std::string events_path;       ///< the event log; empty: none
+  std::string inputs_path;       ///< the input log; empty: none
+  std::filesystem::path save_dir;  ///< empty: save and load refused
+  std::optional<std::string> token;
+  double lockstep_timeout = 10.0;  ///< wall seconds
+  std::size_t stack_bytes = 32 * 1024;
+  double program_budget = 2.0;
+  Limits limits;
+};
+
+class WorldHost {
+ public:
+  /// Builds the world from the loaded scene (std::invalid_argument when the runtime refuses it)
+  /// and opens the logs (std::runtime_error when a path cannot be written).
+  WorldHost(HostOptions options, const turtle::Registry& registry, world::Scene scene);
+  ~WorldHost();
+  WorldHost(const WorldHost&) = delete;
+  WorldHost& operator=(const WorldHost&) = delete;
+
+  // From any thread.
+  void connected(std::shared_ptr<Client> client);
+  void disconnected(std::shared_ptr<Client> client);
+  void post(std::shared_ptr<Client> client, nlohmann::json message);
+  /// GET /api/state: `done` gets the state file's text, called on the simulation thread.
+  void request_state(std::function<void(std::string)> done);
+  void request_stop(std::string reason);
+  std::string world_text() const;
+  const HostOptions& options() const { return options_; }
+  std::size_t clients_open() const { return clients_open_.load(); }
+  std::uint64_t next_client_id() { return ++last_client_id_; }
+
+  /// The simulation thread's loop: until a stop (a signal, --until). Returns the exit code.
+  int run();
+  /// Called on the simulation thread once the loop has ended and every client was told.
+  std::function<void()> on_finished;
+
+ private:
+  class Input;
+  struct Inbound {
+    enum class Kind { message, connect, disconnect, state, stop } kind;
+    std::shared_ptr<Client> client;
+    nlohmann::json message;
+    std::function<void(std::string)> state_done;
+    std::string reason;
+  };
+  struct ClientState {
+    std::shared_ptr<Client> client;
+    bool hello = false;
+    bool authorized = false;
+    std::optional<std::string> stream;  ///< FrameStream key when subscribed
+    std::uint64_t messages = 0, errors = 0;
+    std::size_t claims = 0;
+  };
+  struct Slot {  ///< a turtle's remote side
+    std::uint64_t owner = 0;  ///< the claiming connection, 0 none
+    std::optional<turtle::RemoteCommand> queued;
+    nlohmann::json queued_id;
+    nlohmann::json inflight_id;
+    bool busy = false;      ///< a command was accepted and its result has not come
+    bool orphan = false;    ///< the command in flight was sent by a connection that let go
+  };
+  struct WallChange {
+    std::uint64_t client;
+    nlohmann::json id;
+    sim::WallDef wall;
+  };
+  struct Takeover {
+    std::uint64_t client;
+    nlohmann::json id;
+    std::size_t turtle;
+  };
+  struct FileRequest {
+    std::uint64_t client;
+    nlohmann::json id;
+    bool load;
+    std::string file;
+  };
+
+  // The simulation thread's side.
+  void build_world(world::Scene scene);
+  void drain_inbox();
+  bool wait_inbox_until(double steady_deadline);  ///< true when something arrived
+  void handle(Inbound& in);
+  void handle_message(ClientState& c, const nlohmann::json& m);
+  void at_boundary(turtle::WorldServer& server, std::uint64_t step);
+  std::optional<turtle::RemoteCommand> next_command(std::uint64_t step, std::size_t turtle);
+  void on_report(const turtle::RemoteReport& r);
+  void step_world(double target);
+  void fan_out_events();
+  void send_due_frames(double now);
+  void do_file_requests();
+  void end_world(const std::string& reason);
+  void release_all(ClientState& c, const char* why);
+  void reply(ClientState& c, const nlohmann::json& message);
+  void reply_text(ClientState& c, std::string text);
+  void broadcast(const std::string& text);
+  void broadcast_status();
+  nlohmann::json status_json() const;
+  nlohmann::json world_json() const;
+  nlohmann::json ok(const nlohmann::json& m, const char* request) const;
+  std::vector<bool> claimed() const;
+  FrameClock clock() const;
+  std::size_t turtle_index(const nlohmann::json& m, const char* example) const;
+  void require_live() const;
+  void write_input(const std::string& line);
+  double now() const;  ///< steady clock, seconds
+  void reanchor();
+
+  HostOptions options_;
+  const turtle::Registry& registry_;
+  world::Scene scene_;
+  formats::IdTable ball_ids_;
+  std::unique_ptr<turtle::WorldServer> server_;
+  std::shared_ptr<Input> input_;
+  std::vector<turtle::LogEvent> events_;
+  std::optional<std::ofstream> events_file_, inputs_file_;
+  std::optional<formats::EventLogWriter> events_writer_;
+  std::vector<Slot> slots_;
+  std::map<std::uint64_t, ClientState> clients_;
+  std::map<std::string, FrameStream> streams_;
+  std::deque<WallChange> wall_changes_;
+  std::deque<Takeover> takeovers_;
+  std::deque<FileRequest> file_requests_;
+  // Pacing.
+  bool paused_ = false;
+  double speed_ = 1.0;  ///< 0: as fast as possible
+  std::optional<double> pause_at_;
+  std::uint64_t steps_left_ = 0;  ///< > 0: a `step` request is running
+  double anchor_sim_ = 0.0, anchor_wall_ = 0.0;
+  std::optional<std::string> ended_;
+  bool stopping_ = false;
+  std::string stop_reason_;
+  bool in_step_ = false;
+  std::uint64_t frames_built_ = 0;
+  mutable std::mutex text_mutex_;  // options_.world_text, read by HTTP sessions
+  // The inbox.
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<Inbound> inbox_;
+  std::atomic<std::size_t> clients_open_{0};
+  std::atomic<std::uint64_t> last_client_id_{0};
+};
+
+}  // namespace turtlegas::server

@@ -1,0 +1,273 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/server/frames.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "turtlegas/formats/json_text.hpp"
+#include "turtlegas/server/protocol.hpp"
+#include "turtlegas/sim/angles.hpp"
+
+namespace turtlegas::server {
+namespace {
+
+using formats::append_json_string;
+using formats::append_number;
+
+void append_point(std::string& out, sim::Vec2 p) {
+  out += '[';
+  append_number(out, p.x);
+  out += ", ";
+  append_number(out, p.y);
+  out += ']';
+}
+
+double heading_degrees(const sim::TurtleState& s) { return sim::wrap_degrees(sim::to_degrees(s.heading)); }
+
+void append_clock(std::string& out, const turtle::WorldServer& server, const FrameClock& clock) {
+  out += ", \"t\": ";
+  append_number(out, server.time());
+  out += ", \"step\": ";
+  out += std::to_string(server.step());
+  out += ", \"wall\": ";
+  append_number(out, clock.wall);
+  out += clock.paused ? ", \"paused\": true, \"speed\": " : ", \"paused\": false, \"speed\": ";
+  out += clock.speed.dump();
+}
+
+void append_walls(std::string& out, const turtle::WorldServer& server, std::size_t from) {
+  const std::vector<sim::WallDef>& walls = server.world().walls();
+  out += '[';
+  for (std::size_t k = from; k < walls.size(); ++k) {
+    if (k > from) out += ", ";
+    out += "{\"id\": ";
+    append_json_string(out, walls[k].id);
+    out += ", \"from\": ";
+    append_point(out, walls[k].from);
+    out += ", \"to\": ";
+    append_point(out, walls[k].to);
+    out += '}';
+  }
+  out += ']';
+}
+
+void append_balls(std::string& out, const sim::World& world, bool velocities) {
+  const std::size_t n = world.ball_count();
+  std::string dead;
+  out += "{\"pos\": [";
+  for (std::size_t i = 0; i < n; ++i) {
+    const sim::BallState b = world.ball(i);
+    if (i > 0) out += ", ";
+    append_number(out, b.pos.x);
+    out += ", ";
+    append_number(out, b.pos.y);
+    if (!b.alive) dead += (dead.empty() ? "" : ", ") + std::to_string(i);
+  }
+  out += ']';
+  if (velocities) {
+    out += ", \"vel\": [";
+    for (std::size_t i = 0; i < n; ++i) {
+      const sim::BallState b = world.ball(i);
+      if (i > 0) out += ", ";
+      append_number(out, b.alive ? b.vel.x : 0.0);
+      out += ", ";
+      append_number(out, b.alive ? b.vel.y : 0.0);
+    }
+    out += ']';
+  }
+  out += ", \"dead\": [" + dead + "]}";
+}
+
+void append_turtle_head(std::string& out, const turtle::WorldServer::TurtleInfo& info, bool claimed) {
+  out += "{\"id\": ";
+  append_json_string(out, info.id);
+  out += ", \"pos\": ";
+  append_point(out, info.state.pos);
+  out += ", \"heading\": ";
+  append_number(out, heading_degrees(info.state));
+  out += ", \"pen\": \"";
+  out += pen_name(info.pen_down, info.pen_mode);
+  out += info.it ? "\", \"it\": true" : "\", \"it\": false";
+  out += info.remote ? ", \"remote\": true" : ", \"remote\": false";
+  out += claimed ? ", \"claimed\": true" : ", \"claimed\": false";
+  out += info.finished ? ", \"finished\": true" : ", \"finished\": false";
+}
+
+void append_points(std::string& out, const std::vector<sim::Vec2>& points) {
+  out += '[';
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (k > 0) out += ", ";
+    append_point(out, points[k]);
+  }
+  out += ']';
+}
+
+template <class T>
+void put(std::string& out, T v) {
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));  // the machine is little-endian (x86-64, aarch64): as documented
+  out.append(b, sizeof(T));
+}
+
+}  // namespace
+
+std::string FrameKind::key() const {
+  std::string k = std::to_string(rate) + (binary ? "/b" : "/j") + (velocities ? "/v" : "/-") + (all_events ? "/all" : "/");
+  for (const std::string& e : events) k += e + ",";
+  return k;
+}
+
+bool FrameKind::wants(std::string_view event_kind) const {
+  return all_events || std::binary_search(events.begin(), events.end(), event_kind);
+}
+
+std::string snapshot_text(const turtle::WorldServer& server, const formats::IdTable& ball_ids,
+                          const std::vector<bool>& claimed, const FrameClock& clock, const nlohmann::json& id,
+                          const nlohmann::json& arena) {
+  const sim::World& world = server.world();
+  std::string out = "{\"type\": \"snapshot\"";
+  if (!id.is_null()) out += ", \"id\": " + id.dump();
+  append_clock(out, server, clock);
+  out += ", \"arena\": " + arena.dump();
+  out += ", \"walls\": ";
+  append_walls(out, server, 0);
+  out += ", \"balls\": {\"ids\": [";
+  for (std::size_t i = 0; i < world.ball_count(); ++i) {
+    if (i > 0) out += ", ";
+    append_json_string(out, i < ball_ids.size() ? ball_ids[i] : std::string_view());
+  }
+  out += "], \"radius\": [";
+  for (std::size_t i = 0; i < world.ball_count(); ++i) {
+    if (i > 0) out += ", ";
+    append_number(out, world.radius(i));
+  }
+  out += "], ";
+  std::string balls;
+  append_balls(balls, world, true);
+  out += balls.substr(1);  // the rest of the balls object: pos, vel, dead
+  out += ", \"turtles\": [";
+  for (std::size_t i = 0; i < server.turtle_count(); ++i) {
+    if (i > 0) out += ", ";
+    const turtle::WorldServer::TurtleInfo info = server.turtle_status(i);
+    append_turtle_head(out, info, i < claimed.size() && claimed[i]);
+    out += ", \"radius\": ";
+    append_number(out, world.turtle_radius(i));
+    out += ", \"trail\": ";
+    append_points(out, server.trail_since(i, 0));
+    out += '}';
+  }
+  out += "]}";
+  return out;
+}
+
+FrameStream::FrameStream(FrameKind kind, const turtle::WorldServer& server) : kind_(std::move(kind)) {
+  trail_sent_.resize(server.turtle_count());
+  for (std::size_t i = 0; i < trail_sent_.size(); ++i) trail_sent_[i] = server.trail_size(i);
+  walls_sent_ = server.world().walls().size();
+}
+
+void FrameStream::add_event(std::string_view event_kind, std::string_view line, std::size_t max_events) {
+  if (!kind_.wants(event_kind)) return;
+  if (event_count_ >= max_events) {
+    ++events_dropped_;
+    return;
+  }
+  if (event_count_ > 0) events_ += ", ";
+  events_.append(line);
+  ++event_count_;
+}
+
+std::shared_ptr<const std::string> FrameStream::build(const turtle::WorldServer& server, const std::vector<bool>& claimed,
+                                                      const FrameClock& clock) {
+  ++built;
+  const sim::World& world = server.world();
+  // The parts JSON and binary frames share: new trail points and walls, and the events.
+  std::string trails = "[";
+  std::vector<std::size_t> from(server.turtle_count());
+  std::vector<std::vector<sim::Vec2>> points(server.turtle_count());
+  for (std::size_t i = 0; i < server.turtle_count(); ++i) {
+    from[i] = std::min(trail_sent_[i], server.trail_size(i));
+    points[i] = server.trail_since(i, from[i]);
+    trail_sent_[i] = from[i] + points[i].size();
+  }
+  const std::size_t walls_from = walls_sent_;
+  walls_sent_ = world.walls().size();
+  std::string tail_events = "[" + events_ + "]";
+  const std::size_t dropped = events_dropped_;
+  events_.clear();
+  event_count_ = events_dropped_ = 0;
+
+  auto out = std::make_shared<std::string>();
+  if (!kind_.binary) {
+    std::string& s = *out;
+    s = "{\"type\": \"frame\", \"seq\": " + std::to_string(built);
+    append_clock(s, server, clock);
+    s += ", \"balls\": ";
+    append_balls(s, world, kind_.velocities);
+    s += ", \"turtles\": [";
+    for (std::size_t i = 0; i < server.turtle_count(); ++i) {
+      if (i > 0) s += ", ";
+      append_turtle_head(s, server.turtle_status(i), i < claimed.size() && claimed[i]);
+      s += ", \"trail_from\": " + std::to_string(from[i]) + ", \"trail\": ";
+      append_points(s, points[i]);
+      s += '}';
+    }
+    s += "], \"walls_from\": " + std::to_string(walls_from) + ", \"walls\": ";
+    append_walls(s, server, walls_from);
+    s += ", \"events\": " + tail_events + ", \"events_dropped\": " + std::to_string(dropped) + "}";
+    return out;
+  }
+  // Binary (docs/protocol.md, "Binary frames").
+  std::string tail = "{\"events\": " + tail_events + ", \"events_dropped\": " + std::to_string(dropped) + ", \"trails\": [";
+  for (std::size_t i = 0; i < server.turtle_count(); ++i) {
+    if (i > 0) tail += ", ";
+    tail += "{\"from\": " + std::to_string(from[i]) + ", \"points\": ";
+    append_points(tail, points[i]);
+    tail += '}';
+  }
+  tail += "], \"walls_from\": " + std::to_string(walls_from) + ", \"walls\": ";
+  append_walls(tail, server, walls_from);
+  tail += '}';
+  const std::size_t n = world.ball_count(), m = server.turtle_count();
+  std::string& s = *out;
+  s.reserve(48 + n * (kind_.velocities ? 16 : 8) + m * 16 + tail.size());
+  s.append("TGF1", 4);
+  put<std::uint16_t>(s, 1);
+  put<std::uint16_t>(s, static_cast<std::uint16_t>((clock.paused ? 1u : 0u) | (kind_.velocities ? 2u : 0u)));
+  put<std::uint32_t>(s, static_cast<std::uint32_t>(built));
+  put<std::uint32_t>(s, static_cast<std::uint32_t>(n));
+  put<std::uint32_t>(s, static_cast<std::uint32_t>(m));
+  put<std::uint32_t>(s, static_cast<std::uint32_t>(tail.size()));
+  put<double>(s, server.time());
+  put<double>(s, clock.wall);
+  put<std::uint64_t>(s, server.step());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 0; i < n; ++i) {
+    const sim::BallState b = world.ball(i);
+    put<float>(s, b.alive ? static_cast<float>(b.pos.x) : nan);
+    put<float>(s, b.alive ? static_cast<float>(b.pos.y) : nan);
+  }
+  if (kind_.velocities)
+    for (std::size_t i = 0; i < n; ++i) {
+      const sim::BallState b = world.ball(i);
+      put<float>(s, b.alive ? static_cast<float>(b.vel.x) : 0.0f);
+      put<float>(s, b.alive ? static_cast<float>(b.vel.y) : 0.0f);
+    }
+  std::vector<std::uint32_t> flags(m);
+  for (std::size_t i = 0; i < m; ++i) {
+    const turtle::WorldServer::TurtleInfo info = server.turtle_status(i);
+    put<float>(s, static_cast<float>(info.state.pos.x));
+    put<float>(s, static_cast<float>(info.state.pos.y));
+    put<float>(s, static_cast<float>(heading_degrees(info.state)));
+    flags[i] = (info.pen_down ? 1u : 0u) | (info.pen_down && info.pen_mode == turtle::PenMode::wall ? 2u : 0u) |
+               (info.it ? 4u : 0u) | (info.remote ? 8u : 0u) | (i < claimed.size() && claimed[i] ? 16u : 0u) |
+               (info.finished ? 32u : 0u);
+  }
+  for (std::uint32_t f : flags) put<std::uint32_t>(s, f);
+  s += tail;
+  return out;
+}
+
+}  // namespace turtlegas::server

@@ -1,0 +1,167 @@
+// SPDX-License-Identifier: MIT
+#include "http_session.hpp"
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <string_view>
+
+#include <boost/asio/post.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include "turtlegas/server/protocol.hpp"
+#include "websocket_session.hpp"
+
+namespace turtlegas::server::detail {
+namespace {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+
+const char* content_type(const std::filesystem::path& p) {
+  const std::string ext = p.extension().string();
+  if (ext == ".html" || ext == ".htm") return "text/html; charset=utf-8";
+  if (ext == ".js" || ext == ".mjs") return "text/javascript; charset=utf-8";
+  if (ext == ".css") return "text/css; charset=utf-8";
+  if (ext == ".json") return "application/json";
+  if (ext == ".svg") return "image/svg+xml";
+  if (ext == ".png") return "image/png";
+  if (ext == ".ico") return "image/x-icon";
+  if (ext == ".wasm") return "application/wasm";
+  if (ext == ".txt" || ext == ".md") return "text/plain; charset=utf-8";
+  return "application/octet-stream";
+}
+
+constexpr std::string_view placeholder_page = R"(<!doctype html>
+<html><head><meta charset="utf-8"><title>turtlegas serve</title></head>
+<body><h1>turtlegas serve</h1>
+<p>The viewer is not installed yet. The world is at <a href="/api/world">/api/world</a>, its current
+state at <a href="/api/state">/api/state</a>; the protocol (WebSocket at <code>/ws</code>, or TCP
+lines) is described in docs/protocol.md.</p></body></html>
+)";
+
+/// The file below root that `target` names, or nullopt: no "..", no hidden names, no symlink
+/// leading out of the root.
+std::optional<std::filesystem::path> static_file(const std::filesystem::path& root, std::string_view target) {
+  if (target.empty() || target[0] != '/') return std::nullopt;
+  std::string rel(target.substr(1));
+  if (rel.empty()) rel = "index.html";
+  if (rel.find('\\') != std::string::npos || rel.find('\0') != std::string::npos || rel.find('%') != std::string::npos) return std::nullopt;
+  std::filesystem::path p;
+  std::size_t begin = 0;
+  while (begin <= rel.size()) {
+    const std::size_t end = rel.find('/', begin);
+    const std::string part = rel.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+    if (part.empty() || part[0] == '.') return std::nullopt;  // "", ".", "..", hidden
+    p /= part;
+    if (end == std::string::npos) break;
+    begin = end + 1;
+  }
+  std::error_code ec;
+  const std::filesystem::path canon_root = std::filesystem::weakly_canonical(root, ec);
+  if (ec) return std::nullopt;
+  const std::filesystem::path full = std::filesystem::weakly_canonical(root / p, ec);
+  if (ec) return std::nullopt;
+  const std::string r = canon_root.string() + "/", f = full.string();
+  if (f.compare(0, r.size(), r) != 0) return std::nullopt;  // a symlink out of the root
+  if (!std::filesystem::is_regular_file(full, ec)) return std::nullopt;
+  return full;
+}
+
+}  // namespace
+
+HttpSession::HttpSession(boost::asio::ip::tcp::socket&& socket, WorldHost& host, std::filesystem::path web_root)
+    : stream_(std::move(socket)), host_(host), web_root_(std::move(web_root)) {
+  boost::system::error_code ec;
+  const auto peer = stream_.socket().remote_endpoint(ec);
+  loopback_ = !ec && peer.address().is_loopback();
+}
+
+void HttpSession::run() { read(); }
+
+void HttpSession::read() {
+  parser_.emplace();
+  parser_->body_limit(64 * 1024);
+  parser_->header_limit(16 * 1024);
+  stream_.expires_after(std::chrono::seconds(30));
+  http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+    if (ec) {
+      beast::error_code ignored;
+      self->stream_.socket().shutdown(boost::asio::ip::tcp::socket::shutdown_both, ignored);
+      return;
+    }
+    self->serve(self->parser_->release());
+  });
+}
+
+std::shared_ptr<HttpSession::Response> HttpSession::respond(const Request& req, http::status status, std::string body,
+                                                            const char* type) {
+  auto res = std::make_shared<Response>(status, req.version());
+  res->set(http::field::server, std::string(server_name));
+  res->set(http::field::content_type, type);
+  res->set(http::field::cache_control, "no-store");
+  res->keep_alive(req.keep_alive());
+  const bool head = req.method() == http::verb::head;
+  res->body() = std::move(body);
+  res->prepare_payload();
+  if (head) res->body().clear();
+  return res;
+}
+
+void HttpSession::serve(Request req) {
+  const std::string target(req.target());
+  const std::string path = target.substr(0, target.find('?'));
+  if (beast::websocket::is_upgrade(req)) {
+    if (path != "/ws") return write(respond(req, http::status::not_found, "the WebSocket is at /ws\n", "text/plain"));
+    if (host_.clients_open() >= host_.options().limits.max_clients)
+      return write(respond(req, http::status::service_unavailable,
+                           error_text("too_many_clients", "the server has its maximum of connections (--max-clients)") + "\n",
+                           "application/json"));
+    stream_.expires_never();
+    std::make_shared<WebSocketSession>(stream_.release_socket(), host_)->run(std::move(req));
+    return;
+  }
+  if (req.method() != http::verb::get && req.method() != http::verb::head) {
+    auto res = respond(req, http::status::method_not_allowed, "only GET and HEAD\n", "text/plain");
+    res->set(http::field::allow, "GET, HEAD");
+    return write(res);
+  }
+  if (path.rfind("/api/", 0) == 0) {
+    if (host_.options().token && !loopback_ && req[http::field::authorization] != "Bearer " + *host_.options().token)
+      return write(respond(req, http::status::unauthorized, "send the header Authorization: Bearer TOKEN\n", "text/plain"));
+    if (path == "/api/world") return write(respond(req, http::status::ok, host_.world_text(), "application/json"));
+    if (path == "/api/state") {
+      auto self = shared_from_this();
+      auto shared_req = std::make_shared<Request>(std::move(req));
+      host_.request_state([self, shared_req](std::string body) {
+        boost::asio::post(self->stream_.get_executor(), [self, shared_req, body = std::move(body)]() mutable {
+          self->write(self->respond(*shared_req, http::status::ok, std::move(body), "application/json"));
+        });
+      });
+      return;
+    }
+    return write(respond(req, http::status::not_found, "no such API: /api/world and /api/state\n", "text/plain"));
+  }
+  if (const auto file = static_file(web_root_, path)) {
+    std::ifstream in(*file, std::ios::binary);
+    std::ostringstream body;
+    body << in.rdbuf();
+    return write(respond(req, http::status::ok, body.str(), content_type(*file)));
+  }
+  if (path == "/" || path == "/index.html")
+    return write(respond(req, http::status::ok, std::string(placeholder_page), "text/html; charset=utf-8"));
+  write(respond(req, http::status::not_found, "not found\n", "text/plain"));
+}
+
+void HttpSession::write(std::shared_ptr<Response> res) {
+  http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
+    if (ec || !res->keep_alive()) {
+      beast::error_code ignored;
+      self->stream_.socket().shutdown(boost::asio::ip::tcp::socket::shutdown_send, ignored);
+      return;
+    }
+    self->read();
+  });
+}
+
+}  // namespace turtlegas::server::detail

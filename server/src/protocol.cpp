@@ -1,0 +1,203 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/server/protocol.hpp"
+
+#include <cmath>
+
+#include "turtlegas/sim/suggest.hpp"
+
+namespace turtlegas::server {
+namespace {
+
+using nlohmann::json;
+
+std::string type_name(const json& v) {
+  if (v.is_null()) return "null";
+  if (v.is_boolean()) return "a boolean";
+  if (v.is_number()) return "a number";
+  if (v.is_string()) return "a string";
+  if (v.is_array()) return "an array";
+  return "an object";
+}
+
+std::string path(const char* key) { return std::string("/") + key; }
+
+[[noreturn]] void missing(const char* key, std::string_view what, std::string_view example) {
+  throw RequestError("missing_field", path(key) + " is missing: it must be " + std::string(what) +
+                                          "; send e.g. " + std::string(example),
+                     path(key));
+}
+
+[[noreturn]] void wrong(const char* key, const json& v, std::string_view what, std::string_view example) {
+  throw RequestError("wrong_type", path(key) + " must be " + std::string(what) + " (got " + type_name(v) +
+                                       "); send e.g. " + std::string(example),
+                     path(key));
+}
+
+}  // namespace
+
+const std::vector<std::string>& message_types() {
+  static const std::vector<std::string> types = {
+      "hello", "subscribe", "unsubscribe", "snapshot", "pause", "resume", "step", "speed", "run_until",
+      "claim", "release", "forward", "back", "left", "right", "wait", "yield", "pen", "add_wall",
+      "save", "load", "spawn", "remove", "teleport", "ping", "stats"};
+  return types;
+}
+
+std::string error_text(std::string_view code, std::string_view message, const json* id, std::string_view request,
+                       std::string_view field) {
+  json e = {{"type", "error"}};
+  if (id && !id->is_null()) e["id"] = *id;
+  e["code"] = code;
+  if (!request.empty()) e["request"] = request;
+  if (!field.empty()) e["field"] = field;
+  e["message"] = message;
+  return e.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+std::string error_reply(const json& message, const RequestError& e) {
+  const json* id = nullptr;
+  std::string request;
+  if (message.is_object()) {
+    if (auto it = message.find("id"); it != message.end() && (it->is_number() || (it->is_string() && it->get_ref<const std::string&>().size() <= 64)))
+      id = &*it;
+    if (auto it = message.find("type"); it != message.end() && it->is_string() && it->get_ref<const std::string&>().size() <= 64)
+      request = it->get<std::string>();
+  }
+  return error_text(e.code, e.what(), id, request, e.field);
+}
+
+void check_id(const json& m) {
+  const auto it = m.find("id");
+  if (it == m.end() || it->is_null() || it->is_number()) return;
+  if (it->is_string() && it->get_ref<const std::string&>().size() <= 64) return;
+  throw RequestError("bad_value", "/id must be a number or a string of at most 64 characters (it is echoed in the reply)", "/id");
+}
+
+double number_field(const json& m, const char* key, std::string_view example) {
+  const auto it = m.find(key);
+  if (it == m.end()) missing(key, "a number", example);
+  if (!it->is_number()) wrong(key, *it, "a number", example);
+  const double v = it->get<double>();
+  if (!std::isfinite(v)) throw RequestError("bad_value", path(key) + " must be finite", path(key));
+  return v;
+}
+
+std::optional<double> optional_number(const json& m, const char* key, std::string_view example) {
+  if (!m.contains(key)) return std::nullopt;
+  return number_field(m, key, example);
+}
+
+std::string string_field(const json& m, const char* key, std::string_view example) {
+  const auto it = m.find(key);
+  if (it == m.end()) missing(key, "a string", example);
+  if (!it->is_string()) wrong(key, *it, "a string", example);
+  return it->get<std::string>();
+}
+
+std::optional<bool> optional_bool(const json& m, const char* key, std::string_view example) {
+  const auto it = m.find(key);
+  if (it == m.end()) return std::nullopt;
+  if (!it->is_boolean()) wrong(key, *it, "true or false", example);
+  return it->get<bool>();
+}
+
+sim::Vec2 point_field(const json& m, const char* key, std::string_view prefix, std::string_view example) {
+  const std::string p = std::string(prefix) + "/" + key;
+  const auto it = m.find(key);
+  if (it == m.end())
+    throw RequestError("missing_field", p + " is missing: it must be [x, y]; send e.g. " + std::string(example), p);
+  if (!it->is_array() || it->size() != 2 || !(*it)[0].is_number() || !(*it)[1].is_number())
+    throw RequestError("wrong_type", p + " must be [x, y], two numbers (got " + type_name(*it) + "); send e.g. " + std::string(example), p);
+  const sim::Vec2 v{(*it)[0].get<double>(), (*it)[1].get<double>()};
+  if (!std::isfinite(v.x) || !std::isfinite(v.y)) throw RequestError("bad_value", p + " must be finite", p);
+  return v;
+}
+
+turtle::RemoteCommand read_command(const json& m, std::string_view type) {
+  using K = turtle::RemoteCommand::Kind;
+  turtle::RemoteCommand c;
+  if (type == "pen") {
+    constexpr std::string_view ex = R"({"type": "pen", "turtle": "t1", "down": true, "mode": "line"})";
+    const std::optional<bool> down = optional_bool(m, "down", ex);
+    if (!down) missing("down", "true or false", ex);
+    c.kind = *down ? K::pen_down : K::pen_up;
+    if (m.contains("mode")) {
+      const std::string mode = string_field(m, "mode", ex);
+      if (mode != "line" && mode != "wall")
+        throw RequestError("bad_value", "/mode must be \"line\" or \"wall\" (got \"" + mode + "\")", "/mode");
+      c.pen = mode == "wall" ? turtle::PenMode::wall : turtle::PenMode::line;
+    }
+    return c;
+  }
+  c.kind = *turtle::remote_command_kind(type);
+  if (turtle::takes_amount(c.kind)) {
+    const std::string ex = "{\"type\": \"" + std::string(type) + "\", \"turtle\": \"t1\", \"amount\": " +
+                           (c.kind == K::wait ? "0.5" : c.kind == K::left || c.kind == K::right ? "90" : "100") + "}";
+    c.amount = number_field(m, "amount", ex);
+    if (c.amount < 0.0)
+      throw RequestError("bad_value", "/amount must be >= 0 (got " + json(c.amount).dump() + "); " +
+                                          (c.kind == K::forward ? "use back to go backwards" : c.kind == K::back ? "use forward" : c.kind == K::left ? "use right" : c.kind == K::right ? "use left" : "a wait is a time >= 0"),
+                         "/amount");
+  }
+  return c;
+}
+
+json touch_json(const turtle::Touch& touch) {
+  json names = json::array();
+  if (touch.sensor_names)
+    for (std::size_t k = 0; k < touch.sensor_names->size(); ++k)
+      if (touch.fired(k)) names.push_back((*touch.sensor_names)[k]);
+  const double bearing = touch.bearing == 0.0 ? 0.0 : touch.bearing;  // no "-0.0"
+  return {{"sensors", names}, {"bits", touch.sensors}, {"bearing", bearing}, {"what", touch.what},
+          {"kind", touch.kind}, {"t", touch.t}};
+}
+
+std::string_view pen_name(bool down, turtle::PenMode mode) {
+  if (!down) return "up";
+  return mode == turtle::PenMode::wall ? "wall" : "line";
+}
+
+std::string report_text(const turtle::RemoteReport& r, std::string_view turtle_id, const json& id) {
+  using Kind = turtle::RemoteReport::Kind;
+  json out;
+  switch (r.kind) {
+    case Kind::result: {
+      out["type"] = "result";
+      if (!id.is_null()) out["id"] = id;
+      out["turtle"] = turtle_id;
+      out["command"] = turtle::to_string(r.command.kind);
+      if (turtle::takes_amount(r.command.kind)) out["amount"] = r.command.amount;
+      out["done"] = r.result.done();
+      out["touched"] = r.result.touched();
+      if (r.result.touched()) out["touch"] = touch_json(r.result.touch());
+      break;
+    }
+    case Kind::touch:
+      out = {{"type", "touch"}, {"turtle", turtle_id}, {"touch", touch_json(r.touch)}};
+      break;
+    case Kind::message:
+      out = {{"type", "message"}, {"turtle", turtle_id}, {"data", r.message.data}, {"sent", r.message.t}};
+      break;
+    case Kind::fault:
+      out = {{"type", "fault"}, {"turtle", turtle_id}, {"message", r.fault}};
+      break;
+  }
+  out["t"] = r.t;
+  out["step"] = r.step;
+  if (r.kind == Kind::result) {
+    json state = {{"heading", r.heading}, {"odometer", r.odometer}, {"pen", pen_name(r.pen_down, r.pen_mode)}, {"it", r.it}};
+    if (r.position) state["pos"] = {r.position->x, r.position->y};
+    out["state"] = std::move(state);
+  }
+  return out.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+void check_plain_name(const std::string& name) {
+  bool ok = !name.empty() && name.size() <= 100 && name[0] != '.';
+  for (char c : name)
+    ok = ok && ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-');
+  if (!ok)
+    throw RequestError("bad_path", "/file must be a plain name in the save directory: 1 to 100 of A-Z a-z 0-9 . _ -, not starting with '.' (no '/', no '..'); e.g. \"snap.json\"", "/file");
+}
+
+}  // namespace turtlegas::server

@@ -1,0 +1,188 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Every example of docs/protocol.md, sent to a real server over TCP lines and over WebSocket:
+each documented request gets a reply of the documented type whose keys include the documented
+example's keys (and the nested objects' keys). Also the binary frame layout, and one reply per
+error code that a single well-behaved session can provoke."""
+
+import json
+import os
+import re
+import shutil
+import struct
+import tempfile
+import time
+
+from harness import ROOT, Server, check, main, world
+from turtlegas_client import World, decode_binary_frame
+
+DOC = os.path.join(ROOT, "docs", "protocol.md")
+REQUESTS = {"hello", "subscribe", "unsubscribe", "snapshot", "pause", "resume", "step", "speed", "run_until",
+            "claim", "release", "forward", "back", "left", "right", "wait", "yield", "pen", "add_wall", "save",
+            "load", "ping", "stats"}
+
+
+def doc_examples():
+    """(requests by type, server messages by type) from the ```json blocks of the page."""
+    text = open(DOC).read()
+    requests, replies = {}, {}
+    for block in re.findall(r"```json\n(.*?)```", text, re.S):
+        try:
+            objects = [json.loads(block)]
+        except ValueError:
+            objects = [json.loads(line) for line in block.splitlines() if line.strip()]
+        for o in objects:
+            kind = o["type"]
+            is_request = kind in REQUESTS and ("protocol" in o or kind != "hello") and kind not in ("stats", "snapshot") or \
+                (kind in ("stats", "snapshot") and set(o) <= {"type", "id"})
+            (requests if is_request else replies).setdefault(kind, []).append(o)
+    return requests, replies
+
+
+REQUESTS_DOC, REPLIES_DOC = doc_examples()
+
+
+def same_shape(doc, got, where):
+    """Every key of the documented object is in the reply; nested objects alike (first element of
+    lists of objects)."""
+    check(isinstance(got, dict), "%s: an object (got %r)" % (where, got))
+    for k, v in doc.items():
+        check(k in got, "%s: key %r of the documented example is in the reply %r" % (where, k, sorted(got)))
+        if isinstance(v, dict) and v and isinstance(got[k], dict):
+            same_shape(v, got[k], where + "/" + k)
+        if isinstance(v, list) and v and isinstance(v[0], dict) and isinstance(got[k], list) and got[k]:
+            same_shape(v[0], got[k][0], where + "/" + k + "/0")
+
+
+def reply_shape(kind, got, solicited=True):
+    """A reply to a request with an id echoes it; an unsolicited message (a frame, the snapshot
+    after subscribing) has none."""
+    check(got["type"] == kind, "a %s reply (got %r)" % (kind, got))
+    doc = dict(REPLIES_DOC[kind][0])
+    if not solicited:
+        check("id" not in got, "%s: unsolicited, no id" % kind)
+        doc.pop("id", None)
+    same_shape(doc, got, kind)
+
+
+def ask(w, request):
+    """Sends a documented request as written (its own id) and returns the reply with that id."""
+    m = dict(request)
+    rid = m.pop("id")
+    return w.request(m) if rid is None else w.request(m)
+
+
+def session(w, save_dir):
+    check(REQUESTS_DOC.keys() >= REQUESTS, "the page has an example of every request: missing %s" % sorted(REQUESTS - REQUESTS_DOC.keys()))
+    reply_shape("welcome", w.welcome)
+    doc = REQUESTS_DOC
+    sub = ask(w, doc["subscribe"][0])
+    reply_shape("subscribed", sub)
+    check(sub["events"] == ["tag", "touch"] and sub["rate"] == 30, "subscribed as asked: %r" % sub)
+    snap = w.frames.get(timeout=10)
+    reply_shape("snapshot", snap, solicited=False)
+    check(snap["balls"]["ids"] == ["b1", "b2"] and len(snap["balls"]["pos"]) == 4, "the snapshot's balls: %r" % snap["balls"])
+    frame = w.frames.get(timeout=10)
+    reply_shape("frame", frame, solicited=False)
+    check(frame["seq"] >= 1 and len(frame["turtles"]) == 2, "a frame: %r" % frame)
+    reply_shape("ok", ask(w, doc["unsubscribe"][0]))
+    reply_shape("snapshot", ask(w, doc["snapshot"][0]))
+    for kind in ("pause", "resume", "step", "speed", "run_until"):
+        r = ask(w, doc[kind][0])
+        reply_shape("ok", r)
+        check(r["request"] == kind, "ok names its request: %r" % r)
+    check(w.request({"type": "speed", "factor": "max"})["status"]["speed"] == "max", "speed max")
+    w.resume()
+    reply_shape("claimed", ask(w, doc["claim"][0]))
+    for kind in ("forward", "back", "left", "right", "wait", "yield", "pen"):
+        r = ask(w, doc[kind][0])
+        # `touch` only when touched; `amount` only for the commands that take one (docs: yield, pen have none).
+        skip = {"touch"} if not r.get("touched") else set()
+        if kind in ("yield", "pen"):
+            skip.add("amount")
+        same_shape({k: v for k, v in REPLIES_DOC["result"][0].items() if k not in skip}, r, kind)
+        check(("amount" in r) == (kind not in ("yield", "pen")), "amount echoed for %s only if it has one" % kind)
+        check(r["command"] == (kind if kind != "pen" else "pen_down"), "the result names the command: %r" % r)
+    # In lockstep a boundary (where add_wall happens) needs t1's next command: let it go first.
+    reply_shape("ok", ask(w, doc["release"][0]))
+    r = ask(w, doc["add_wall"][0])
+    reply_shape("ok", r)
+    check(r["request"] == "add_wall", "add_wall ok")
+    r = ask(w, doc["save"][0])
+    check(r["type"] == "ok" and r["file"] == "snap.json", "save ok: %r" % r)
+    saved = json.load(open(os.path.join(save_dir, "snap.json")))
+    check("turtles" in saved and "balls" in saved and saved["t"] > 0, "the saved state: %r" % sorted(saved))
+    # The error example of the page, exactly.
+    try:
+        w.request({"type": "forward", "turtle": "t1", "amount": "x"})
+        check(False, "a string amount is refused")
+    except Exception as e:
+        reply_shape("error", e.reply)
+        check(e.reply["code"] == "wrong_type" and e.reply["field"] == "/amount", "wrong_type at /amount: %r" % e.reply)
+    for kind in ("spawn", "remove", "teleport"):
+        try:
+            w.request({"type": kind})
+            check(False, kind + " is refused")
+        except Exception as e:
+            check(e.reply["code"] == "unsupported", "%s: unsupported (%r)" % (kind, e.reply))
+    r = ask(w, doc["load"][0])
+    check(r["type"] == "ok", "load ok: %r" % r)
+    deadline = time.monotonic() + 10
+    notice = None
+    while time.monotonic() < deadline:
+        n = w.notices.get(timeout=10)
+        if n["type"] == "world":
+            notice = n
+            break
+    check(notice and notice["world"]["name"] == "protocol room", "every connection hears of the new world: %r" % notice)
+    reply_shape("pong", ask(w, doc["ping"][0]))
+    reply_shape("stats", ask(w, doc["stats"][0]))
+
+
+def with_server(connect):
+    d = tempfile.mkdtemp()
+    try:
+        shutil.copy(world("protocol_room.json"), os.path.join(d, "room.json"))
+        with Server(world("protocol_room.json"), "--save-dir", d, "--paused") as s:
+            w = connect(s)
+            session(w, d)
+            check(s.stop() == 0, "SIGINT: exit 0")
+            check(w.bye and w.bye["reason"] == "signal", "bye on SIGINT: %r" % w.bye)
+    finally:
+        shutil.rmtree(d)
+
+
+def test_doc_examples_over_lines():
+    with_server(lambda s: World.connect("127.0.0.1", s.line_port))
+
+
+def test_doc_examples_over_websocket():
+    with_server(lambda s: World.connect_ws("127.0.0.1", s.http_port))
+
+
+def test_binary_frames():
+    with Server(world("protocol_room.json"), "--speed", "max") as s:
+        w = World.connect_ws("127.0.0.1", s.http_port)
+        sub = w.subscribe(rate=50, events="all", fmt="binary")
+        check(sub["format"] == "binary", "binary subscription")
+        snap = w.frames.get(timeout=10)
+        check(snap["type"] == "snapshot", "a JSON snapshot first")
+        f = w.frames.get(timeout=10)
+        check(isinstance(f, dict) and "pos" in f, "a binary frame decoded: %r" % (f,))
+        check(f["version"] == 1 and len(f["pos"]) == 4 and len(f["vel"]) == 4 and len(f["turtles"]) == 6, "2 balls, 2 turtles")
+        check(f["turtle_flags"][0] & 8 and not f["turtle_flags"][1] & 8, "t1 is remote, t2 is not")
+        check("events" in f["tail"] and len(f["tail"]["trails"]) == 2, "the tail: %r" % f["tail"])
+        f2 = w.frames.get(timeout=10)
+        check(f2["seq"] > f["seq"] and f2["t"] >= f["t"], "frames go on")
+        # Over TCP lines binary frames are refused.
+        l = World.connect("127.0.0.1", s.line_port)
+        try:
+            l.subscribe(fmt="binary")
+            check(False, "binary over lines refused")
+        except Exception as e:
+            check(e.reply["code"] == "unsupported", "unsupported: %r" % e.reply)
+        s.stop()
+
+
+if __name__ == "__main__":
+    main([test_doc_examples_over_lines, test_doc_examples_over_websocket, test_binary_frames])
