@@ -88,7 +88,10 @@ std::optional<ParamProblem> check_params(const std::string& controller, const Co
   if (!info.params_declared || !params.is_object()) return std::nullopt;
   std::vector<std::string> known;
   for (const ParamSpec& s : info.params) known.push_back(s.name);
-  for (const auto& [key, value] : params.items()) {
+  for (const auto& item : params.items()) {
+    // Named, not a structured binding: clang 14 cannot capture those in the lambda below.
+    const std::string& key = item.key();
+    const nlohmann::json& value = item.value();
     if (is_comment(key)) continue;
     const std::string pointer = "/" + pointer_token(key);
     const ParamSpec* spec = nullptr;
