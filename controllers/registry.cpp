@@ -3,24 +3,31 @@
 
 namespace turtlegas::controllers {
 
+// Each controller's file defines it and its declaration (parameters, restartable).
 void wander(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo wander_info();
 void wall_follower(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo wall_follower_info();
 void spiral(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo spiral_info();
 void square(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo square_info();
 void tag_chaser(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo tag_chaser_info();
 void tag_evader(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo tag_evader_info();
 void tag_random(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo tag_random_info();
 
 turtle::Registry builtin_registry() {
   turtle::Registry r = turtle::base_registry();
-  r.add("wander", wander, "go until touched, back off, turn a random angle (step, back_off, max_turn)");
-  r.add("wall_follower", wall_follower, "keep a wall on one side (hand: right|left, hop, probe, back_off)");
-  r.add("spiral", spiral, "square spiral, sides growing until a touch (start, grow, angle, sides)");
-  r.add("square", square, "drive a square (side, laps, left)");
-  r.add("tag_chaser", tag_chaser,
-        "tag: when it, sweep and lunge at the last tagger; else keep still (leg, lunge, no_tag_back, back_off, flee)");
-  r.add("tag_evader", tag_evader, "tag: when not it, follow walls and flee touches (reach, curve, back_off, flee, leg)");
-  r.add("tag_random", tag_random, "tag: random legs whatever the role, a baseline (leg, back_off)");
+  r.add("wander", wander, wander_info());
+  r.add("wall_follower", wall_follower, wall_follower_info());
+  r.add("spiral", spiral, spiral_info());
+  r.add("square", square, square_info());
+  r.add("tag_chaser", tag_chaser, tag_chaser_info());
+  r.add("tag_evader", tag_evader, tag_evader_info());
+  r.add("tag_random", tag_random, tag_random_info());
   return r;
 }
 

@@ -2,23 +2,25 @@
 // tag_chaser: when "it", sweep the arena in long legs and, after being tagged, wait out the
 // no-tag-back interval facing the tagger and lunge at it; when not "it", keep still (a still
 // turtle is the hardest to run into) and flee from any turtle that touches it.
-//   params: leg (units, default 400), lunge (units, 80), no_tag_back (s, the world's rule, 2),
-//           back_off (units, 5), flee (units, 60)
+//   params: declared in tag_chaser_info() below (`turtlegas controllers` lists them)
 #include <algorithm>
 #include <optional>
 #include <string>
 
 #include "tag_common.hpp"
+#include <limits>
+
+#include "turtlegas/turtle/registry.hpp"
 #include "turtlegas/turtle/turtle.hpp"
 
 namespace turtlegas::controllers {
 
 void tag_chaser(turtle::Turtle& t, const turtle::Params& p) {
-  const double leg = p.get("leg", 400.0);
-  const double lunge = p.get("lunge", 80.0);
-  const double no_tag_back = p.get("no_tag_back", 2.0);
-  const double back_off = p.get("back_off", 5.0);
-  const double flee = p.get("flee", 60.0);
+  const double leg = p.get<double>("leg");
+  const double lunge = p.get<double>("lunge");
+  const double no_tag_back = p.get<double>("no_tag_back");
+  const double back_off = p.get<double>("back_off");
+  const double flee = p.get<double>("flee");
 
   // The last turtle that touched us, and where: a tag's message follows its touch at the same
   // control step, so the tagger's bearing is known when the message says we are "it".
@@ -65,6 +67,19 @@ void tag_chaser(turtle::Turtle& t, const turtle::Params& p) {
       }
     }
   }
+}
+
+turtle::ControllerInfo tag_chaser_info() {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  turtle::ControllerInfo info;
+  info.summary = "tag: when it, sweep and lunge at the last tagger; else keep still";
+  info.params = {turtle::number_param("leg", 400.0, 0, inf, "the longest sweeping leg, units"),
+                 turtle::number_param("lunge", 80.0, 0, inf, "the lunge at the tagger, units"),
+                 turtle::number_param("no_tag_back", 2.0, 0, inf, "how long to wait before lunging, seconds (the world's rule)"),
+                 turtle::number_param("back_off", 5.0, 0, inf, "how far to back off after a touch, units"),
+                 turtle::number_param("flee", 60.0, 0, inf, "how far to flee a touch when not it, units")};
+  info.restartable = true;  // it reads its Turtle and Params only
+  return info;
 }
 
 }  // namespace turtlegas::controllers

@@ -4,18 +4,21 @@
 // Feel along the wall in short hops: after each hop, turn towards the wall and probe; a touch
 // means the wall is still there, so turn back along it; no touch means a corner went away, so
 // follow it round. Touching something ahead means an inside corner: turn away from the wall.
-//   params: hand, hop (default 20), probe (default 12), back_off (default 3)
+//   params: declared in wall_follower_info() below (`turtlegas controllers` lists them)
 #include <string>
 
+#include <limits>
+
+#include "turtlegas/turtle/registry.hpp"
 #include "turtlegas/turtle/turtle.hpp"
 
 namespace turtlegas::controllers {
 
 void wall_follower(turtle::Turtle& t, const turtle::Params& p) {
-  const bool right_hand = p.get<std::string>("hand", "right") != "left";
-  const double hop = p.get("hop", 20.0);
-  const double probe = p.get("probe", 12.0);
-  const double back_off = p.get("back_off", 3.0);
+  const bool right_hand = p.get<std::string>("hand") != "left";
+  const double hop = p.get<double>("hop");
+  const double probe = p.get<double>("probe");
+  const double back_off = p.get<double>("back_off");
   auto towards_wall = [&](double deg) { return right_hand ? t.right(deg) : t.left(deg); };
   auto away_from_wall = [&](double deg) { return right_hand ? t.left(deg) : t.right(deg); };
 
@@ -38,6 +41,18 @@ void wall_follower(turtle::Turtle& t, const turtle::Params& p) {
     }
     // No touch: the wall turned away (an outside corner); keep the new heading and go on.
   }
+}
+
+turtle::ControllerInfo wall_follower_info() {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  turtle::ControllerInfo info;
+  info.summary = "keep a wall on one side";
+  info.params = {turtle::string_param("hand", "right", {"right", "left"}, "which side the wall is kept on"),
+                 turtle::number_param("hop", 20.0, 0, inf, "how far to drive along the wall between probes, units"),
+                 turtle::number_param("probe", 12.0, 0, inf, "how far to reach sideways for the wall, units"),
+                 turtle::number_param("back_off", 3.0, 0, inf, "how far to back off after a touch, units")};
+  info.restartable = true;  // it reads its Turtle and Params only
+  return info;
 }
 
 }  // namespace turtlegas::controllers

@@ -2,20 +2,42 @@
 #include "check_command.hpp"
 
 #include <cstdio>
+#include <string>
+#include <vector>
+
+#include <spdlog/spdlog.h>
 
 #include "cli_common.hpp"
+#include "scene_scales.hpp"
 
 namespace turtlegas::apps {
 
 int check_command(const std::string& file, const turtle::Registry& registry) {
   const world::Scene scene = load(file, registry);
   const sim::WorldDef& def = scene.def;
-  const sim::World exact = make_world(def, sim::Mode::exact, file);
-  const sim::World step = make_world(def, sim::Mode::step, file);
+  // One engine at a time: a scene near the memory budget must not need two of it at once (an
+  // explicit "cell": 1 over 14000 x 14000 took 3 GB when both were built together).
+  double cell_size = 0.0;
+  int cells_x = 0, cells_y = 0;
+  std::vector<std::string> warnings;
+  for (sim::Mode mode : {sim::Mode::exact, sim::Mode::step}) {
+    const sim::World world = make_world(def, mode, file);
+    if (mode == sim::Mode::step) cell_size = world.cell_size(), cells_x = world.cells_x(), cells_y = world.cells_y();
+    // How much work the scene's scales predict (scene_scales.hpp), over its expect list's run or
+    // one simulated second.
+    SceneScales scales = predict_scales(def, mode);
+    scales.set_cell(world.cell_size());
+    const double seconds = scene.expect.until.value_or(1.0);
+    const std::string span = std::string(sim::to_string(mode)) + " mode: " +
+                             (scene.expect.until ? "the expect list's run to until " + fmt(seconds)
+                                                 : std::string("one simulated second"));
+    for (std::string& w : scale_warnings(scales, seconds, span)) warnings.push_back(std::move(w));
+  }
   std::printf("%s: ok: \"%s\", %s, arena %s x %s (boundary %s), cell %s (%d x %d), dt %s s\n", file.c_str(),
-              def.name.c_str(), count_summary(def, def.balls.size()).c_str(), fmt(def.arena.width).c_str(), fmt(def.arena.height).c_str(),
-              boundary_name(def.arena.boundary), fmt(step.cell_size()).c_str(), step.cells_x(), step.cells_y(),
+              def.name.c_str(), count_summary(def, def.balls.size()).c_str(), fmt(def.arena.width).c_str(),
+              fmt(def.arena.height).c_str(), boundary_name(def.arena.boundary), fmt(cell_size).c_str(), cells_x, cells_y,
               fmt(def.dt).c_str());
+  for (const std::string& w : warnings) spdlog::warn("{}: {}", file, w);
   if (!def.turtles.empty()) {
     // Building the servers checks what only the runtime knows (controllers, sensors); no program
     // runs until the first control step, so this costs nothing.

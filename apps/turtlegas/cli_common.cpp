@@ -3,7 +3,10 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <system_error>
 #include <vector>
 
 #include "turtlegas/world/world_file.hpp"
@@ -25,6 +28,46 @@ std::unique_ptr<turtle::WorldServer> make_server(const world::Scene& scene, cons
   } catch (const std::invalid_argument& e) {
     throw BadInput(file + ": " + std::string(sim::to_string(options.mode)) + " mode: " + e.what());
   }
+}
+
+namespace {
+
+std::string range_words(const std::string& noun, const std::string& unit, const std::string& lo, const std::string& hi,
+                        bool open_min, bool unbounded) {
+  std::string s = "must be " + noun + (unit.empty() ? "" : " of " + unit);
+  if (unbounded) return s + (open_min ? " > " : " >= ") + lo;
+  return s + " from " + lo + (open_min ? " (exclusive)" : "") + " to " + hi;
+}
+
+}  // namespace
+
+CLI::Validator real_in(double min, double max, const std::string& unit, bool min_exclusive) {
+  const bool unbounded = max >= std::numeric_limits<double>::max();
+  const std::string words = range_words("a number", unit, fmt(min), fmt(max), min_exclusive, unbounded);
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        double v = 0.0;
+        const char* end = text.data() + text.size();
+        const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+        const bool parsed = ec == std::errc() && ptr == end;
+        if (parsed && std::isfinite(v) && (min_exclusive ? v > min : v >= min) && v <= max) return {};
+        return words + " (got " + text + ")";
+      },
+      words);
+}
+
+CLI::Validator integer_in(std::int64_t min, std::int64_t max, const std::string& unit) {
+  const std::string words = range_words("a whole number", unit, std::to_string(min), std::to_string(max), false,
+                                        max == std::numeric_limits<std::int64_t>::max());
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        std::int64_t v = 0;
+        const char* end = text.data() + text.size();
+        const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+        if (ec == std::errc() && ptr == end && v >= min && v <= max) return {};
+        return words + " (got " + text + ")";
+      },
+      words);
 }
 
 std::string count_summary(const sim::WorldDef& def, std::size_t balls) {

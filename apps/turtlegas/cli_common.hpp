@@ -4,10 +4,14 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include <CLI/CLI.hpp>
 
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/sim/world.hpp"
@@ -45,6 +49,17 @@ sim::World make_world(Def&& def, sim::Mode mode, const std::string& file) {
     throw BadInput(file + ": " + std::string(sim::to_string(mode)) + " mode: " + e.what());
   }
 }
+
+/// Range checks for numeric options, for every command: applied to the option's text before CLI11
+/// converts it, which would read "-1" into a std::size_t as 2^64 - 1 and take "nan" and "inf" as
+/// numbers. A value out of range is a parse error (exit code 2): "--rounds: must be a whole
+/// number from 1 to 1000000 (got -1)".
+///
+/// A finite number from `min` to `max` (> min when min_exclusive), of `unit` ("seconds"; may
+/// be empty): `run->add_option("--dt", dt)->check(real_in(0, 1e9, "seconds", true))`.
+CLI::Validator real_in(double min, double max, const std::string& unit, bool min_exclusive = false);
+/// A whole number from `min` to `max`, written without a fraction or exponent.
+CLI::Validator integer_in(std::int64_t min, std::int64_t max, const std::string& unit = {});
 
 /// "3 balls, 1 wall (+4 arena walls), 2 turtles".
 std::string count_summary(const sim::WorldDef& def, std::size_t balls);

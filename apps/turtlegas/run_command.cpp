@@ -9,16 +9,23 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
-#include "atomic_file.hpp"
+#include "checkpoint.hpp"
 #include "cli_common.hpp"
+#include "output_file.hpp"
+#include "scene_scales.hpp"
+#include "signals.hpp"
 #include "turtlegas/formats/event_log.hpp"
 #include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/names.hpp"
@@ -35,21 +42,30 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Simulated time / until on stderr, refreshed in place, only on a terminal and only once a run
-/// has taken long enough for it to help.
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+/// A line on stderr, refreshed in place, only on a terminal and only once a run has taken long
+/// enough for it to help: simulated time, events per second, and when it will be done.
 class Progress {
  public:
   explicit Progress(double until) : until_(until), start_(Clock::now()), enabled_(::isatty(STDERR_FILENO) != 0) {}
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
 
-  void update(double t, std::uint64_t events) {
+  void update(double t, std::uint64_t events, const char* doing) {
     if (!enabled_) return;
     const auto now = Clock::now();
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     if (elapsed < 2.0 || now - last_ < std::chrono::milliseconds(200)) return;
+    if (!shown_) t0_ = t, events0_ = events, since_ = now;  // rates from the first line on
     last_ = now;
+    const double span = std::chrono::duration<double>(now - since_).count();
     const double pct = until_ > 0.0 ? 100.0 * t / until_ : 100.0;
-    std::fprintf(stderr, "\r  t = %.6g / %.6g s  %5.1f%%  %.3g events/s ", t, until_, pct,
-                 static_cast<double>(events) / elapsed);
+    const double rate = span > 0.0 ? static_cast<double>(events - events0_) / span : 0.0;
+    const double sim_rate = span > 0.0 ? (t - t0_) / span : 0.0;
+    const std::string eta = sim_rate > 0.0 ? human_duration((until_ - t) / sim_rate) : std::string("unknown");
+    std::fprintf(stderr, "\r\033[K  %st = %.6g / %.6g s  %5.1f%%  %.3g events/s  ETA %s ", doing, t, until_, pct, rate,
+                 eta.c_str());
     std::fflush(stderr);
     shown_ = true;
   }
@@ -61,47 +77,91 @@ class Progress {
 
  private:
   double until_;
-  Clock::time_point start_;
-  Clock::time_point last_{};
+  Clock::time_point start_, since_{}, last_{};
+  double t0_ = 0.0;
+  std::uint64_t events0_ = 0;
   bool enabled_;
   bool shown_ = false;
 };
 
-
 /// What a run adds up besides the engine's own Stats.
 struct RunTotals {
-  double wall_seconds = 0.0;
   double energy_start = 0.0;
   std::uint64_t touches = 0;
   std::uint64_t faults = 0;
   std::size_t turtles_finished = 0;
 };
 
-/// Advances in chunks so the event buffer stays bounded and progress can be shown; the physics
-/// does not depend on where a run is cut. `advance(t)` runs to t and returns the events since the
-/// last call, which `flush` gets. Chunks start at `first_chunk` and adapt to about 0.1 s of wall
-/// time, but never drop below `min_chunk`.
-template <class Advance, class Flush>
-double run_in_chunks(double from, double until, double first_chunk, double min_chunk, Progress& progress,
-                     Advance&& advance, Flush&& flush) {
-  const auto start = Clock::now();
-  double t = from;
-  double chunk = first_chunk;
-  while (t < until) {
-    double next = std::min(until, t + chunk);
-    if (!(next > t)) next = until;
-    const auto chunk_start = Clock::now();
-    const auto [events, total_events] = advance(next);
-    const double took = std::chrono::duration<double>(Clock::now() - chunk_start).count();
-    flush();
-    if ((took > 0.25 || events > (1u << 20)) && chunk / 2.0 >= min_chunk) chunk /= 2.0;
-    else if (took < 0.05 && events < (1u << 18)) chunk *= 2.0;
-    t = next;
-    progress.update(t, total_events);
+/// Why the chunk loop ended.
+enum class Stop { until, signal, max_wall_seconds, max_events };
+
+const char* stop_name(Stop s, int sig) {
+  switch (s) {
+    case Stop::until: return "";
+    case Stop::signal: return signal_name(sig);
+    case Stop::max_wall_seconds: return "max-wall-seconds";
+    case Stop::max_events: return "max-events";
   }
-  return std::chrono::duration<double>(Clock::now() - start).count();
+  return "";
 }
 
+/// How the loop cuts a run into chunks. The physics does not depend on where a run is cut; the
+/// cuts are where outputs are flushed, progress is shown, limits and Ctrl-C are looked at, and
+/// checkpoints are written. A chunk starts small enough for the scene's predicted event rate
+/// (scene_scales.hpp: a runaway scene still comes back every ~2^14 events) and then adapts to
+/// about 0.1 s of wall time, halving above 0.25 s or 2^20 events, doubling below 0.05 s and 2^18.
+struct Pace {
+  double chunk = 0.0;
+};
+
+struct Limits {
+  double until = 0.0;
+  std::optional<double> max_wall_seconds;
+  std::optional<std::uint64_t> max_events;
+  std::optional<double> checkpoint_every;
+};
+
+/// Runs chunks until `limits.until` or a stop. `advance(t)` runs to t and returns the engine's
+/// event count; `flush()` writes what the chunk logged; `checkpoint(t, why)` is called at every
+/// multiple of checkpoint_every.
+template <class Advance, class Flush, class AtCheckpoint>
+std::pair<Stop, int> run_in_chunks(double from, const Limits& limits, Pace& pace, Clock::time_point start,
+                                   Progress& progress, const char* doing, Advance&& advance, Flush&& flush,
+                                   AtCheckpoint&& checkpoint) {
+  double t = from;
+  std::uint64_t events = 0;
+  double events_per_second = 0.0;  // simulated, measured over the last chunk
+  const double every = limits.checkpoint_every.value_or(0.0);
+  double next_checkpoint = every > 0.0 ? (std::floor(t / every) + 1.0) * every : INFINITY;
+  while (t < limits.until) {
+    if (const int sig = stop_signal()) return {Stop::signal, sig};
+    if (limits.max_wall_seconds && seconds_since(start) >= *limits.max_wall_seconds) return {Stop::max_wall_seconds, 0};
+    if (limits.max_events && events >= *limits.max_events) return {Stop::max_events, 0};
+    double chunk = pace.chunk;
+    // Near --max-events, a chunk of about what is left.
+    if (limits.max_events && events_per_second > 0.0)
+      chunk = std::min(chunk, std::max(static_cast<double>(*limits.max_events - events) / events_per_second, chunk / 1024));
+    double next = std::min({limits.until, t + chunk, next_checkpoint});
+    if (!(next > t)) next = std::nextafter(t, INFINITY);  // a chunk below one ulp of t
+    const auto chunk_start = Clock::now();
+    const std::uint64_t before = events;
+    events = advance(next);
+    const double took = seconds_since(chunk_start);
+    flush();
+    const double done = static_cast<double>(events - before);
+    events_per_second = done / (next - t);
+    if ((took > 0.25 || done > 0x1p20) && pace.chunk / 2.0 > 0.0) pace.chunk /= 2.0;
+    else if (took < 0.05 && done < 0x1p18 && pace.chunk * 2.0 < INFINITY) pace.chunk *= 2.0;
+    t = next;
+    note_run_time(t);
+    if (t >= next_checkpoint) {
+      checkpoint(t, "every " + fmt(every) + " s");
+      next_checkpoint = (std::floor(t / every) + 1.0) * every;
+    }
+    progress.update(t, events, doing);
+  }
+  return {Stop::until, 0};
+}
 
 /// The --stats summary on stdout.
 void print_summary(const formats::RunFigures& run, const sim::World& world, const world::Scene& scene,
@@ -110,8 +170,9 @@ void print_summary(const formats::RunFigures& run, const sim::World& world, cons
   const sim::Stats& st = world.stats();
   const double energy_start = run.energy_start, energy_end = run.energy_end;
   const double de = energy_start != 0.0 ? (energy_end - energy_start) / std::abs(energy_start) : energy_end - energy_start;
-  std::printf("%s (%s): %s, %s mode, t = 0 -> %s s\n", scene.def.name.c_str(), run.world.c_str(), count_summary(scene.def, run.balls).c_str(),
-              sim::to_string(run.mode).data(), fmt(world.time()).c_str());
+  std::printf("%s (%s): %s, %s mode, t = 0 -> %s s%s\n", scene.def.name.c_str(), run.world.c_str(),
+              count_summary(scene.def, run.balls).c_str(), sim::to_string(run.mode).data(), fmt(world.time()).c_str(),
+              run.stopped.empty() ? "" : (" (stopped early: " + run.stopped + ")").c_str());
   std::printf("  collisions   %llu  (ball-ball %llu, ball-wall %llu, ball-wall-end %llu)\n", ull(st.collisions()),
               ull(st.ball_ball), ull(st.ball_wall), ull(st.ball_wall_end));
   if (!scene.def.turtles.empty()) {
@@ -138,66 +199,137 @@ void print_summary(const formats::RunFigures& run, const sim::World& world, cons
   std::printf("  max overlap  %s  (%.3g of a radius)\n", fmt(run.max_overlap).c_str(), run.max_overlap_relative);
 }
 
+/// The state file's bytes, hashed: what a checkpoint says the run had reached.
+std::uint64_t state_hash(const sim::World& world, const formats::RunNames& names) {
+  std::ostringstream s;
+  formats::write_state(s, world, names);
+  return fnv1a64(s.str());
+}
+
+/// The checks a resumed run makes before it starts: the same world, mode and dt, and programs
+/// that replay.
+void check_resumable(const Checkpoint& c, const RunOptions& opt, const world::Scene& scene,
+                     const turtle::Registry& registry) {
+  const std::string where = "--resume " + opt.resume + ": ";
+  if (file_hash(opt.world, "the world file") != c.world_hash)
+    throw BadInput(where + "the world file " + opt.world + " is not the one the checkpoint was written for (" + c.world +
+                   ", whose bytes hash differently): resume with that world, unchanged");
+  if (opt.mode && sim::mode_from_string(*opt.mode) != c.mode)
+    throw BadInput(where + "the checkpoint is of a " + std::string(sim::to_string(c.mode)) + " mode run; leave out --mode " +
+                   *opt.mode);
+  if (opt.dt && *opt.dt != c.dt)
+    throw BadInput(where + "the checkpoint is of a run with dt " + fmt(c.dt) + " s; leave out --dt " + fmt(*opt.dt));
+  if (!(opt.until > c.t))
+    throw BadInput(where + "the checkpoint is at t = " + fmt(c.t) + " s; --until must be later (got " + fmt(opt.until) +
+                   ")");
+  for (std::size_t i = 0; i < scene.programs.size(); ++i) {
+    const std::string& name = scene.programs[i].controller;
+    const turtle::ControllerInfo* info = registry.info(name);
+    if (info && info->restartable) continue;
+    throw BadInput(where + "turtle '" + scene.def.turtles[i].id + "' runs controller '" + name +
+                   "', which does not declare itself restartable. A checkpoint holds no program state (coroutines "
+                   "cannot be saved); resuming replays every program from the start, which only a restartable "
+                   "controller does exactly (docs/controllers.md, \"Checkpoints\"). Rerun from the start instead");
+  }
+}
+
 }  // namespace
 
 CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::string>& plugins,
                           const char* plugin_help) {
   RunOptions& opt = line.parsed;
+  line.plugins = &plugins;
+  constexpr double big = std::numeric_limits<double>::max();
   CLI::App* run = app.add_subcommand("run", "Simulate a world file until time T");
   run->add_option("world", opt.world, "World file (format turtlegas-world/1)")->required();
-  run->add_option("--until", opt.until, "Simulated time to stop at, seconds")->required();
-  run->add_option("--mode", opt.mode, "exact (event-driven) or step (the memo's fixed steps)")
-      ->check(CLI::IsMember(sim::mode_names))
-      ->capture_default_str();
-  line.dt_option = run->add_option("--dt", line.dt, "Step in seconds (overrides the world file's dt)");
-  run->add_option("--events", opt.events, "Write the event log here (JSON lines)");
-  run->add_option("--state-out", opt.state_out, "Write the final state here (JSON)");
+  run->add_option("--until", opt.until, "Simulated time to stop at, seconds")->required()->check(real_in(0, big, "seconds"));
+  line.mode_option = run->add_option("--mode", line.mode, "exact (event-driven) or step (the memo's fixed steps)")
+                         ->check(CLI::IsMember(sim::mode_names))
+                         ->capture_default_str();
+  line.dt_option = run->add_option("--dt", line.dt, "Step in seconds (overrides the world file's dt)")
+                       ->check(real_in(0, big, "seconds", true));
+  run->add_option("--events", opt.events, "Write the event log here (JSON lines; - for standard output)");
+  run->add_option("--state-out", opt.state_out, "Write the final state here (JSON; - for standard output)");
   run->add_flag("--stats", opt.stats, "Print a summary of the run");
-  run->add_option("--stats-json", opt.stats_json, "Write the run's statistics here (JSON)");
-  run->add_option("--svg", opt.svg, "Write an SVG picture of the final state here");
+  run->add_option("--stats-json", opt.stats_json, "Write the run's statistics here (JSON; - for standard output)");
+  run->add_option("--svg", opt.svg, "Write an SVG picture of the final state here (- for standard output)");
   run->add_option("--plugin", plugins, plugin_help);
   run->add_option("--inputs", opt.inputs,
                   "Replay this input log (written by `turtlegas serve --inputs-out`) into the world's remote turtles");
   run->add_option("--stack-kib", opt.stack_kib, "Each turtle program's stack, KiB (a guard page is added)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(16, 1024 * 1024, "KiB"));
   run->add_option("--program-budget", opt.program_budget,
                   "Wall-clock seconds a turtle program may run without issuing a command before the run stops")
-      ->capture_default_str();
-
+      ->capture_default_str()
+      ->check(real_in(0, 1e6, "seconds", true));
+  line.max_wall_option =
+      run->add_option("--max-wall-seconds", line.max_wall_seconds,
+                      "Stop the run cleanly after this much wall-clock time, outputs written up to there (exit 3)")
+          ->check(real_in(0, 1e9, "seconds", true));
+  line.max_events_option =
+      run->add_option("--max-events", line.max_events,
+                      "Stop the run cleanly once the engine has taken this many events, outputs written (exit 3)")
+          ->check(integer_in(1, std::numeric_limits<std::int64_t>::max(), "events"));
+  run->add_option("--checkpoint", opt.checkpoint,
+                  "Write a checkpoint here at the end, when the run stops early, and every --checkpoint-every");
+  line.checkpoint_every_option =
+      run->add_option("--checkpoint-every", line.checkpoint_every, "Simulated seconds between checkpoints")
+          ->check(real_in(0, big, "seconds", true));
+  run->add_option("--resume", opt.resume, "Continue the run a checkpoint was written for (replays it to there)");
   return run;
 }
 
 int run_command(const RunOptions& opt, const turtle::Registry& registry) {
-  if (!std::isfinite(opt.until) || opt.until < 0.0)
-    throw BadInput("--until must be a finite time >= 0 in seconds (got " + fmt(opt.until) + ")");
-  if (opt.dt && (!std::isfinite(*opt.dt) || *opt.dt <= 0.0))
-    throw BadInput("--dt must be a finite time > 0 in seconds (got " + fmt(*opt.dt) + ")");
-  constexpr std::size_t min_stack_kib = 16, max_stack_kib = 1024 * 1024;
-  if (opt.stack_kib < min_stack_kib || opt.stack_kib > max_stack_kib)
-    throw BadInput("--stack-kib must be from " + std::to_string(min_stack_kib) + " to " + std::to_string(max_stack_kib) +
-                   " (got " + std::to_string(opt.stack_kib) + ")");
-  if (!std::isfinite(opt.program_budget) || opt.program_budget <= 0.0)
-    throw BadInput("--program-budget must be a finite time > 0 in seconds of wall clock (got " +
-                   fmt(opt.program_budget) + ")");
-  const sim::Mode mode = sim::mode_from_string(opt.mode).value_or(sim::Mode::exact);  // CLI11 checked it
+  const auto start = Clock::now();
+  if (opt.checkpoint_every && opt.checkpoint.empty())
+    throw BadInput("--checkpoint-every needs --checkpoint F, the file to write the checkpoints to");
+  std::optional<Checkpoint> resume;
+  if (!opt.resume.empty()) resume = read_checkpoint(opt.resume);
+  const sim::Mode mode = resume ? resume->mode : sim::mode_from_string(opt.mode.value_or("exact")).value_or(sim::Mode::exact);
 
-  // Outputs are opened before the run, so a bad path costs nothing.
-  std::optional<AtomicFile> events_file, state_file, stats_file, svg_file;
+  // Outputs are checked and opened before the run, so a bad path costs nothing; none may be an
+  // input (the checkpoint that is resumed may be the one written: it is replaced whole).
+  std::vector<NamedPath> inputs{{opt.world, "the world file"}};
+  for (const std::string& p : opt.plugins) inputs.push_back({p, "--plugin"});
+  std::vector<NamedPath> outputs{{opt.events, "--events"}, {opt.state_out, "--state-out"},
+                                 {opt.stats_json, "--stats-json"}, {opt.svg, "--svg"}, {opt.checkpoint, "--checkpoint"}};
+  if (opt.stats) outputs.push_back({"-", "--stats"});
+  if (!opt.resume.empty()) {
+    std::vector<NamedPath> others(outputs.begin(), outputs.end() - (opt.stats ? 2 : 1));
+    check_outputs(others, {{opt.resume, "--resume"}});
+  }
+  check_outputs(outputs, inputs);
+  if (opt.checkpoint == "-") throw BadInput("--checkpoint needs a file name, not standard output");
+  std::optional<OutputFile> events_file, state_file, stats_file, svg_file;
   if (!opt.events.empty()) events_file.emplace(opt.events, "--events");
   if (!opt.state_out.empty()) state_file.emplace(opt.state_out, "--state-out");
   if (!opt.stats_json.empty()) stats_file.emplace(opt.stats_json, "--stats-json");
   if (!opt.svg.empty()) svg_file.emplace(opt.svg, "--svg");
+  if (!opt.checkpoint.empty()) OutputFile probe(opt.checkpoint, "--checkpoint");  // checks the path only
 
   world::Scene scene = load(opt.world, registry);
   sim::WorldDef& def = scene.def;
-  if (opt.dt) def.dt = *opt.dt;
+  if (resume) {
+    check_resumable(*resume, opt, scene, registry);
+    def.dt = resume->dt;
+  } else if (opt.dt) {
+    def.dt = *opt.dt;
+  }
   const std::size_t ball_count = def.balls.size();
   // For the event log and the state file, kept apart from the scene, which the World may take
   // the balls of (World(WorldDef&&)).
   const formats::IdTable ball_ids = formats::ball_ids(def);
 
+  install_stop_signals();
+  install_crash_report(opt.world);
+
   Progress progress(opt.until);
   RunTotals totals;
+  Limits limits;
+  limits.max_wall_seconds = opt.max_wall_seconds;
+  limits.max_events = opt.max_events;
+  limits.checkpoint_every = opt.checkpoint_every;
   // Exactly one of these runs the scene: the bare engine, or the world server when there are
   // turtles (which then owns the engine).
   std::optional<sim::World> bare;
@@ -212,70 +344,127 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
       throw BadInput(std::string("--inputs: ") + e.what());
     }
   }
+  SceneScales scales;
+  std::function<std::uint64_t(double)> advance;
+  std::function<void(bool)> flush;  // true: write the chunk's events, false: a replay's, dropped
+  std::vector<sim::Event> bare_events;
+  std::vector<turtle::LogEvent> server_events;
+  std::optional<formats::EventLogWriter> writer;
+  if (events_file) writer.emplace(events_file->stream());
+  double first_chunk = 0.0;
   if (def.turtles.empty() && !replay) {
     // The World takes the balls over, so that the scene's copy of them (and their ids' strings)
     // and the engine are never in memory together: a million balls then cost about 170 bytes each
     // rather than 260. def keeps everything else.
-    // (the ids' own strings go with the balls)
     std::vector<sim::BallDef> balls = std::move(def.balls);
     def.balls.clear();
     sim::WorldDef given = def;  // everything but the balls: small
     given.balls = std::move(balls);
+    scales = predict_scales(given, mode);
     bare.emplace(make_world(std::move(given), mode, opt.world));
     sim::World& world = *bare;
     totals.energy_start = world.energy();
-    std::vector<sim::Event> events;
-    std::optional<formats::EventLogWriter> writer;
-    const formats::RunNames names{ball_ids, def, world};
-    if (events_file) {
-      writer.emplace(events_file->stream());
-      world.set_event_log(&events);
-    }
+    world.set_event_log(&bare_events);
     // A quarter step first: short enough for a million balls.
-    totals.wall_seconds = run_in_chunks(
-        world.time(), opt.until, std::min((opt.until - world.time()) / 64.0, def.dt / 4.0), 0.0, progress,
-        [&](double t) {
-          world.advance_to(t);
-          return std::pair{events.size(), world.stats().events};
-        },
-        [&] {
-          if (writer) writer->write(events, names);
-          events.clear();
-        });
-    world.set_event_log(nullptr);
+    first_chunk = std::min((opt.until - world.time()) / 64.0, def.dt / 4.0);
+    advance = [&world](double t) {
+      world.advance_to(t);
+      return world.stats().events;
+    };
+    flush = [&, names = formats::RunNames{ball_ids, def, world}](bool write) {
+      if (write && writer) {
+        writer->write(bare_events, names);
+        events_file->flush();
+      }
+      bare_events.clear();
+    };
   } else {
     turtle::ServerOptions options;
     options.mode = mode;
     options.stack_bytes = opt.stack_kib * 1024;
     options.program_budget = opt.program_budget;
     options.input = replay;
+    scales = predict_scales(def, mode);
     server = make_server(scene, registry, options, opt.world);
     totals.energy_start = server->world().energy();
     // The log is always kept: touches and faults are counted from it.
-    std::vector<turtle::LogEvent> events;
-    std::optional<formats::EventLogWriter> writer;
-    if (events_file) writer.emplace(events_file->stream());
-    server->set_event_log(&events);
+    server->set_event_log(&server_events);
     // Whole control steps at first; programs run only at step boundaries anyway.
-    totals.wall_seconds = run_in_chunks(
-        server->time(), opt.until, def.dt, def.dt, progress,
-        [&](double t) {
-          server->run_until(t);  // a BusyLoopError ends the run (exit 1)
-          return std::pair{events.size(), server->world().stats().events};
-        },
-        [&] {
-          for (const turtle::LogEvent& e : events) {
-            totals.touches += e.kind == "touch" ? 1 : 0;
-            totals.faults += e.kind == "fault" ? 1 : 0;
-          }
-          if (writer) writer->write(events);
-          events.clear();
-        });
-    server->set_event_log(nullptr);
-    for (std::size_t i = 0; i < server->turtle_count(); ++i) totals.turtles_finished += server->turtle(i).finished ? 1 : 0;
+    first_chunk = def.dt;
+    turtle::WorldServer& s = *server;
+    advance = [&s](double t) {
+      s.run_until(t);  // a BusyLoopError ends the run (exit 1)
+      return s.world().stats().events;
+    };
+    flush = [&](bool write) {
+      for (const turtle::LogEvent& e : server_events) {
+        totals.touches += e.kind == "touch" ? 1 : 0;
+        totals.faults += e.kind == "fault" ? 1 : 0;
+      }
+      if (write && writer) {
+        writer->write(server_events);
+        events_file->flush();
+      }
+      server_events.clear();
+    };
+  }
+  const sim::World& world = server ? server->world() : *bare;
+  const formats::RunNames names{ball_ids, def, world};
+  // A scene whose scales predict a run that will not finish says so, with numbers, before it
+  // starts (check says the same); the chunks start small enough to come back all the same.
+  scales.set_cell(world.cell_size());
+  for (const std::string& w :
+       scale_warnings(scales, opt.until - world.time(), "this run to --until " + fmt(opt.until)))
+    spdlog::warn("{}: {}; --max-wall-seconds or --max-events end it cleanly", opt.world, w);
+  if (scales.events_per_second > 0.0) first_chunk = std::min(first_chunk, 0x1p14 / scales.events_per_second);
+  Pace pace{std::max(first_chunk, std::numeric_limits<double>::denorm_min())};
+
+  auto write_checkpoint_at = [&](double t, const std::string& why) {
+    Checkpoint c;
+    c.world = opt.world;
+    c.world_hash = file_hash(opt.world, "the world file");
+    c.mode = mode;
+    c.dt = def.dt;
+    c.t = t;
+    c.events = world.stats().events;
+    c.state_hash = state_hash(world, names);
+    c.why = why;
+    OutputFile out(opt.checkpoint, "--checkpoint");
+    write_checkpoint(out.stream(), c);
+    out.commit();
+  };
+
+  std::pair<Stop, int> end{Stop::until, 0};
+  if (resume) {
+    // The replay: the same run to the checkpoint's time, its events dropped, then the proof that
+    // it is the same run.
+    Limits to_checkpoint = limits;
+    to_checkpoint.until = resume->t;
+    to_checkpoint.checkpoint_every.reset();
+    end = run_in_chunks(world.time(), to_checkpoint, pace, start, progress, "replaying: ", advance,
+                        [&] { flush(false); }, [](double, const std::string&) {});
+    if (end.first == Stop::until) {
+      const bool same = world.time() == resume->t && world.stats().events == resume->events &&
+                        state_hash(world, names) == resume->state_hash;
+      if (!same)
+        throw std::runtime_error("--resume " + opt.resume + ": replaying the run to t = " + fmt(resume->t) +
+                                 " s did not arrive at the checkpoint's state (a controller that is not "
+                                 "deterministic, or a different turtlegas?); rerun from the start");
+    }
+  }
+  if (end.first == Stop::until) {
+    limits.until = opt.until;
+    end = run_in_chunks(world.time(), limits, pace, start, progress, "", advance, [&] { flush(true); },
+                        [&](double t, const std::string& why) { write_checkpoint_at(t, why); });
   }
   progress.clear();
-  const sim::World& world = server ? server->world() : *bare;
+  if (server) {
+    server->set_event_log(nullptr);
+    for (std::size_t i = 0; i < server->turtle_count(); ++i) totals.turtles_finished += server->turtle(i).finished ? 1 : 0;
+  } else {
+    bare->set_event_log(nullptr);
+  }
+  const std::string stopped = stop_name(end.first, end.second);
 
   const sim::Overlap now = world.measure_overlap(), seen = world.max_contact_overlap();
   formats::RunFigures run;
@@ -283,6 +472,8 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   run.name = def.name;
   run.mode = mode;
   run.until = opt.until;
+  run.t = world.time();
+  run.stopped = stopped;
   run.dt = def.dt;
   run.seed = def.seed;
   run.balls = ball_count;
@@ -291,7 +482,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   run.turtles_finished = totals.turtles_finished;
   run.touches = totals.touches;
   run.faults = totals.faults;
-  run.wall_seconds = totals.wall_seconds;
+  run.wall_seconds = seconds_since(start);
   run.energy_start = totals.energy_start;
   run.energy_end = world.energy();
   run.max_overlap = std::max(now.depth, seen.depth);
@@ -299,7 +490,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
 
   if (events_file) events_file->commit();
   if (state_file) {
-    formats::write_state(state_file->stream(), world, formats::RunNames{ball_ids, def, world});
+    formats::write_state(state_file->stream(), world, names);
     state_file->commit();
   }
   if (stats_file) {
@@ -310,8 +501,13 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     formats::write_svg(svg_file->stream(), server ? formats::snapshot_of(*server, def) : formats::snapshot_of(world, def));
     svg_file->commit();
   }
+  if (!opt.checkpoint.empty()) write_checkpoint_at(world.time(), stopped.empty() ? "the end of the run" : stopped);
   if (opt.stats) print_summary(run, world, scene, server.get());
-  return exit_ok;
+  if (end.first == Stop::until) return exit_ok;
+  spdlog::warn("{}: stopped at t = {} s of {} ({}); the outputs are written up to there{}", opt.world,
+               fmt(world.time()), fmt(opt.until), stopped,
+               opt.checkpoint.empty() ? "" : "; continue with --resume " + opt.checkpoint);
+  return end.first == Stop::signal ? exit_code_for(end.second) : exit_limit;
 }
 
 }  // namespace turtlegas::apps

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,32 +19,55 @@ namespace turtlegas::apps {
 struct RunOptions {
   std::string world;
   double until = 0.0;
-  std::string mode = "exact";
+  std::optional<std::string> mode;  ///< exact (the default) or step
   std::optional<double> dt;
   std::string events, state_out, stats_json, svg;
   std::string inputs;  ///< an input log to replay (docs/protocol.md, "The input log")
   bool stats = false;
   std::size_t stack_kib = 32;   ///< each turtle program's stack
   double program_budget = 2.0;  ///< wall-clock seconds a program may run without a command
+  /// Limits that end a run early, cleanly, its outputs written up to where it got (exit code 3).
+  std::optional<double> max_wall_seconds;
+  std::optional<std::uint64_t> max_events;
+  /// Checkpoints (checkpoint.hpp): written to `checkpoint` every `checkpoint_every` simulated
+  /// seconds, when the run stops early, and at its end; `resume` continues from one.
+  std::string checkpoint;
+  std::optional<double> checkpoint_every;
+  std::string resume;
+  std::vector<std::string> plugins;  ///< for the output-is-an-input check
 };
 
 /// The `run` subcommand's command line, parsed into a RunOptions by options() once CLI11 has run.
 struct RunCommandLine {
   RunOptions parsed;
-  double dt = 0.0;
-  CLI::Option* dt_option = nullptr;
+  std::string mode = "exact";
+  double dt = 0.0, max_wall_seconds = 0.0, checkpoint_every = 0.0;
+  std::uint64_t max_events = 0;
+  CLI::Option *mode_option = nullptr, *dt_option = nullptr, *max_wall_option = nullptr, *max_events_option = nullptr,
+              *checkpoint_every_option = nullptr;
+  const std::vector<std::string>* plugins = nullptr;
   RunOptions options() const {
     RunOptions o = parsed;
+    if (mode_option && *mode_option) o.mode = mode;
     if (dt_option && *dt_option) o.dt = dt;
+    if (max_wall_option && *max_wall_option) o.max_wall_seconds = max_wall_seconds;
+    if (max_events_option && *max_events_option) o.max_events = max_events;
+    if (checkpoint_every_option && *checkpoint_every_option) o.checkpoint_every = checkpoint_every;
+    if (plugins) o.plugins = *plugins;
     return o;
   }
 };
+
+/// Exit code of a run that stopped at --max-wall-seconds or --max-events before --until (its
+/// outputs are whole, up to the time it reached). Ctrl-C and SIGTERM give 130 and 143.
+constexpr int exit_limit = 3;
 
 /// Adds the `run` subcommand to `app`, parsing into `line`; --plugin goes into `plugins`.
 CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::string>& plugins,
                           const char* plugin_help);
 
-/// Runs the world and writes the outputs asked for; exit_ok, or throws BadInput for bad input.
+/// Runs the world and writes the outputs asked for: exit_ok, exit_limit, 128 + the signal that
+/// stopped it, or throws BadInput for bad input.
 int run_command(const RunOptions& opt, const turtle::Registry& registry);
 
 }  // namespace turtlegas::apps

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "atomic_file.hpp"
+#include "output_file.hpp"
 #include "cli_common.hpp"
 
 #include "turtlegas/sim/mode_names.hpp"
@@ -46,7 +46,7 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
 
   // Opened before the rounds are played, so a bad path costs nothing; renamed into place only
   // when written whole.
-  std::optional<AtomicFile> json_file;
+  std::optional<OutputFile> json_file;
   if (!options.json_out.empty()) json_file.emplace(options.json_out, "--json");
   const world::Scene scene = load(options.world, registry);
   world::TournamentResult result;

@@ -5,8 +5,10 @@
 // Follow a wall on the right: go until something is touched, back off, turn left (a right angle if
 // the touch was in front, a little otherwise), then curve back towards the wall. Without the curve
 // back it would just bounce round the room; with it, it hugs the wall.
-//   params: back_off (units, default 5), curve (degrees, default 20), reach (units, default 40)
+//   params: declared in turtlegas_register below (back_off, curve, reach)
+#include <limits>
 #include <string>
+#include <utility>
 
 #include "turtlegas/turtle/turtle.hpp"
 #include "turtlegas/turtle/registry.hpp"  // for turtle::Registry, in turtlegas_register only
@@ -14,9 +16,10 @@
 namespace {
 
 void feeler(turtlegas::turtle::Turtle& t, const turtlegas::turtle::Params& p) {
-  const double back_off = p.get("back_off", 5.0);
-  const double curve = p.get("curve", 20.0);
-  const double reach = p.get("reach", 40.0);
+  // Their defaults come from the declaration below.
+  const double back_off = p.get<double>("back_off");
+  const double curve = p.get<double>("curve");
+  const double reach = p.get<double>("reach");
   // An interrupt handler: runs in this program, for each touch, before the command it cut short
   // returns.
   int touches = 0;
@@ -37,7 +40,17 @@ void feeler(turtlegas::turtle::Turtle& t, const turtlegas::turtle::Params& p) {
 }  // namespace
 
 /// The plugin's entry point: turtlegas calls it once, with the registry world files are checked
-/// against, before it loads the world.
+/// against, before it loads the world. The declaration gives the parameters (checked when a world
+/// is loaded, listed by `turtlegas controllers`) and says that the program is restartable: it
+/// reads its Turtle and Params only, so a checkpointed run can be resumed by replaying it.
 extern "C" void turtlegas_register(turtlegas::turtle::Registry& registry) {
-  registry.add("feeler", feeler, "wall on the right by feel: forward until touched, back off, turn left (back_off, curve, reach)");
+  namespace tt = turtlegas::turtle;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  tt::ControllerInfo info;
+  info.summary = "wall on the right by feel: forward until touched, back off, turn left";
+  info.params = {tt::number_param("back_off", 5.0, 0, inf, "how far to back off after a touch, units"),
+                 tt::number_param("curve", 20.0, -360, 360, "the turn back towards the wall, degrees"),
+                 tt::number_param("reach", 40.0, 0, inf, "how far to feel ahead, units")};
+  info.restartable = true;
+  registry.add("feeler", feeler, std::move(info));
 }

@@ -7,11 +7,12 @@ namespace turtlegas::formats {
 
 nlohmann::json stats_json(const RunFigures& run, const sim::World& world) {
   const sim::Stats& st = world.stats();
-  return {
+  nlohmann::json j = {
       {"world", run.world},
       {"name", run.name},
       {"mode", sim::to_string(run.mode).data()},
       {"until", run.until},
+      {"t", run.t},
       {"dt", run.dt},
       {"seed", run.seed},
       {"balls", run.balls},
@@ -42,6 +43,8 @@ nlohmann::json stats_json(const RunFigures& run, const sim::World& world) {
       {"max_overlap", run.max_overlap},
       {"max_overlap_relative", run.max_overlap_relative},
   };
+  if (!run.stopped.empty()) j["stopped"] = run.stopped;
+  return j;
 }
 
 void write_stats(std::ostream& out, const RunFigures& run, const sim::World& world) {

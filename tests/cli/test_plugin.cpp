@@ -1,18 +1,84 @@
 // SPDX-License-Identifier: MIT
-// A controller plugin for the CLI tests: "spinner" drives a little, then loops without ever issuing
-// another command (a busy loop the run must stop).
+// A controller plugin for the CLI tests: programs that misbehave in the ways a run must survive
+// or report.
+//   spinner    drives a little, then loops without ever issuing another command (a busy loop)
+//   swallower  catches every exception around its commands, the one that ends it at teardown too
+//   big_frame  calls a function with a 200 KiB local array (a frame far larger than the guard page)
+//   bad_amount forward(NaN) or right(inf), as params.call says
+//   crasher    after params.after seconds: a null dereference, abort() or exit(7) (params.how)
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <limits>
+#include <string>
 
-#include "turtlegas/turtle/turtle.hpp"
 #include "turtlegas/turtle/registry.hpp"
+#include "turtlegas/turtle/turtle.hpp"
+
+namespace {
+
+using turtlegas::turtle::Params;
+using turtlegas::turtle::Turtle;
+
+[[gnu::noinline]] double big_frame(double x) {
+  volatile char frame[200 * 1024];
+  frame[0] = static_cast<char>(x);  // the lowest address, 200 KiB below the caller's frame
+  frame[sizeof frame - 1] = static_cast<char>(x);
+  return frame[0] + frame[sizeof frame - 1];
+}
+
+}  // namespace
 
 extern "C" void turtlegas_register(turtlegas::turtle::Registry& registry) {
   registry.add(
       "spinner",
-      [](turtlegas::turtle::Turtle& t, const turtlegas::turtle::Params&) {
+      [](Turtle& t, const Params&) {
         t.forward(10);
         volatile std::uint64_t n = 0;
         for (;;) n = n + 1;
       },
       "a busy loop, for tests");
+  registry.add(
+      "swallower",
+      [](Turtle& t, const Params&) {
+        for (;;) {
+          try {
+            t.forward(1000);
+            t.right(90);
+          } catch (...) {  // NOLINT(bugprone-empty-catch): the misbehaviour under test
+          }
+        }
+      },
+      "catches everything, also the end of the run, for tests");
+  registry.add(
+      "big_frame",
+      [](Turtle& t, const Params&) {
+        t.forward(10);
+        t.forward(big_frame(1.0));
+      },
+      "a 200 KiB stack frame, for tests");
+  registry.add(
+      "bad_amount",
+      [](Turtle& t, const Params& p) {
+        t.forward(5);
+        const std::string call = p.get<std::string>("call", "forward");
+        if (call == "forward") t.forward(std::nan(""));
+        if (call == "right") t.right(std::numeric_limits<double>::infinity());
+        t.forward(5);
+      },
+      "forward(NaN) or right(inf), for tests");
+  registry.add(
+      "crasher",
+      [](Turtle& t, const Params& p) {
+        t.wait(p.get("after", 0.5));
+        const std::string how = p.get<std::string>("how", "null");
+        if (how == "null") {
+          volatile int* volatile nowhere = nullptr;
+          *nowhere = 1;
+        }
+        if (how == "abort") std::abort();
+        if (how == "exit") std::exit(7);
+        t.forward(10);
+      },
+      "crashes the process after a while, for tests");
 }

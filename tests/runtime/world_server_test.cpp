@@ -3,9 +3,13 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <string>
+#include <vector>
 
 #include "fixtures.hpp"
+#include "turtlegas/turtle/registry.hpp"
 #include "turtlegas/turtle/turtle.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
@@ -361,4 +365,146 @@ TEST_CASE("where a run is cut into run_until calls does not change it", "[runtim
     REQUIRE(cut_run.size() == whole.size());
     CHECK(first_difference(whole, cut_run) == whole.size());
   }
+}
+
+// --- Issue 17 -------------------------------------------------------------------------------------
+
+TEST_CASE("ending a run unwinds suspended programs, running their destructors", "[runtime][teardown]") {
+  int destroyed = 0;
+  struct Guard {
+    int* n;
+    ~Guard() { ++*n; }
+  };
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("t", {100, 100}, 0));
+  Registry r = base_registry();
+  r.add("holder", [&destroyed](Turtle& t, const Params&) {
+    const Guard g{&destroyed};
+    try {
+      for (;;) t.forward(1000);
+    } catch (const std::exception&) {  // lets the unwinding through: it is not a std::exception
+      FAIL("the unwinding was caught as a std::exception");
+    }
+  });
+  {
+    WorldServer s(d, {program("holder")}, r);
+    s.run_until(1.0);
+    CHECK(destroyed == 0);
+  }
+  CHECK(destroyed == 1);
+}
+
+TEST_CASE("a program that swallows the unwinding is abandoned at the end of the run, not spun", "[runtime][teardown][regression]") {
+  // Before: ~WorldServer unwound the program by throwing; the program caught it, issued another
+  // command, and the destructor looped for ever at 100 % CPU (in run, test and tag alike).
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("swallower", {100, 100}, 0));
+  d.turtles.push_back(body("polite", {300, 100}, 0));
+  Registry r = base_registry();
+  int commands_after_end = 0;
+  r.add("swallower", [&commands_after_end](Turtle& t, const Params&) {
+    bool caught = false;
+    for (;;) {
+      try {
+        if (caught) ++commands_after_end;
+        t.forward(1000);
+        t.right(90);
+      } catch (...) {  // NOLINT(bugprone-empty-catch): the misbehaviour under test
+        caught = true;
+      }
+    }
+  });
+  {
+    WorldServer s(d, {program("swallower"), program("script", R"({"commands": [["forward", 1000]]})")}, r);
+    s.run_until(2.0);
+  }  // returns: the swallower is abandoned at its next command
+  CHECK(commands_after_end == 1);
+}
+
+TEST_CASE("NaN and infinite amounts fault the program with a message naming the call", "[runtime][regression]") {
+  struct Case {
+    std::string call;
+    std::string says;
+  };
+  for (const Case& c : std::vector<Case>{{"forward", "forward(nan): the distance must be a finite number"},
+                                         {"back", "back(inf): the distance must be a finite number"},
+                                         {"right", "right(nan): the angle must be a finite number"},
+                                         {"left", "left(-inf): the angle must be a finite number"},
+                                         {"wait", "wait(-1): the time must be a finite number of seconds >= 0"}}) {
+    sim::WorldDef d = arena();
+    d.turtles.push_back(body("t", {100, 100}, 0));
+    Registry r = base_registry();
+    r.add("bad", [call = c.call](Turtle& t, const Params&) {
+      t.forward(10);
+      if (call == "forward") t.forward(std::nan(""));
+      if (call == "back") t.back(INFINITY);
+      if (call == "right") t.right(std::nan(""));
+      if (call == "left") t.left(-INFINITY);
+      if (call == "wait") t.wait(-1);
+      t.forward(10);
+    });
+    WorldServer s(d, {program("bad")}, r);
+    s.run_until(3.0);
+    INFO(c.call << ": " << s.turtle(0).fault);
+    CHECK(s.turtle(0).fault.find("turtle 't': " + c.says) != std::string::npos);
+    // It drove its first 10 units and nothing more (forward(NaN) drove 86 units backwards).
+    CHECK(s.turtle(0).state.pos.x == Approx(100).margin(1e-9));
+    CHECK(s.turtle(0).state.pos.y == Approx(110).margin(1e-9));
+    CHECK(std::fmod(s.turtle(0).state.heading + 2 * M_PI, 2 * M_PI) == Approx(0).margin(1e-12));
+  }
+}
+
+TEST_CASE("a negative distance or angle is a direction, the same in the API and in script", "[runtime]") {
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("api", {100, 100}, 0));
+  d.turtles.push_back(body("script", {300, 100}, 0));
+  Registry r = base_registry();
+  r.add("negative", [](Turtle& t, const Params&) {
+    t.forward(-20);
+    t.right(-90);
+    t.back(-10);
+  });
+  WorldServer s(d, {program("negative"), program("script", R"({"commands": [["forward", -20], ["right", -90], ["back", -10]]})")}, r);
+  s.run_until(5.0);
+  for (std::size_t i = 0; i < 2; ++i) {
+    INFO(s.turtle(i).fault);
+    CHECK(s.turtle(i).fault.empty());
+    // Back 20 (to y = 80), a left turn (heading -x), forward 10 (x - 10).
+    CHECK(s.turtle(i).state.pos.x == Approx((i == 0 ? 100 : 300) - 10.0).margin(1e-9));
+    CHECK(s.turtle(i).state.pos.y == Approx(80).margin(1e-9));
+  }
+}
+
+TEST_CASE("Params::get of an integer refuses what the type cannot hold (params-int-ub)", "[runtime][regression]") {
+  // Before: nlohmann's double-to-int cast, undefined behaviour out of range (laps: 9e36).
+  const Params p(nlohmann::json::parse(R"({"big": 9e36, "half": 2.5, "neg": -3, "whole": 1e3, "huge": 18446744073709551615})"));
+  CHECK_THROWS_WITH(p.get<int>("big", 0), Catch::Contains("params.big must be a whole number"));
+  CHECK_THROWS_WITH(p.get<int>("half", 0), Catch::Contains("params.half must be a whole number"));
+  CHECK_THROWS_WITH(p.get<unsigned>("neg", 0u), Catch::Contains("params.neg must be a whole number"));
+  CHECK_THROWS_WITH(p.get<std::int64_t>("huge", 0), Catch::Contains("params.huge"));
+  CHECK(p.get<int>("neg", 0) == -3);
+  CHECK(p.get<int>("whole", 0) == 1000);
+  CHECK(p.get<std::uint64_t>("huge", 0) == 18446744073709551615ull);
+  CHECK(p.get<int>("absent", 7) == 7);
+}
+
+TEST_CASE("check_params: unknown keys with did-you-mean, types, ranges, comments", "[runtime]") {
+  ControllerInfo info;
+  info.params = {number_param("step", 10, 0, 100, "units"), integer_param("laps", 1, 0, 1000, "laps"),
+                 boolean_param("left", false, "turn left"), string_param("hand", "right", {"right", "left"}, "side")};
+  info.params_declared = true;
+  auto problem = [&](const char* params) { return check_params("c", info, nlohmann::json::parse(params)); };
+  CHECK_FALSE(problem(R"({"step": 5, "laps": 3, "left": true, "hand": "left", "x-why": 1})").has_value());
+  const auto typo = problem(R"({"stpe": 5})");
+  REQUIRE(typo.has_value());
+  CHECK(typo->pointer == "/stpe");
+  CHECK(typo->reason.find("did you mean \"step\"") != std::string::npos);
+  CHECK(problem(R"({"step": 101})")->reason.find("step must be a number from 0 to 100, got 101") != std::string::npos);
+  CHECK(problem(R"({"step": true})")->pointer == "/step");
+  CHECK(problem(R"({"laps": 2.5})")->reason.find("laps must be an integer") != std::string::npos);
+  CHECK(problem(R"({"left": 1})")->pointer == "/left");
+  CHECK(problem(R"({"hand": "rihgt"})")->reason.find("did you mean \"right\"") != std::string::npos);
+  CHECK(with_defaults(info, nlohmann::json::object()).at("laps") == 1);
+  // A controller that declares nothing is not checked.
+  CHECK_FALSE(check_params("c", ControllerInfo{}, nlohmann::json::parse(R"({"anything": 1})")).has_value());
 }

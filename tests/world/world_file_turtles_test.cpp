@@ -118,7 +118,11 @@ TEST_CASE("a script turtle's commands are checked at load time") {
   CHECK_ERROR(one(R"(, "params": {"commands": [["right", "ninety"]]})"), c + "/0/1", "expected a number, got a string");
   CHECK_ERROR(one(R"(, "params": {"commands": [["pendown", 1]]})"), c + "/0", "'pendown' takes no amount");
   CHECK_ERROR(one(R"(, "params": {"commands": [["wait", -1]]})"), c + "/0/1", "'wait' needs an amount >= 0 in seconds");
-  CHECK_ERROR(one(R"(, "params": {"commands": [["forward", -1]]})"), c + "/0/1", "use [\"back\", ...]");
+  // Negative distances and angles are directions, as in the Turtle API (docs/controllers.md).
+  CHECK(parse(one(R"(, "params": {"commands": [["forward", -1], ["back", -2], ["left", -30], ["right", -45]]})"))
+            .programs[0]
+            .params.at("commands")
+            .size() == 4);
   CHECK_ERROR(one(R"(, "params": {"commands": ["forward", 10]})"), c + "/0", "a command must be [command, amount]");
   CHECK_ERROR(one(R"(, "params": {"commands": {"forward": 10}})"), c, "commands must be a list of [command, amount]");
   CHECK_ERROR(one(R"(, "params": {"comands": []})"), "/turtles/0/params/comands",

@@ -1,7 +1,12 @@
 // SPDX-License-Identifier: MIT
 // The expect engine (turtlegas/world/expect.hpp): each assertion kind passing and failing, with the
 // failure message checked, and the load errors of bad `expect` lists.
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <csignal>
 #include <string>
 
 #include <catch2/catch.hpp>
@@ -149,4 +154,41 @@ TEST_CASE("the kinds table") {
     CHECK(std::any_of(world::assertion_kinds().begin(), world::assertion_kinds().end(),
                       [&](const world::AssertionKind& k) { return k.key == key; }));
   }
+}
+
+TEST_CASE("expect: a tiny dt does not store every control-step time up front (test-tiny-dt-oom)", "[expect][regression]") {
+#if defined(__SANITIZE_ADDRESS__)
+  WARN("skipped under AddressSanitizer, which reserves more address space than the limit below");
+  return;
+#endif
+  // Before: run_expectations built a vector of every k dt before running (dt 1e-9 to until 100:
+  // 1e11 doubles, 800 GB) and died of it. Now the boundaries are made as the run goes: a child
+  // with 256 MiB of address space is still running after five seconds (and is then killed).
+  const std::string text = R"({"format": "turtlegas-world/1", "dt": 1e-9, "arena": {"width": 100, "height": 100},
+    "balls": [{"id": "b", "pos": [50, 50], "radius": 1}], "expect": [{"until": 100}]})";
+  const world::Scene scene = world::parse_scene(text, "tiny-dt.json", registry());
+  const pid_t pid = ::fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    const rlimit limit{256u << 20, 256u << 20};
+    ::setrlimit(RLIMIT_AS, &limit);
+    try {
+      (void)world::run_expectations(scene, registry(), sim::Mode::exact);
+    } catch (...) {
+      ::_exit(3);  // std::bad_alloc
+    }
+    ::_exit(0);
+  }
+  int status = 0;
+  pid_t ended = 0;
+  for (int k = 0; k < 250 && ended == 0; ++k) {
+    ::usleep(20000);
+    ended = ::waitpid(pid, &status, WNOHANG);
+  }
+  if (ended == 0) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+  }
+  INFO("the child " << (ended == 0 ? "was still running" : "ended, status " + std::to_string(status)));
+  CHECK(ended == 0);
 }

@@ -3,6 +3,7 @@
 // calls do, on the program's own stack.
 #include "agent.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -13,6 +14,7 @@
 #include "sensors.hpp"
 #include "server_impl.hpp"
 #include "turtlegas/sim/angles.hpp"
+#include "turtlegas/sim/format.hpp"
 
 namespace turtlegas::turtle {
 
@@ -27,6 +29,7 @@ void Agent::not_own_program() const {
 // running the handlers out of line when there is something for them.
 Result Agent::issue(sim::TurtleCommand c) {
   if (!fiber || detail::Fiber::current() != &*fiber) [[unlikely]] not_own_program();
+  if (ending) [[unlikely]] refuse_while_ending(c);
   command = c;
   waiting_on = c.kind;
   waiting = true;
@@ -39,6 +42,37 @@ Result Agent::issue(sim::TurtleCommand c) {
   Result r = std::move(answer);
   if (!inbox.empty() || !messages.empty()) [[unlikely]] deliver();
   return r;
+}
+
+void Agent::end_program() {
+  if (!fiber) return;
+  if (!fiber->done()) {
+    ending = true;
+    const double budget = server->options.program_budget;
+    using Outcome = detail::Fiber::Outcome;
+    switch (fiber->stop(budget)) {
+      case Outcome::finished:
+      case Outcome::suspended: break;  // unwound, or refused with refuse_while_ending's warning
+      case Outcome::stack_overflow:
+        spdlog::warn("turtle '{}': its program overflowed its stack while the run was ending; it was abandoned", id);
+        break;
+      case Outcome::over_budget:
+        spdlog::warn("turtle '{}': its program ran for more than {} s without a command while the run was ending (a "
+                     "catch (...) that swallows the unwinding, then a loop?); it was abandoned",
+                     id, budget);
+        break;
+    }
+  }
+  fiber.reset();
+}
+
+void Agent::refuse_while_ending(sim::TurtleCommand c) {
+  static constexpr const char* names[] = {"yield", "forward/back", "left/right", "wait"};
+  spdlog::warn("turtle '{}': its program issued a command ({}) while the run was ending, after catching the exception "
+               "that unwinds it; a catch (...) in a controller must rethrow (docs/controllers.md). The program is "
+               "abandoned",
+               id, names[static_cast<int>(c.kind)]);
+  for (;;) fiber->suspend();  // stop() sees it suspend again and never resumes it
 }
 
 void Agent::deliver() {
@@ -58,11 +92,40 @@ void Agent::deliver() {
 // ---------------------------------------------------------------------------------------------
 // The controller API
 
-Result Turtle::forward(double distance) { return agent_->issue({sim::TurtleCommand::Kind::move, distance}); }
-Result Turtle::back(double distance) { return agent_->issue({sim::TurtleCommand::Kind::move, -distance}); }
-Result Turtle::right(double degrees) { return agent_->issue({sim::TurtleCommand::Kind::turn, sim::to_radians(degrees)}); }
-Result Turtle::left(double degrees) { return agent_->issue({sim::TurtleCommand::Kind::turn, sim::to_radians(-degrees)}); }
-Result Turtle::wait(double seconds) { return agent_->issue({sim::TurtleCommand::Kind::wait, seconds}); }
+namespace {
+
+// A NaN or infinite amount has no motion to give (forward(NaN) drove 86 units backwards, right(NaN)
+// turned 171 degrees): the program faults, naming the call.
+[[noreturn, gnu::noinline, gnu::cold]] void bad_amount(const Agent& a, const char* call, double amount,
+                                                       const char* what) {
+  throw std::invalid_argument("turtle '" + a.id + "': " + call + "(" + sim::format_number(amount) + "): " + what);
+}
+
+}  // namespace
+
+// Negative amounts are directions: forward(-d) is back(d) and right(-a) is left(a), as in Logo
+// and in the script controller; a wait cannot be negative.
+Result Turtle::forward(double distance) {
+  if (!std::isfinite(distance)) [[unlikely]] bad_amount(*agent_, "forward", distance, "the distance must be a finite number of units");
+  return agent_->issue({sim::TurtleCommand::Kind::move, distance});
+}
+Result Turtle::back(double distance) {
+  if (!std::isfinite(distance)) [[unlikely]] bad_amount(*agent_, "back", distance, "the distance must be a finite number of units");
+  return agent_->issue({sim::TurtleCommand::Kind::move, -distance});
+}
+Result Turtle::right(double degrees) {
+  if (!std::isfinite(degrees)) [[unlikely]] bad_amount(*agent_, "right", degrees, "the angle must be a finite number of degrees");
+  return agent_->issue({sim::TurtleCommand::Kind::turn, sim::to_radians(degrees)});
+}
+Result Turtle::left(double degrees) {
+  if (!std::isfinite(degrees)) [[unlikely]] bad_amount(*agent_, "left", degrees, "the angle must be a finite number of degrees");
+  return agent_->issue({sim::TurtleCommand::Kind::turn, sim::to_radians(-degrees)});
+}
+Result Turtle::wait(double seconds) {
+  if (!(seconds >= 0.0 && std::isfinite(seconds))) [[unlikely]]
+    bad_amount(*agent_, "wait", seconds, "the time must be a finite number of seconds >= 0");
+  return agent_->issue({sim::TurtleCommand::Kind::wait, seconds});
+}
 void Turtle::yield() { agent_->issue({sim::TurtleCommand::Kind::stop, 0.0}); }
 void Turtle::pen_up() { agent_->pen_down = false; }
 void Turtle::pen_down(PenMode mode) {

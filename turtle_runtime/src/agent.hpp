@@ -26,8 +26,9 @@ class alignas(64) Agent {
   Agent() = default;
   Agent(const Agent&) = delete;
   Agent& operator=(const Agent&) = delete;
-  // A program suspended mid-command is unwound first, while everything it may still use is alive.
-  ~Agent() { fiber.reset(); }
+  // A program suspended mid-command is unwound first, while everything it may still use is alive
+  // (end_program, agent.cpp).
+  ~Agent() { end_program(); }
 
   WorldServer::Impl* server = nullptr;
   std::size_t index = 0;
@@ -40,6 +41,7 @@ class alignas(64) Agent {
   bool lays_wall = false;  // the command waited on lays a wall (the pen in wall mode, a move)
   bool remote = false;       // runs the remote program (remote.hpp, remote.cpp)
   bool wants_input = false;  // the remote program is suspended in await_remote()
+  bool ending = false;     // end_program() is unwinding the program: a command now abandons it
   sim::TurtleCommand::Kind waiting_on = sim::TurtleCommand::Kind::stop;
   bool pen_down = false;
   bool it = false;                            // the game's role, as Turtle::it() reports it
@@ -69,6 +71,12 @@ class alignas(64) Agent {
   /// The remote program's wait for its next command (remote.cpp): suspends until the scheduler
   /// has one, delivering touches and messages that arrive meanwhile.
   RemoteCommand await_remote();
+  /// Unwinds a program suspended mid-command (Fiber::stop); one that will not be unwound (it
+  /// catches the unwinding and issues a command, or loops) is abandoned with a warning naming the
+  /// turtle.
+  void end_program();
+  /// issue() while end_program() unwinds: warns and leaves the program for good.
+  [[noreturn, gnu::noinline, gnu::cold]] void refuse_while_ending(sim::TurtleCommand c);
   /// The touch and message handlers, on the program's stack (they may issue commands).
   [[gnu::noinline]] void deliver();
   [[noreturn, gnu::noinline, gnu::cold]] void not_own_program() const;

@@ -13,13 +13,20 @@
 #include <chrono>
 #include <pthread.h>
 #include <thread>
+#include <vector>
 
 #include <boost/context/fiber.hpp>
 #include <boost/context/protected_fixedsize_stack.hpp>
 
 // AddressSanitizer keeps shadow state per stack and must be told about every switch between them;
-// Boost's fcontext switches do not tell it, so we do, around each resume and suspend.
-#if defined(__SANITIZE_ADDRESS__)
+// Boost's fcontext switches do not tell it, so we do, around each resume and suspend. GCC says it
+// is on with __SANITIZE_ADDRESS__, clang (14) only through __has_feature.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define TURTLEGAS_FIBER_ASAN 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(TURTLEGAS_FIBER_ASAN)
 #include <sanitizer/common_interface_defs.h>
 #define TURTLEGAS_ASAN_SWITCH(save, bottom, size) __sanitizer_start_switch_fiber(save, bottom, size)
 #define TURTLEGAS_ASAN_ARRIVE(save, bottom, size) __sanitizer_finish_switch_fiber(save, bottom, size)
@@ -53,7 +60,10 @@ pthread_t g_scheduler_thread;
 constexpr std::size_t kGuardSlack = 64 * 1024;
 const std::size_t kPage = boost::context::stack_traits::page_size();
 
-struct sigaction g_previous_segv{}, g_previous_bus{};
+struct sigaction g_previous_segv{}, g_previous_bus{}, g_previous_alarm{};
+// SIGALRMs the watchdog has sent and the handler has not yet seen: any other SIGALRM is someone
+// else's (an alarm() of the program's own) and goes to the handler that was there before ours.
+std::atomic<int> g_alarms_in_flight{0};
 
 void on_segv(int sig, siginfo_t* info, void* uctx) {
   char* addr = static_cast<char*>(info->si_addr);
@@ -72,9 +82,28 @@ void on_segv(int sig, siginfo_t* info, void* uctx) {
   std::raise(sig);
 }
 
-void on_alarm(int) {
-  if (g_running != nullptr && g_slice.load(std::memory_order_relaxed) == g_doomed_slice.load(std::memory_order_relaxed))
-    jump_back(2);
+void on_alarm(int sig, siginfo_t* info, void* uctx) {
+  int ours = g_alarms_in_flight.load(std::memory_order_relaxed);
+  while (ours > 0 && !g_alarms_in_flight.compare_exchange_weak(ours, ours - 1, std::memory_order_relaxed)) {
+  }
+  if (ours > 0) {
+    // Ours, sent to the scheduler's thread only: jump out if the slice it condemned still runs (a
+    // late one, for a slice that has since suspended, is dropped).
+    if (g_running != nullptr && pthread_equal(pthread_self(), g_scheduler_thread) &&
+        g_slice.load(std::memory_order_relaxed) == g_doomed_slice.load(std::memory_order_relaxed))
+      jump_back(2);
+    return;
+  }
+  const struct sigaction& prev = g_previous_alarm;
+  if ((prev.sa_flags & SA_SIGINFO) && prev.sa_sigaction) {
+    prev.sa_sigaction(sig, info, uctx);
+  } else if (prev.sa_handler == SIG_DFL) {
+    // What the alarm would have done without us: end the process.
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+  } else if (prev.sa_handler != SIG_IGN && prev.sa_handler != nullptr) {
+    prev.sa_handler(sig);
+  }
 }
 
 // (Re)installs the handlers. Called whenever a fiber is made, so that a handler someone else
@@ -99,10 +128,12 @@ void install_handlers() {
   sigaction(SIGSEGV, &sa, &g_previous_segv);
   sigaction(SIGBUS, &sa, &g_previous_bus);
   struct sigaction al{};
-  al.sa_handler = on_alarm;
-  al.sa_flags = SA_ONSTACK;
+  al.sa_sigaction = on_alarm;
+  al.sa_flags = SA_SIGINFO | SA_ONSTACK;
   sigemptyset(&al.sa_mask);
-  sigaction(SIGALRM, &al, nullptr);
+  struct sigaction current_alarm{};
+  sigaction(SIGALRM, nullptr, &current_alarm);
+  if (current_alarm.sa_sigaction != on_alarm) sigaction(SIGALRM, &al, &g_previous_alarm);
 }
 
 // Boost's protected stack, remembering where its guard page is.
@@ -132,6 +163,12 @@ class GuardedStack {
 
 void watchdog() {
   using namespace std::chrono;
+  // A process-wide SIGALRM (someone's alarm()) must not land on this thread: the handler may
+  // jump into the scheduler's slice, which only the scheduler's thread may do.
+  sigset_t alarm;
+  sigemptyset(&alarm);
+  sigaddset(&alarm, SIGALRM);
+  pthread_sigmask(SIG_BLOCK, &alarm, nullptr);
   std::uint64_t watched = 0;
   steady_clock::time_point since = steady_clock::now();
   for (;;) {
@@ -146,7 +183,8 @@ void watchdog() {
     }
     if ((slice & 1) && duration_cast<nanoseconds>(now - since).count() > budget) {
       g_doomed_slice.store(slice, std::memory_order_relaxed);
-      pthread_kill(g_scheduler_thread, SIGALRM);
+      g_alarms_in_flight.fetch_add(1, std::memory_order_relaxed);
+      if (pthread_kill(g_scheduler_thread, SIGALRM) != 0) g_alarms_in_flight.fetch_sub(1, std::memory_order_relaxed);
       since = now;
     }
   }
@@ -183,6 +221,8 @@ class alignas(64) Fiber::Impl {
   bool started = false;
   bool finished = false;
   bool abandoned = false;  // a fault left its stack mid-flight: never resume or unwind it
+  bool stopping = false;   // stop() has resumed it to unwind
+  double last_budget = 0.0;
   std::function<void()> body;
   std::exception_ptr error;
   // For AddressSanitizer: the resumer's stack as seen from inside, and fake-stack handles.
@@ -208,9 +248,11 @@ Fiber::Fiber(std::function<void()> body, std::size_t stack_bytes) : impl_(std::m
                              try {
                                impl->body();
                              } catch (const ctx::detail::forced_unwind&) {
-                               // The fiber is being destroyed while suspended: let it unwind.
+                               // The fiber is being destroyed before it ever ran: let it unwind.
                                TURTLEGAS_ASAN_SWITCH(nullptr, impl->outer_bottom, impl->outer_size);
                                throw;
+                             } catch (const Stop&) {
+                               // stop(): the body has unwound, as asked.
                              } catch (...) {
                                impl->error = std::current_exception();
                              }
@@ -221,20 +263,42 @@ Fiber::Fiber(std::function<void()> body, std::size_t stack_bytes) : impl_(std::m
 }
 
 Fiber::~Fiber() {
-  if (impl_->self && !impl_->abandoned) {
-    // Suspended mid-program: destroying the handle unwinds the body's stack, on that stack.
-    TURTLEGAS_ASAN_SWITCH(&impl_->outer_fake, impl_->guard_lo + kPage,
-                          impl_->reserved - kPage);
-    impl_->self = ctx::fiber{};
-    TURTLEGAS_ASAN_ARRIVE(impl_->outer_fake, nullptr, nullptr);
+  if (impl_->self && !impl_->abandoned && !impl_->finished) {
+    if (impl_->started) {
+      stop(impl_->last_budget);
+    } else {
+      // Never resumed: destroying the handle unwinds Boost's entry frame only; no code of ours runs.
+      TURTLEGAS_ASAN_SWITCH(&impl_->outer_fake, impl_->guard_lo + kPage, impl_->reserved - kPage);
+      impl_->self = ctx::fiber{};
+      TURTLEGAS_ASAN_ARRIVE(impl_->outer_fake, nullptr, nullptr);
+    }
   }
   if (impl_->abandoned) {
-    // A fault left the body mid-slice: `caller` still names the resume() we jumped out of, and
-    // destroying it would switch into that dead context. Let the handle go without touching it;
-    // the fiber's stack is leaked with it.
-    new (std::malloc(sizeof(ctx::fiber))) ctx::fiber(std::move(impl_->caller));
+    // A fault, or a body that would not stop, left the body mid-flight: `caller` may still name
+    // the resume() we jumped out of, and destroying `self` would unwind a body that refuses to
+    // be unwound. Let both handles go without touching them; the fiber's stack is leaked with
+    // them (kept reachable, so that leak checkers do not report it as lost).
+    static std::vector<ctx::fiber>* const leaked = new std::vector<ctx::fiber>;
+    leaked->push_back(std::move(impl_->caller));
+    if (impl_->self) leaked->push_back(std::move(impl_->self));
   }
 }
+
+Fiber::Outcome Fiber::stop(double budget_seconds) {
+  if (impl_->finished || impl_->abandoned) return Outcome::finished;
+  if (!impl_->started) return Outcome::finished;  // the destructor lets an unstarted body go
+  impl_->stopping = true;
+  const Outcome outcome = resume(budget_seconds);
+  if (outcome == Outcome::suspended) {
+    // The body caught Stop and suspended again (a command issued from a catch (...) that did
+    // not rethrow): it is never resumed again.
+    impl_->abandoned = true;
+    return Outcome::suspended;
+  }
+  return outcome;
+}
+
+bool Fiber::stopping() const { return impl_->stopping; }
 
 Fiber::Outcome Fiber::resume(double budget_seconds) {
   if (impl_->finished || impl_->abandoned) return Outcome::finished;
@@ -256,6 +320,8 @@ Fiber::Outcome Fiber::resume(double budget_seconds) {
     impl_->abandoned = true;
     return jumped == 1 ? Outcome::stack_overflow : Outcome::over_budget;
   }
+  impl_->started = true;
+  impl_->last_budget = budget_seconds;
   g_guard_lo = impl_->guard_lo;
   g_guard_hi = impl_->guard_lo + kPage;
   g_running = impl_.get();
@@ -273,15 +339,13 @@ Fiber::Outcome Fiber::resume(double budget_seconds) {
 
 void Fiber::suspend() {
   impl_->suspended_at = static_cast<char*>(__builtin_frame_address(0));
+  const bool was_stopping = impl_->stopping;
   TURTLEGAS_ASAN_SWITCH(&impl_->inner_fake, impl_->outer_bottom, impl_->outer_size);
-  try {
-    impl_->caller = std::move(impl_->caller).resume();
-  } catch (const ctx::detail::forced_unwind&) {
-    // Destroyed while suspended: we are back on this stack to unwind it.
-    TURTLEGAS_ASAN_ARRIVE(impl_->inner_fake, &impl_->outer_bottom, &impl_->outer_size);
-    throw;
-  }
+  impl_->caller = std::move(impl_->caller).resume();
   TURTLEGAS_ASAN_ARRIVE(impl_->inner_fake, &impl_->outer_bottom, &impl_->outer_size);
+  // Resumed by stop(): unwind the body. (A body that suspends again while stopping is abandoned
+  // by stop() and never comes back here.)
+  if (impl_->stopping && !was_stopping) throw Stop{};
 }
 
 void Fiber::prefetch_record() const { __builtin_prefetch(impl_.get()); }

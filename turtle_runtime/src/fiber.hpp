@@ -17,6 +17,11 @@ namespace turtlegas::turtle::detail {
 /// that started the slice; the fiber is then abandoned (its stack is leaked, never unwound) and
 /// resume() reports what happened.
 ///
+/// A body suspended mid-flight is ended by stop() (the destructor calls it): it resumes the body,
+/// and suspend() then throws Stop, which unwinds the body's frames (running their destructors) up
+/// to the fiber's entry. A body that catches Stop and suspends again (a `catch (...)` that does
+/// not rethrow, around a command) cannot be unwound: it is abandoned there, its stack leaked.
+///
 /// One simulation thread per process: the running slice, its guard page and the watchdog's view
 /// of it are process-wide (fiber.cpp), and the busy-loop signal goes to the thread that last
 /// resumed a fiber. Every WorldServer of a process must therefore run its programs on one thread
@@ -32,15 +37,27 @@ class Fiber {
     over_budget,     ///< the body ran past the budget without suspending
   };
 
+  /// What suspend() throws to unwind a body that stop() ends. Not a std::exception, so that
+  /// `catch (const std::exception&)` lets it through; a `catch (...)` must rethrow it.
+  struct Stop {};
+
   Fiber(std::function<void()> body, std::size_t stack_bytes);
+  /// Stops a body suspended mid-flight (stop(), with the budget of the last resume).
   ~Fiber();
   Fiber(const Fiber&) = delete;
   Fiber& operator=(const Fiber&) = delete;
 
   /// Runs the body until it suspends or ends. budget_seconds <= 0 means no budget.
   Outcome resume(double budget_seconds);
-  /// From inside the body: back to whoever resumed it.
+  /// From inside the body: back to whoever resumed it. Throws Stop when stop() resumes it.
   void suspend();
+  /// Ends a suspended body: resumes it so that its suspend() throws Stop, within the budget.
+  /// Returns finished when it unwound (or had ended); suspended when it caught Stop and suspended
+  /// again, and stack_overflow or over_budget when it faulted while unwinding: in those three
+  /// cases the body is abandoned, never resumed or unwound again.
+  Outcome stop(double budget_seconds);
+  /// Whether stop() has been called: from inside the body, a suspend() now abandons it for good.
+  bool stopping() const;
   bool done() const;
   /// What the body threw, if it ended by throwing.
   std::exception_ptr error() const;

@@ -33,7 +33,27 @@ std::uint64_t fnv1a(const std::string& s) {
   return h;
 }
 
+ProgramInFlight g_in_flight;
+
+/// Marks a's program as the one running for the span of a resume.
+class InFlight {
+ public:
+  InFlight(const Agent& a, double t) {
+    g_in_flight.t = t;
+    g_in_flight.controller = a.program.controller.c_str();
+    g_in_flight.turtle = a.id.c_str();
+  }
+  ~InFlight() {
+    g_in_flight.turtle = nullptr;
+    g_in_flight.controller = nullptr;
+  }
+  InFlight(const InFlight&) = delete;
+  InFlight& operator=(const InFlight&) = delete;
+};
+
 }  // namespace
+
+const ProgramInFlight& program_in_flight() { return g_in_flight; }
 
 void WorldServer::Impl::finish_command(Agent& a) {
   // The end of the command the program waits on, worked out before it resumes (see issue()).
@@ -68,7 +88,10 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
                                   std::to_string(a->program.sensors.size()) + ")");
     for (const SensorArc& arc : a->program.sensors) a->sensor_names.push_back(arc.name);
     a->controller = a->remote ? detail::remote_program_for(*a) : *controller;
-    a->params = Params(a->program.params);
+    // The declared defaults are the controller's (Params::get<T>(key)); the loader has checked
+    // the rest against the declarations. A remote turtle's params are its client's business.
+    a->params = a->remote ? Params(a->program.params)
+                          : Params(with_defaults(*registry.info(a->program.controller), a->program.params));
     a->pen_down = a->program.pen_down || a->program.pen_walls;
     if (a->program.pen_walls) {
       if (!a->program.builder)
@@ -105,8 +128,12 @@ void WorldServer::Impl::run_program(Agent& a) {
 }
 
 bool WorldServer::Impl::resume(Agent& a) {
-  const auto outcome = a.fiber->resume(options.program_budget);
   const double now = world.time();
+  detail::Fiber::Outcome outcome;
+  {
+    const InFlight in_flight(a, now);
+    outcome = a.fiber->resume(options.program_budget);
+  }
   auto park = [&](const std::string& fault) {
     a.finished = true;
     a.fault = fault;

@@ -61,7 +61,14 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
       expect_object(*x, at(p, "params"), "params");
       program.params = *x;
     }
-    if (program.controller == "script") check_script(program.params, at(p, "params"));
+    if (program.controller == "script") {
+      check_script(program.params, at(p, "params"));
+    } else if (const turtle::ControllerInfo* info = registry_ ? registry_->info(program.controller) : nullptr) {
+      // A controller that declares its parameters (registry.hpp): a typo ("stpe") or a value out
+      // of range would otherwise silently take the default or fault at run time.
+      if (auto problem = turtle::check_params(program.controller, *info, program.params))
+        fail(at(p, "params") + problem->pointer, problem->reason);
+    }
     if (const json* x = find(t, "sensors")) program.sensors = read_sensors(*x, at(p, "sensors"));
     if (const json* x = find(t, "pen")) {
       const std::string pp = at(p, "pen");
@@ -164,13 +171,10 @@ void Reader::check_script(const json& params, const std::string& path) const {
     }
     if (c.size() != 2) fail(p, "'" + name + "' needs one number, e.g. [\"" + name + "\", 100], got " + c.dump());
     const double amount = number(c[1], at(p, 1));
-    if (amount < 0.0)
-      fail(at(p, 1), "'" + name + "' needs an amount >= 0 in " + std::string(turtle::unit_name(command->amount)) + " (got " + num(amount) + ")" +
-                         (name == "forward" ? "; use [\"back\", ...] to go backwards"
-                          : name == "back"  ? "; use [\"forward\", ...] to go forwards"
-                          : name == "left"  ? "; use [\"right\", ...] to turn the other way"
-                          : name == "right" ? "; use [\"left\", ...] to turn the other way"
-                                            : ""));
+    // A negative distance or angle is a direction, as in the Turtle API: ["forward", -5] drives
+    // backwards like ["back", 5]. Time only runs forwards.
+    if (command->op == turtle::ScriptCommand::Op::wait && amount < 0.0)
+      fail(at(p, 1), "'wait' needs an amount >= 0 in seconds (got " + num(amount) + ")");
   }
 }
 

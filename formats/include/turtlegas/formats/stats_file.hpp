@@ -20,7 +20,11 @@ struct RunFigures {
   std::string world;             ///< the world file, as given
   std::string name;              ///< the scene's name
   sim::Mode mode = sim::Mode::exact;
-  double until = 0.0;            ///< seconds
+  double until = 0.0;            ///< seconds: the time asked for
+  double t = 0.0;                ///< seconds: the time reached (until, unless the run stopped early)
+  /// Empty for a run that reached until; else why it stopped early: "SIGINT", "SIGTERM",
+  /// "max-wall-seconds" or "max-events".
+  std::string stopped;
   double dt = 0.0;               ///< seconds
   std::uint64_t seed = 0;
   std::size_t balls = 0;         ///< at the start

@@ -20,8 +20,13 @@
 // clockwise); distances are world units, times seconds.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
 #include <memory>
 #include <optional>
 #include <string>
@@ -33,27 +38,62 @@
 
 namespace turtlegas::turtle {
 
-/// A controller's parameters: the world file's `params` object.
+/// A controller's parameters: the world file's `params` object (with the defaults of the
+/// parameters its controller declares in the registry filled in, registry.hpp).
 class Params {
  public:
   Params() = default;
   explicit Params(nlohmann::json json) : json_(std::move(json)) {}
   /// The value of `key` converted to T, or `fallback` when absent. A present value of the wrong
-  /// type throws std::invalid_argument naming the key.
+  /// type throws std::invalid_argument naming the key, and so does a number that an integral T
+  /// cannot hold exactly (2.5, or 9e36 for an int).
   template <class T>
   T get(const std::string& key, T fallback) const {
     if (!json_.is_object() || !json_.contains(key)) return fallback;
-    try {
-      return json_.at(key).get<T>();
-    } catch (const nlohmann::json::exception&) {
-      throw std::invalid_argument("params." + key + " has the wrong type: " + json_.at(key).dump());
-    }
+    return convert<T>(key, json_.at(key));
   }
   double get(const std::string& key, double fallback) const { return get<double>(key, fallback); }
+  /// The value of `key`, which the controller's declaration gives a default: throws
+  /// std::invalid_argument when it is absent all the same (an undeclared key).
+  template <class T>
+  T get(const std::string& key) const {
+    if (!json_.is_object() || !json_.contains(key))
+      throw std::invalid_argument("params." + key + " is not given and has no declared default");
+    return convert<T>(key, json_.at(key));
+  }
   bool has(const std::string& key) const { return json_.is_object() && json_.contains(key); }
   const nlohmann::json& json() const { return json_; }
 
  private:
+  template <class T>
+  static T convert(const std::string& key, const nlohmann::json& v) {
+    if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+      // nlohmann converts a double to an integer with a cast, which is undefined behaviour out of
+      // range (laps: 9e36 made the turtle silently do nothing).
+      using L = std::numeric_limits<T>;
+      if (v.is_number_unsigned()) {
+        if (const auto u = v.get<std::uint64_t>(); std::in_range<T>(u)) return static_cast<T>(u);
+      } else if (v.is_number_integer()) {
+        if (const auto i = v.get<std::int64_t>(); std::in_range<T>(i)) return static_cast<T>(i);
+      } else if (v.is_number_float()) {
+        const double d = v.get<double>();
+        // [min, max + 1) in doubles: both ends are zero or powers of two, so exact.
+        const double lo = static_cast<double>(L::min()), hi = std::ldexp(1.0, L::digits);
+        if (d == std::trunc(d) && d >= lo && d < hi) return static_cast<T>(d);
+      } else {
+        throw std::invalid_argument("params." + key + " has the wrong type: " + v.dump());
+      }
+      throw std::invalid_argument("params." + key + " must be a whole number from " + std::to_string(L::min()) +
+                                  " to " + std::to_string(L::max()) + ", got " + v.dump());
+    } else {
+      try {
+        return v.get<T>();
+      } catch (const nlohmann::json::exception&) {
+        throw std::invalid_argument("params." + key + " has the wrong type: " + v.dump());
+      }
+    }
+  }
+
   nlohmann::json json_ = nlohmann::json::object();
 };
 

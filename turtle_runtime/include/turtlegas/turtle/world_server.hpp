@@ -100,6 +100,18 @@ struct BusyLoopError : std::runtime_error {
 
 class Game;  // game.hpp
 
+/// The turtle program running now on this process's simulation thread, for a crash report: a
+/// fatal signal or an exit() inside a controller's code can then name the turtle and the time.
+/// Plain pointers into the server's own strings, valid while that program runs; all null when
+/// no program runs. Safe to read from a signal handler.
+struct ProgramInFlight {
+  const char* volatile turtle = nullptr;      ///< the turtle's id
+  const char* volatile controller = nullptr;  ///< its controller's name
+  volatile double t = 0.0;                    ///< simulated time, seconds
+};
+/// The program running now (see ProgramInFlight).
+const ProgramInFlight& program_in_flight();
+
 class WorldServer {
  public:
   /// programs[i] belongs to def.turtles[i]. Throws std::invalid_argument for a controller that is

@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: MIT
+#include "checkpoint.hpp"
+
+#include <cinttypes>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.hpp"
+
+namespace turtlegas::apps {
+namespace {
+
+constexpr const char* checkpoint_format = "turtlegas-checkpoint/1";
+
+// Hashes as 16 hex digits: a JSON number would lose their low bits in most readers.
+std::string hex(std::uint64_t v) {
+  char buf[20];
+  std::snprintf(buf, sizeof buf, "%016" PRIx64, v);
+  return buf;
+}
+
+}  // namespace
+
+std::uint64_t fnv1a64(std::string_view bytes) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::uint64_t file_hash(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw BadInput(what + " " + path + ": cannot read it");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return fnv1a64(s.str());
+}
+
+void write_checkpoint(std::ostream& out, const Checkpoint& c) {
+  const nlohmann::json j = {
+      {"format", checkpoint_format},
+      {"world", c.world},
+      {"world_fnv1a", hex(c.world_hash)},
+      {"mode", sim::to_string(c.mode).data()},
+      {"dt", c.dt},
+      {"t", c.t},
+      {"events", c.events},
+      {"state_fnv1a", hex(c.state_hash)},
+      {"why", c.why},
+      {"resume", "turtlegas run " + c.world + " --resume THIS_FILE --until T: replays the run to t without outputs, "
+                                              "checks the state there, and goes on"},
+  };
+  out << j.dump(2) << '\n';
+}
+
+Checkpoint read_checkpoint(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw BadInput("--resume " + path + ": no such file, or it cannot be read");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw BadInput("--resume " + path + ": not a checkpoint (invalid JSON: " + e.what() + ")");
+  }
+  const std::string where = "--resume " + path + ": ";
+  if (!j.is_object() || j.value("format", std::string()) != checkpoint_format)
+    throw BadInput(where + "not a checkpoint: /format must be \"" + checkpoint_format +
+                   "\" (write one with run --checkpoint F)");
+  Checkpoint c;
+  auto field = [&](const char* key) -> const nlohmann::json& {
+    if (!j.contains(key)) throw BadInput(where + "/" + key + ": missing; the checkpoint is damaged");
+    return j.at(key);
+  };
+  auto hash = [&](const char* key) {
+    const nlohmann::json& v = field(key);
+    std::uint64_t h = 0;
+    if (!v.is_string() || std::sscanf(v.get<std::string>().c_str(), "%" SCNx64, &h) != 1)
+      throw BadInput(where + "/" + key + ": not a hash; the checkpoint is damaged");
+    return h;
+  };
+  try {
+    c.world = field("world").get<std::string>();
+    c.world_hash = hash("world_fnv1a");
+    const auto mode = sim::mode_from_string(field("mode").get<std::string>());
+    if (!mode) throw BadInput(where + "/mode: not exact or step; the checkpoint is damaged");
+    c.mode = *mode;
+    c.dt = field("dt").get<double>();
+    c.t = field("t").get<double>();
+    c.events = field("events").get<std::uint64_t>();
+    c.state_hash = hash("state_fnv1a");
+    c.why = j.value("why", std::string());
+  } catch (const nlohmann::json::exception& e) {
+    throw BadInput(where + "a key has the wrong type (" + e.what() + "); the checkpoint is damaged");
+  }
+  if (!(c.t >= 0.0) || !(c.dt > 0.0)) throw BadInput(where + "/t or /dt out of range; the checkpoint is damaged");
+  return c;
+}
+
+}  // namespace turtlegas::apps

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: MIT
+// `run --checkpoint F` and `run --resume F`: what a checkpoint holds, and reading and writing one.
+//
+// A checkpoint holds a run's inputs and how far it got, not its memory: the world file's hash, the
+// mode and dt, the time reached, and the hash of the state and the event count there. Turtle
+// programs are coroutines, which cannot be written to a file, and the engine's event queue is its
+// own; so `--resume` rebuilds the run from the world file and replays it, without writing
+// anything, to the checkpoint's time (determinism makes that the same run, bit for bit), checks
+// that it arrived at the same state, and carries on from there, writing its outputs. The replay
+// costs the simulation up to that time, without the outputs; what it buys is that a resumed run
+// is exactly the run that was interrupted (docs/controllers.md, "Checkpoints").
+#pragma once
+
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <string_view>
+
+#include "turtlegas/sim/world.hpp"
+#include "turtlegas/sim/world_def.hpp"
+
+namespace turtlegas::apps {
+
+/// A checkpoint file, format turtlegas-checkpoint/1.
+struct Checkpoint {
+  std::string world;               ///< the world file, as given
+  std::uint64_t world_hash = 0;    ///< FNV-1a of its bytes
+  sim::Mode mode = sim::Mode::exact;
+  double dt = 0.0;                 ///< seconds, the run's (after --dt)
+  double t = 0.0;                  ///< seconds: the time the run had reached
+  std::uint64_t events = 0;        ///< the engine's event count there
+  std::uint64_t state_hash = 0;    ///< FNV-1a of the state file there (formats/state_file.hpp)
+  std::string why;                 ///< "every 10 s", "SIGINT", "max-events", ...
+};
+
+/// 64-bit FNV-1a.
+std::uint64_t fnv1a64(std::string_view bytes);
+/// FNV-1a of a file's bytes; BadInput naming `what` when it cannot be read.
+std::uint64_t file_hash(const std::string& path, const std::string& what);
+
+void write_checkpoint(std::ostream& out, const Checkpoint& c);
+/// Reads a checkpoint; BadInput (naming the file and the key) for one that is not.
+Checkpoint read_checkpoint(const std::string& path);
+
+}  // namespace turtlegas::apps

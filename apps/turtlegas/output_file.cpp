@@ -1,0 +1,169 @@
+// SPDX-License-Identifier: MIT
+#include "output_file.hpp"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <utility>
+
+#include "cli_common.hpp"
+
+namespace turtlegas::apps {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The temporary files being written, for remove_temporaries(): fixed slots of plain pointers, so
+// that a signal handler can walk them without locks or allocation.
+std::array<std::atomic<const char*>, 32> g_temporaries{};
+
+void register_temporary(const char* path) {
+  for (auto& slot : g_temporaries) {
+    const char* expected = nullptr;
+    if (slot.compare_exchange_strong(expected, path)) return;
+  }
+  // More than 32 outputs at once: the extra ones are still removed by their destructors.
+}
+
+void unregister_temporary(const char* path) {
+  for (auto& slot : g_temporaries) {
+    const char* expected = path;
+    if (slot.compare_exchange_strong(expected, nullptr)) return;
+  }
+}
+
+/// Follows symlinks (a chain of at most 40, as the kernel does) to the path they end at, which
+/// may not exist yet (a dangling link names the file to create).
+fs::path follow_links(fs::path p, std::string_view option) {
+  for (int hops = 0; hops < 40; ++hops) {
+    std::error_code ec;
+    if (!fs::is_symlink(fs::symlink_status(p, ec))) return p;
+    const fs::path to = fs::read_symlink(p, ec);
+    if (ec) return p;
+    p = to.is_absolute() ? to : p.parent_path() / to;
+  }
+  throw BadInput(std::string(option) + ": '" + p.string() + "': too many levels of symbolic links");
+}
+
+/// The file at p, identified by device and inode (following links), if it exists.
+bool same_file(const std::string& a, const std::string& b) {
+  struct stat sa{}, sb{};
+  if (::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  // Not there yet (a new output): the same name once links and dots are resolved.
+  std::error_code ec1, ec2;
+  const fs::path ca = fs::weakly_canonical(a, ec1), cb = fs::weakly_canonical(b, ec2);
+  return !ec1 && !ec2 && ca == cb;
+}
+
+}  // namespace
+
+OutputFile::OutputFile(const std::string& path, std::string_view option) : path_(path), option_(option) {
+  const std::string opt(option);
+  if (path == "-") {
+    kind_ = Kind::standard_output;
+    return;
+  }
+  if (path.empty()) throw BadInput(opt + ": needs a file name (or - for standard output)");
+  target_ = follow_links(path, option);
+  std::error_code ec;
+  const fs::file_status st = fs::status(target_, ec);
+  if (fs::is_directory(st)) throw BadInput(opt + ": '" + path + "' is a directory; give a file name");
+  if (fs::exists(st) && !fs::is_regular_file(st)) {
+    // A terminal, a pipe, a device: there is nothing to replace, and renaming over it would put a
+    // regular file in its place (as root, over /dev/stdout). Written as it goes.
+    kind_ = Kind::direct;
+    out_.open(target_, std::ios::binary | std::ios::out);
+    if (!out_) throw BadInput(opt + ": cannot open '" + path + "' for writing; check its permissions");
+    return;
+  }
+  const fs::path dir = target_.parent_path().empty() ? fs::path(".") : target_.parent_path();
+  if (!fs::is_directory(dir, ec))
+    throw BadInput(opt + ": directory '" + dir.string() + "' does not exist; create it first");
+  tmp_ = dir / ("." + target_.filename().string() + ".tmp-" + std::to_string(::getpid()));
+  out_.open(tmp_, std::ios::binary | std::ios::trunc);
+  if (!out_) throw BadInput(opt + ": cannot write in '" + dir.string() + "'; check its permissions");
+  register_temporary(tmp_.c_str());
+  // The replacement keeps the permissions of the file it replaces.
+  if (fs::is_regular_file(st)) fs::permissions(tmp_, st.permissions(), ec);
+}
+
+OutputFile::~OutputFile() {
+  if (kind_ != Kind::replaced || committed_) return;
+  unregister_temporary(tmp_.c_str());
+  out_.close();
+  std::error_code ec;
+  fs::remove(tmp_, ec);
+}
+
+std::ostream& OutputFile::stream() { return kind_ == Kind::standard_output ? std::cout : out_; }
+
+void OutputFile::flush() { stream().flush(); }
+
+void OutputFile::commit() {
+  if (committed_) return;
+  committed_ = true;
+  switch (kind_) {
+    case Kind::standard_output:
+      std::cout.flush();
+      if (!std::cout) throw std::runtime_error(option_ + ": could not finish writing to standard output");
+      return;
+    case Kind::direct:
+      out_.close();
+      if (out_.fail()) throw std::runtime_error(option_ + ": could not finish writing '" + path_ + "'");
+      return;
+    case Kind::replaced: break;
+  }
+  out_.close();
+  unregister_temporary(tmp_.c_str());
+  std::error_code ec;
+  if (out_.fail()) {
+    fs::remove(tmp_, ec);
+    throw std::runtime_error(option_ + ": could not finish writing '" + path_ + "' (disk full?); it is left as it was");
+  }
+  fs::rename(tmp_, target_, ec);
+  if (ec) {
+    fs::remove(tmp_, ec);
+    throw std::runtime_error(option_ + ": could not put '" + path_ + "' in place: " + ec.message());
+  }
+}
+
+void check_outputs(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs) {
+  const NamedPath* on_stdout = nullptr;
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const NamedPath& out = outputs[i];
+    if (out.path.empty()) continue;
+    if (out.path == "-") {
+      if (on_stdout)
+        throw BadInput(on_stdout->option + " and " + out.option +
+                       " both write to standard output (-); give one of them a file name");
+      on_stdout = &out;
+      continue;
+    }
+    for (const NamedPath& in : inputs)
+      if (!in.path.empty() && in.path != "-" && same_file(out.path, in.path))
+        throw BadInput(out.option + " " + out.path + ": that is " + in.option + " (" + in.path +
+                       "); writing it would overwrite it: give another file name");
+    for (std::size_t j = 0; j < i; ++j)
+      if (!outputs[j].path.empty() && outputs[j].path != "-" && same_file(out.path, outputs[j].path)) {
+        // Two outputs into one device (/dev/null) are harmless; into one file, one would be lost.
+        struct stat s{};
+        if (::stat(out.path.c_str(), &s) == 0 && !S_ISREG(s.st_mode)) continue;
+        throw BadInput(outputs[j].option + " and " + out.option + " both write '" + out.path +
+                       "'; give each its own file");
+      }
+  }
+}
+
+void remove_temporaries() noexcept {
+  for (auto& slot : g_temporaries)
+    if (const char* p = slot.exchange(nullptr)) ::unlink(p);
+}
+
+}  // namespace turtlegas::apps

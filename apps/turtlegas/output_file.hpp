@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: MIT
+// The files a command writes: standard output, devices and pipes written directly, regular files
+// replaced whole or not at all, and never one of the command's own inputs.
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <iosfwd>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace turtlegas::apps {
+
+/// An output file named on the command line (`option` names it in messages):
+/// - "-" is standard output;
+/// - a path to something that is not a regular file (a terminal, a FIFO such as bash's
+///   `>(jq ...)`, /dev/null, or a symlink to one of those) is opened and written directly;
+/// - a regular file, or a name that does not exist yet, is written under a temporary name in
+///   the same directory and renamed over it by commit(), so that a failed or interrupted run never
+///   leaves a file that looks whole. A symlink is followed: the file it points to is replaced
+///   (keeping its permissions), the link stays.
+/// Opening checks the path (BadInput for a missing directory, a directory given as the file, or
+/// one that cannot be written in), so a bad path costs nothing. The temporary file is removed by
+/// the destructor unless committed, and by a fatal signal or exit() (remove_temporaries()).
+class OutputFile {
+ public:
+  OutputFile(const std::string& path, std::string_view option);
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+  ~OutputFile();
+
+  std::ostream& stream();
+  /// Hands what has been written so far on to the target (a reader of a pipe or of standard
+  /// output sees it at once; a replaced file's temporary has it on disk).
+  void flush();
+  /// Finishes the file: closes it and, for a replaced file, renames it over the target. Throws
+  /// std::runtime_error when a write failed (a full disk, say), leaving the target as it was.
+  void commit();
+
+  const std::string& path() const { return path_; }
+  bool to_stdout() const { return kind_ == Kind::standard_output; }
+
+ private:
+  enum class Kind { standard_output, direct, replaced };
+  std::string path_;
+  std::string option_;
+  Kind kind_ = Kind::replaced;
+  std::filesystem::path target_;  // the file replaced (a symlink's target) or written directly
+  std::filesystem::path tmp_;
+  std::ofstream out_;
+  bool committed_ = false;
+};
+
+/// A file named on the command line, and the option that named it ("--events"; the world file's
+/// is "the world file").
+struct NamedPath {
+  std::string path;
+  std::string option;
+};
+
+/// Refuses (BadInput, exit code 2) an output that is one of the inputs (the same file, by any
+/// name or link: `--svg w.json` would overwrite the world), two outputs that are the same file,
+/// and two outputs on standard output. Empty paths are ignored.
+void check_outputs(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs);
+
+/// Removes every OutputFile's temporary file now: async-signal-safe (unlink only), for a fatal
+/// signal's handler and for exit() (crash_report.hpp).
+void remove_temporaries() noexcept;
+
+}  // namespace turtlegas::apps

@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: MIT
+// How much work a scene predicts per simulated second, from its scales alone (speeds, fields,
+// the cell, the step): for `check`'s warnings about runs that would never finish, and for the
+// size of a run's first chunk (so that a runaway scene still shows progress and obeys its limits).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "turtlegas/sim/world_def.hpp"
+
+namespace turtlegas::apps {
+
+/// Order-of-magnitude predictions, meant to catch absurd scenes (a speed of 1e150, a dt of
+/// 1e-300), not to time ordinary ones: each is an upper estimate of the steady rate.
+struct SceneScales {
+  /// Events (collisions and cell crossings) per simulated second: for every ball, twice the
+  /// fastest speed it can reach (its speed plus what the fields can give it across the arena,
+  /// sqrt(2 a L)) over the cell side; for every turtle its speed over the cell side. Set by
+  /// set_cell() from the sums below.
+  double events_per_second = 0.0;
+  std::string events_why;  ///< the body that dominates, in numbers
+  /// Steps per simulated second: step mode's steps, and the turtles' control steps (1/dt each).
+  double steps_per_second = 0.0;
+  std::string steps_why;
+
+  double speed_sum = 0.0;     ///< units/s: twice each ball's speed bound, plus each turtle's
+  double fastest = 0.0;       ///< units/s, the largest speed bound
+  std::string fastest_id;
+  bool by_fields = false;     ///< the fields give the fastest body most of its speed
+  /// The event rate and its cause for cells of this side (the engine's cell_size()).
+  void set_cell(double cell);
+};
+
+/// The scene's speeds and steps; events_per_second needs set_cell() (a world's cell size is known
+/// once it is built; the World may take the scene's balls then).
+SceneScales predict_scales(const sim::WorldDef& def, sim::Mode mode);
+
+/// A run of `seconds` predicting more than this many events, or steps, is warned about.
+constexpr double absurd_events = 1e10;
+constexpr double absurd_steps = 1e9;
+/// What the warnings convert counts into wall time with: a fast run's pace.
+constexpr double nominal_events_per_second = 1e7;
+
+/// One line per absurd prediction for a run of `seconds` (simulated), naming its cause and the
+/// wall time it would take at the nominal pace; `span` says what the run is ("a run to
+/// --until 1e308", "the expect list's run to until 1e12", "one simulated second").
+std::vector<std::string> scale_warnings(const SceneScales& scales, double seconds, const std::string& span);
+
+/// "12 s", "3.5 min", "2.1 h", "4.2 days", "3e+134 years".
+std::string human_duration(double seconds);
+
+}  // namespace turtlegas::apps

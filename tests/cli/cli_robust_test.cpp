@@ -1,0 +1,579 @@
+// SPDX-License-Identifier: MIT
+// Issue 17, the CLI's half: nothing hangs, nothing is lost. Runs that used to hang are spawned and
+// waited for with a deadline (spawn.hpp), never without a bound; signals go to the spawned process
+// only.
+#include <poll.h>
+#include <pty.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include "run_cli.hpp"
+#include "spawn.hpp"
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using namespace turtlegas::test;
+
+namespace {
+
+const std::string worlds = std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/";
+
+/// One turtle running `controller` (from the test plugin) with `params`, in a walled box.
+std::string plugin_world(const std::string& controller, const std::string& params = "{}", const std::string& extra = "") {
+  return R"({"format": "turtlegas-world/1", "arena": {"width": 200, "height": 200, "boundary": "walls"},)" + extra +
+         R"( "turtles": [{"id": "rogue", "pos": [100, 100], "controller": ")" + controller + R"(", "params": )" + params +
+         "}]}";
+}
+
+/// A gas that runs for as long as it is asked to: 200 discs in a walled box.
+const std::string long_gas = R"({"format": "turtlegas-world/1", "arena": {"width": 200, "height": 200, "boundary": "walls"},
+  "gas": [{"count": 200, "radius": 2, "speed": 50, "seed": 3}]})";
+
+/// Every line of an event log parses as JSON (a log cut short mid-line would not).
+std::size_t well_formed_lines(const fs::path& log) {
+  std::ifstream in(log);
+  std::string line;
+  std::size_t n = 0;
+  while (std::getline(in, line)) {
+    INFO("line " << n + 1 << ": " << line);
+    REQUIRE_NOTHROW(json::parse(line));
+    ++n;
+  }
+  return n;
+}
+
+bool has_temporaries(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+// --- §1: the swallowed-exception teardown spin ---------------------------------------------------
+
+TEST_CASE("robust: a controller that swallows the teardown's exception does not spin at the end of a run") {
+  // Before: the run reached --until, then spun at 100 % CPU for ever in the destructor (the
+  // program caught the unwinding and issued another command).
+  TempDir dir;
+  const fs::path w = dir.write("w.json", plugin_world("swallower"));
+  Spawned p(dir.path, {"run", w.string(), "--until", "3", "--plugin", TEST_PLUGIN, "--stats"});
+  const auto ended = p.wait_for(60);
+  REQUIRE(ended.has_value());
+  INFO(p.err());
+  CHECK(ended->code == 0);
+  CHECK(contains(p.err(), "turtle 'rogue'"));
+  CHECK(contains(p.err(), "while the run was ending"));
+  CHECK(contains(p.out(), "t = 0 -> 3 s"));
+}
+
+TEST_CASE("robust: turtlegas test ends a world whose controller swallows the teardown's exception") {
+  TempDir dir;
+  const fs::path w = dir.write("w.json", plugin_world("swallower", "{}", R"( "expect": [{"until": 2}],)"));
+  Spawned p(dir.path, {"test", w.string(), "--plugin", TEST_PLUGIN});
+  const auto ended = p.wait_for(60);
+  REQUIRE(ended.has_value());
+  INFO(p.out() << p.err());
+  CHECK(ended->code == 0);
+  CHECK(contains(p.err(), "turtle 'rogue'"));
+}
+
+// --- §1: numeric options are range-checked ------------------------------------------------------
+
+TEST_CASE("robust: numeric options out of range are refused with exit 2, naming the option and the range") {
+  TempDir dir;
+  const std::string w = worlds + "gas.json";
+  struct Case {
+    std::vector<std::string> args;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {{"--until", "-1"}, "--until"},
+      {{"--until", "nan"}, "--until"},
+      {{"--until", "inf"}, "--until"},
+      {{"--until", "1", "--dt", "0"}, "--dt"},
+      {{"--until", "1", "--dt", "-1e-3"}, "--dt"},
+      {{"--until", "1", "--stack-kib", "-1"}, "--stack-kib"},  // wrapped to 2^64 - 1 before
+      {{"--until", "1", "--stack-kib", "8"}, "--stack-kib"},
+      {{"--until", "1", "--program-budget", "0"}, "--program-budget"},
+      {{"--until", "1", "--max-events", "-1"}, "--max-events"},
+      {{"--until", "1", "--max-events", "1.5"}, "--max-events"},
+      {{"--until", "1", "--max-wall-seconds", "0"}, "--max-wall-seconds"},
+      {{"--until", "1", "--max-wall-seconds", "inf"}, "--max-wall-seconds"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"run", w};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const Result r = run(dir, args);
+    INFO(c.args[c.args.size() - 2] << " " << c.args.back() << ": " << r.err);
+    CHECK(r.code == 2);
+    CHECK(contains(r.err, c.says));
+    CHECK(contains(r.err, "must be"));
+  }
+}
+
+// --- §2: output files ---------------------------------------------------------------------------
+
+TEST_CASE("robust: - is standard output") {
+  TempDir dir;
+  const Result r = run(dir, {"run", worlds + "gas.json", "--until", "0.5", "--events", "-"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(!fs::exists(dir.path / "-"));  // before: a file named "-"
+  std::istringstream lines(r.out);
+  std::string line;
+  std::size_t n = 0;
+  while (std::getline(lines, line)) {
+    REQUIRE_NOTHROW(json::parse(line));
+    ++n;
+  }
+  CHECK(n > 10);
+  const Result two = run(dir, {"run", worlds + "gas.json", "--until", "0.5", "--events", "-", "--svg", "-"});
+  CHECK(two.code == 2);
+  CHECK(contains(two.err, "both write to standard output"));
+}
+
+TEST_CASE("robust: a FIFO is written directly") {
+  // (Not tried on /dev/null or /dev/stdout: a turtlegas without the fix, run as root, replaces
+  // them with regular files for the whole machine.)
+  TempDir dir;
+  const fs::path fifo = dir.path / "events.fifo";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  // A reader for the FIFO (before: the run wrote a temporary file and renamed it over the FIFO,
+  // and a reader waiting on it saw nothing).
+  std::string got;
+  std::thread reader([&] {
+    std::ifstream in(fifo);
+    std::stringstream s;
+    s << in.rdbuf();
+    got = s.str();
+  });
+  const Result r = run(dir, {"run", worlds + "gas.json", "--until", "0.5", "--events", fifo.string()});
+  reader.join();
+  INFO(r.err);
+  CHECK(r.code == 0);
+  CHECK(fs::is_fifo(fifo));  // still a FIFO
+  CHECK(std::count(got.begin(), got.end(), '\n') > 10);
+  CHECK(!has_temporaries(dir.path));
+}
+
+TEST_CASE("robust: a symlinked output is followed, its target replaced and the link kept") {
+  TempDir dir;
+  fs::create_directories(dir.path / "real");
+  const fs::path target = dir.path / "real" / "state.json", link = dir.path / "state-link.json";
+  std::ofstream(target) << "old";
+  fs::permissions(target, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  fs::create_symlink(target, link);
+  const Result r = run(dir, {"run", worlds + "gas.json", "--until", "0.5", "--state-out", link.string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(fs::is_symlink(link));  // before: the link was replaced by a regular file
+  REQUIRE_NOTHROW(json::parse(read(target)));
+  CHECK(fs::status(target).permissions() == (fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read));
+  CHECK(!has_temporaries(dir.path / "real"));
+}
+
+TEST_CASE("robust: a regular file is replaced whole or left as it was") {
+  TempDir dir;
+  const fs::path out = dir.path / "stats.json";
+  std::ofstream(out) << "previous";
+  // A run that fails after its outputs were opened (a busy-looping turtle) leaves the old file.
+  // (Busy-loop recovery jumps across stacks, which AddressSanitizer cannot follow: there a
+  // controller that calls exit() fails the run instead.)
+#if defined(__SANITIZE_ADDRESS__)
+  const fs::path w = dir.write("w.json", plugin_world("crasher", R"({"how": "exit", "after": 0.2})"));
+#else
+  const fs::path w = dir.write("w.json", plugin_world("spinner"));
+#endif
+  const Result bad =
+      run(dir, {"run", w.string(), "--until", "5", "--plugin", TEST_PLUGIN, "--program-budget", "0.2", "--stats-json", out.string()});
+  CHECK(bad.code == 1);
+  CHECK(read(out) == "previous");
+  CHECK(!has_temporaries(dir.path));
+  const Result good = run(dir, {"run", worlds + "gas.json", "--until", "0.5", "--stats-json", out.string()});
+  INFO(good.err);
+  REQUIRE(good.code == 0);
+  CHECK(json::parse(read(out)).at("until") == 0.5);
+}
+
+TEST_CASE("robust: an output that is an input is refused with exit 2") {
+  TempDir dir;
+  const fs::path w = dir.write("w.json", read(worlds + "gas.json"));
+  const std::string before = read(w);
+  for (const std::string option : {"--svg", "--events", "--state-out", "--stats-json", "--checkpoint"}) {
+    const Result r = run(dir, {"run", w.string(), "--until", "0.5", option, w.string()});
+    INFO(option << ": " << r.err);
+    CHECK(r.code == 2);
+    CHECK(contains(r.err, "the world file"));
+    CHECK(read(w) == before);  // before: --svg w.json overwrote the world
+  }
+  // By another name: a symlink to it, and ./w.json.
+  fs::create_symlink(w, dir.path / "alias.json");
+  CHECK(run(dir, {"run", w.string(), "--until", "0.5", "--svg", (dir.path / "alias.json").string()}).code == 2);
+  CHECK(run(dir, {"run", "w.json", "--until", "0.5", "--svg", "./w.json"}).code == 2);
+  CHECK(read(w) == before);
+  // Two outputs into one file.
+  const Result twice =
+      run(dir, {"run", w.string(), "--until", "0.5", "--svg", (dir.path / "o.txt").string(), "--state-out",
+                (dir.path / "." / "o.txt").string()});
+  CHECK(twice.code == 2);
+  CHECK(contains(twice.err, "both write"));
+}
+
+// --- §3: NaN and infinite amounts ----------------------------------------------------------------
+
+TEST_CASE("robust: forward(NaN) and right(inf) fault the program with a clear message") {
+  for (const std::string call : {"forward", "right"}) {
+    TempDir dir;
+    const fs::path w = dir.write("w.json", plugin_world("bad_amount", R"({"call": ")" + call + R"("})"));
+    const fs::path events = dir.path / "e.jsonl", state = dir.path / "s.json", stats = dir.path / "st.json";
+    const Result r = run(dir, {"run", w.string(), "--until", "5", "--plugin", TEST_PLUGIN, "--events", events.string(),
+                               "--state-out", state.string(), "--stats-json", stats.string()});
+    INFO(call << ": " << r.err);
+    REQUIRE(r.code == 0);
+    std::ifstream in(events);
+    std::string line, fault;
+    while (std::getline(in, line))
+      if (json::parse(line).at("kind") == "fault") fault = line;
+    INFO(fault);
+    CHECK(contains(fault, call == "forward" ? "forward(nan)" : "right(inf)"));
+    CHECK(contains(fault, "must be a finite number"));
+    CHECK(json::parse(read(stats)).at("faults") == 1);
+    // The turtle drove its first 5 units and no more (before: forward(NaN) drove 86 backwards).
+    const json s = json::parse(read(state));
+    const double x = s.at("turtles").at(0).at("pos").at(0);
+    const double y = s.at("turtles").at(0).at("pos").at(1);
+    CHECK(std::hypot(x - 100.0, y - 105.0) < 1e-9);  // heading 0 is +y
+  }
+}
+
+// --- §1: runaway runs: limits, check's warnings --------------------------------------------------
+
+namespace {
+
+// A ball at speed 1e150 in a walled box: about 1e150 collisions a second.
+const std::string runaway = R"({"format": "turtlegas-world/1", "arena": {"width": 100, "height": 100, "boundary": "walls"},
+  "balls": [{"id": "bullet", "pos": [50, 50], "vel": [1e150, 3e149], "radius": 1}]})";
+
+}  // namespace
+
+TEST_CASE("robust: --max-events ends a runaway run cleanly, its outputs written up to there") {
+  // Before: the run went on for ever without a word.
+  TempDir dir;
+  const fs::path w = dir.write("w.json", runaway);
+  const fs::path events = dir.path / "e.jsonl", stats = dir.path / "stats.json";
+  Spawned p(dir.path, {"run", w.string(), "--until", "1", "--max-events", "20000", "--events", events.string(),
+                       "--stats-json", stats.string()});
+  const auto ended = p.wait_for(120);
+  REQUIRE(ended.has_value());
+  INFO(p.err());
+  CHECK(ended->code == 3);
+  CHECK(contains(p.err(), "max-events"));
+  CHECK(contains(p.err(), "predicts about"));  // the warning before the run, in numbers
+  const json s = json::parse(read(stats));
+  CHECK(s.at("stopped") == "max-events");
+  CHECK(s.at("t").get<double>() < 1.0);
+  CHECK(s.at("events").get<double>() >= 20000);
+  CHECK(s.at("events").get<double>() < 20000 * 64);  // stopped near the limit, not far beyond
+  CHECK(well_formed_lines(events) >= 20000);
+  CHECK(!has_temporaries(dir.path));
+}
+
+TEST_CASE("robust: --max-wall-seconds ends a runaway run cleanly") {
+  TempDir dir;
+  const fs::path w = dir.write("w.json", runaway);
+  const fs::path stats = dir.path / "stats.json", state = dir.path / "state.json";
+  Spawned p(dir.path, {"run", w.string(), "--until", "1e308", "--max-wall-seconds", "1", "--stats-json", stats.string(),
+                       "--state-out", state.string()});
+  const auto ended = p.wait_for(120);
+  REQUIRE(ended.has_value());
+  INFO(p.err());
+  CHECK(ended->code == 3);
+  CHECK(json::parse(read(stats)).at("stopped") == "max-wall-seconds");
+  CHECK_NOTHROW(json::parse(read(state)));
+}
+
+TEST_CASE("robust: check warns, with numbers, about scenes whose scales predict a run that never ends") {
+  TempDir dir;
+  struct Case {
+    std::string world, says;
+  };
+  const std::vector<Case> cases = {
+      {runaway, "'bullet' may reach speed 1.04e+150"},
+      {R"({"format": "turtlegas-world/1", "arena": {"width": 100, "height": 100, "boundary": "walls"},
+          "effects": {"gravity": [0, -1e300]}, "balls": [{"id": "b", "pos": [50, 50], "radius": 1}]})",
+       "the fields accelerate it"},
+      {R"({"format": "turtlegas-world/1", "dt": 1e-300, "arena": {"width": 100, "height": 100},
+          "turtles": [{"id": "t", "pos": [50, 50], "controller": "wander"}]})",
+       "steps"},
+      {R"({"format": "turtlegas-world/1", "arena": {"width": 100, "height": 100, "boundary": "walls"},
+          "balls": [{"id": "b", "pos": [50, 50], "vel": [10, 0], "radius": 1}], "expect": [{"until": 1e12}]})",
+       "until 1e+12"},
+  };
+  for (const Case& c : cases) {
+    const fs::path w = dir.write("w.json", c.world);
+    const Result r = run(dir, {"check", w.string()});
+    INFO(c.world << "\n" << r.out << r.err);
+    CHECK(r.code == 0);  // warnings, not errors
+    CHECK(contains(r.err, "predicts about"));
+    CHECK(contains(r.err, c.says));
+  }
+  // An ordinary scene is not warned about.
+  const Result fine = run(dir, {"check", worlds + "gas.json"});
+  CHECK(fine.code == 0);
+  CHECK(!contains(fine.err, "predicts"));
+}
+
+// --- §2: SIGINT and SIGTERM ------------------------------------------------------------------------
+
+TEST_CASE("robust: SIGINT and SIGTERM stop a run at a control boundary with every output written") {
+  for (const int sig : {SIGINT, SIGTERM}) {
+    TempDir dir;
+    const fs::path w = dir.write("w.json", long_gas);
+    const fs::path events = dir.path / "e.jsonl", stats = dir.path / "stats.json", state = dir.path / "state.json";
+    Spawned p(dir.path, {"run", w.string(), "--until", "1e9", "--events", events.string(), "--stats-json",
+                         stats.string(), "--state-out", state.string()});
+    // The log of a long run is written as it goes: wait until some of it is there.
+    fs::path tmp;
+    REQUIRE(Spawned::wait_for_file_prefix(dir.path, ".e.jsonl.tmp-", 4096, 60, tmp));
+    p.send(sig);
+    const auto ended = p.wait_for(60);
+    REQUIRE(ended.has_value());
+    INFO(p.err());
+    CHECK(ended->code == 128 + sig);  // 130, 143
+    CHECK(contains(p.err(), sig == SIGINT ? "SIGINT" : "SIGTERM"));
+    const json s = json::parse(read(stats));
+    CHECK(s.at("stopped") == (sig == SIGINT ? "SIGINT" : "SIGTERM"));
+    CHECK(s.at("t").get<double>() > 0.0);
+    CHECK(json::parse(read(state)).at("t") == s.at("t"));
+    CHECK(well_formed_lines(events) > 10);
+    CHECK(!has_temporaries(dir.path));  // before: a hidden .e.jsonl.tmp-PID was left
+  }
+}
+
+// --- §3: controllers declare their parameters ------------------------------------------------------
+
+TEST_CASE("robust: check validates a controller's params against its declaration") {
+  TempDir dir;
+  auto world = [](const std::string& controller, const std::string& params) {
+    return R"({"format": "turtlegas-world/1", "arena": {"width": 200, "height": 200},
+      "turtles": [{"id": "t", "pos": [100, 100], "controller": ")" + controller + R"(", "params": )" + params + "}]}";
+  };
+  struct Case {
+    std::string controller, params, path, says;
+  };
+  const std::vector<Case> cases = {
+      // Before: a typo silently took the default, a wrong type passed check.
+      {"wander", R"({"stpe": 10})", "/turtles/0/params/stpe", "did you mean \"step\""},
+      {"wander", R"({"step": "far"})", "/turtles/0/params/step", "step must be a number"},
+      {"square", R"({"laps": 2.5})", "/turtles/0/params/laps", "laps must be an integer"},
+      {"square", R"({"laps": 9e36})", "/turtles/0/params/laps", "laps must be an integer"},  // params-int-ub
+      {"spiral", R"({"sides": 1e10})", "/turtles/0/params/sides", "sides must be an integer"},
+      {"wall_follower", R"({"hand": "rihgt"})", "/turtles/0/params/hand", "did you mean \"right\""},
+  };
+  for (const Case& c : cases) {
+    const fs::path w = dir.write("w.json", world(c.controller, c.params));
+    const Result r = run(dir, {"check", w.string()});
+    INFO(c.controller << " " << c.params << ": " << r.err);
+    CHECK(r.code == 2);
+    CHECK(contains(r.err, c.path));
+    CHECK(contains(r.err, c.says));
+  }
+  // Comments ("x-") and declared keys pass.
+  const fs::path ok = dir.write("w.json", world("wander", R"({"step": 10, "x-note": "why"})"));
+  const Result r = run(dir, {"check", ok.string()});
+  INFO(r.err);
+  CHECK(r.code == 0);
+}
+
+TEST_CASE("robust: turtlegas controllers lists each controller's parameters") {
+  TempDir dir;
+  const Result r = run(dir, {"controllers"});
+  REQUIRE(r.code == 0);
+  // wander's step: its type and range, its default and its help.
+  std::istringstream lines(r.out);
+  std::string line, step;
+  while (std::getline(lines, line))
+    if (line.rfind("    step ", 0) == 0 && step.empty()) step = line;
+  INFO(r.out);
+  CHECK(contains(step, "number"));
+  CHECK(contains(step, "default"));
+  CHECK(contains(r.out, "hand"));
+  CHECK(contains(r.out, "right|left"));
+}
+
+// --- §3: a native crash, a huge frame ----------------------------------------------------------------
+
+TEST_CASE("robust: a native crash in a controller is reported with the turtle and the time") {
+  for (const std::string how : {"null", "abort", "exit"}) {
+    TempDir dir;
+    const fs::path w = dir.write("w.json", plugin_world("crasher", R"({"how": ")" + how + R"(", "after": 0.5})"));
+    const fs::path stats = dir.path / "stats.json";
+    const Result r = run(dir, {"run", w.string(), "--until", "5", "--plugin", TEST_PLUGIN, "--stats-json", stats.string()});
+    INFO(how << ": " << r.err);
+    CHECK(r.code != 0);
+    // Before: the process died with no word of which turtle or world.
+    CHECK(contains(r.err, "turtle 'rogue' (controller 'crasher')"));
+    CHECK(contains(r.err, "at t = 0.5"));
+    CHECK(contains(r.err, w.string()));
+    CHECK(!fs::exists(stats));
+    CHECK(!has_temporaries(dir.path));
+  }
+}
+
+TEST_CASE("robust: a 200 KiB stack frame gives the overflowed-its-stack fault") {
+#if defined(__SANITIZE_ADDRESS__)
+  WARN("skipped under AddressSanitizer, which has its own stack checks");
+  return;
+#endif
+  // Before (no -fstack-clash-protection): the frame jumped the guard page and the run crashed.
+  TempDir dir;
+  const fs::path w = dir.write("w.json", plugin_world("big_frame"));
+  const fs::path events = dir.path / "e.jsonl";
+  const Result r = run(dir, {"run", w.string(), "--until", "3", "--plugin", TEST_PLUGIN, "--events", events.string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(contains(read(events), "overflowed its stack"));
+}
+
+// --- §2: checkpoints -------------------------------------------------------------------------------
+
+namespace {
+
+std::string fmt_number(double v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
+/// Runs `world` to `until` in one go, and again as a run to `until / 2` that writes a checkpoint,
+/// resumed from it to `until`: the final states are the same bytes, and the resumed run's event
+/// log is the uninterrupted one's tail.
+void check_resume(const std::string& world, double until, const std::vector<std::string>& extra = {}) {
+  TempDir dir;
+  auto args = [&](std::vector<std::string> a) {
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  };
+  const std::string u = fmt_number(until), half = fmt_number(until / 2);
+  const Result whole = run(dir, args({"run", world, "--until", u, "--state-out", (dir.path / "whole.json").string(), "--events", (dir.path / "whole.jsonl").string()}));
+  INFO(whole.err);
+  REQUIRE(whole.code == 0);
+  const Result first = run(dir, args({"run", world, "--until", half, "--checkpoint", (dir.path / "c.json").string()}));
+  INFO(first.err);
+  REQUIRE(first.code == 0);
+  const json c = json::parse(read(dir.path / "c.json"));
+  CHECK(c.at("format") == "turtlegas-checkpoint/1");
+  const Result resumed =
+      run(dir, args({"run", world, "--until", u, "--resume", (dir.path / "c.json").string(), "--state-out", (dir.path / "resumed.json").string(), "--events", (dir.path / "resumed.jsonl").string()}));
+  INFO(resumed.err);
+  REQUIRE(resumed.code == 0);
+  CHECK(read(dir.path / "resumed.json") == read(dir.path / "whole.json"));
+  // The resumed log is the uninterrupted log's tail: the events after the checkpoint's time.
+  const std::string whole_log = read(dir.path / "whole.jsonl"), tail = read(dir.path / "resumed.jsonl");
+  REQUIRE(tail.size() > 0);
+  REQUIRE(whole_log.size() >= tail.size());
+  CHECK(whole_log.compare(whole_log.size() - tail.size(), tail.size(), tail) == 0);
+}
+
+}  // namespace
+
+TEST_CASE("robust: a resumed run continues bit-identically: a gas") { check_resume(worlds + "gas.json", 4); }
+TEST_CASE("robust: a resumed run continues bit-identically: a gas with a moving wall") {
+  check_resume(worlds + "piston.json", 40);
+}
+TEST_CASE("robust: a resumed run continues bit-identically: a tag game") { check_resume(worlds + "tag.json", 20); }
+
+TEST_CASE("robust: --checkpoint-every writes checkpoints as the run goes, and SIGINT one more") {
+  TempDir dir;
+  const fs::path w = dir.write("w.json", long_gas);
+  Spawned p(dir.path, {"run", w.string(), "--until", "1e9", "--checkpoint", "c.json", "--checkpoint-every", "0.5"});
+  REQUIRE(Spawned::wait_for_file(dir.path / "c.json", 10, 60));
+  p.send(SIGINT);
+  const auto ended = p.wait_for(60);
+  REQUIRE(ended.has_value());
+  CHECK(ended->code == 130);
+  const json c = json::parse(read(dir.path / "c.json"));
+  CHECK(c.at("why") == "SIGINT");
+  INFO(p.err());
+  CHECK(contains(p.err(), "--resume c.json"));
+}
+
+TEST_CASE("robust: resume refuses a world with a controller that is not restartable, and a changed world") {
+  TempDir dir;
+  const std::string c = (dir.path / "c.json").string();
+  const fs::path w = dir.write("w.json", plugin_world("swallower"));
+  const Result first = run(dir, {"run", w.string(), "--until", "1", "--plugin", TEST_PLUGIN, "--checkpoint", c});
+  INFO(first.err);
+  REQUIRE(first.code == 0);
+  const Result resumed = run(dir, {"run", w.string(), "--until", "2", "--plugin", TEST_PLUGIN, "--resume", c});
+  CHECK(resumed.code == 2);
+  CHECK(contains(resumed.err, "turtle 'rogue' runs controller 'swallower', which does not declare itself restartable"));
+
+  const fs::path g = dir.write("g.json", long_gas);
+  REQUIRE(run(dir, {"run", g.string(), "--until", "0.5", "--checkpoint", c}).code == 0);
+  dir.write("g.json", long_gas + " ");
+  const Result changed = run(dir, {"run", g.string(), "--until", "1", "--resume", c});
+  CHECK(changed.code == 2);
+  CHECK(contains(changed.err, "is not the one the checkpoint was written for"));
+}
+
+// --- §1: the progress line ---------------------------------------------------------------------------
+
+TEST_CASE("robust: a long run on a terminal shows a progress line with events/s and an ETA") {
+  // Before: a runaway run was silent for ever. stderr is a pseudo-terminal here, as in a shell.
+  TempDir dir;
+  const fs::path w = dir.write("w.json", runaway);
+  int master = -1;
+  const pid_t pid = ::forkpty(&master, nullptr, nullptr, nullptr);
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    const std::string bin = TURTLEGAS_BIN, world = w.string();
+    ::execl(bin.c_str(), bin.c_str(), "run", world.c_str(), "--until", "1", "--max-wall-seconds", "4", nullptr);
+    ::_exit(127);
+  }
+  std::string seen;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  int status = 0;
+  bool ended = false;
+  while (std::chrono::steady_clock::now() < deadline) {
+    pollfd pfd{master, POLLIN, 0};
+    if (::poll(&pfd, 1, 100) > 0) {
+      char buf[4096];
+      const ssize_t n = ::read(master, buf, sizeof buf);
+      if (n > 0) seen.append(buf, static_cast<std::size_t>(n));
+      if (n <= 0 && ::waitpid(pid, &status, WNOHANG) == pid) {
+        ended = true;
+        break;
+      }
+    } else if (::waitpid(pid, &status, WNOHANG) == pid) {
+      ended = true;
+      break;
+    }
+  }
+  if (!ended) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+  }
+  ::close(master);
+  INFO(seen);
+  REQUIRE(ended);
+  CHECK(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 3);
+  CHECK(contains(seen, "t = "));
+  CHECK(contains(seen, " / 1 s"));
+  CHECK(contains(seen, "events/s"));
+  CHECK(contains(seen, "ETA"));
+}
