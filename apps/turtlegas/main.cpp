@@ -77,7 +77,7 @@ int run(int argc, char** argv) {
     load_plugins(plugins, registry);
     if (*list) return controllers_command(registry);
     if (*check) return check_command(check_worlds, registry);
-    if (*test) return test_command(test_opt, registry);
+    if (*test) return test_command(test_opt, registry, plugins);
     if (*tag) return run_tag_command(tag_opt, registry);
     return run_command(run_line.options(), registry);
   } catch (const BadInput& e) {
