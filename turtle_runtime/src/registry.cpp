@@ -7,6 +7,8 @@
 
 #include "turtlegas/sim/suggest.hpp"
 
+#include "mirror_controller.hpp"
+
 namespace turtlegas::turtle {
 
 void Registry::add(std::string name, Controller controller, std::string summary) {
@@ -44,6 +46,8 @@ const std::string& Registry::summary(const std::string& name) const {
 Registry base_registry() {
   Registry r;
   r.add("script", script_controller, "runs params.commands, a fixed list of [command, amount]");
+  r.add("mirror", detail::mirror_controller,
+        "runs another controller as its mirror image (of, params, axis, through, twin: share its random stream)");
   return r;
 }
 
