@@ -8,6 +8,7 @@ packages=(
   nlohmann-json3-dev libspdlog-dev libcli11-dev catch2
   libboost-dev libboost-context-dev
   python3
+  dpkg-dev binutils   # the Debian package: cpack (dpkg-shlibdeps), tests/package/deb_test.py (readelf)
 )
 
 missing=()

@@ -2,6 +2,7 @@
 #include "check_command.hpp"
 
 #include <cstdio>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -11,8 +12,9 @@
 #include "scene_scales.hpp"
 
 namespace turtlegas::apps {
+namespace {
 
-int check_command(const std::string& file, const turtle::Registry& registry) {
+int check_one(const std::string& file, const turtle::Registry& registry) {
   const world::Scene scene = load(file, registry);
   const sim::WorldDef& def = scene.def;
   // One engine at a time: a scene near the memory budget must not need two of it at once (an
@@ -59,6 +61,31 @@ int check_command(const std::string& file, const turtle::Registry& registry) {
                 controller_summary(scene).c_str());
   }
   return exit_ok;
+}
+
+}  // namespace
+
+int check_command(const std::vector<std::string>& files, const turtle::Registry& registry) {
+  int worst = exit_ok;
+  std::size_t bad = 0;
+  for (const std::string& file : files) {
+    int rc = exit_ok;
+    try {
+      rc = check_one(file, registry);
+    } catch (const BadInput& e) {
+      spdlog::error("{}", e.what());
+      rc = exit_bad_input;
+    } catch (const std::exception& e) {
+      spdlog::error("{}: {}", file, e.what());
+      rc = exit_failure;
+    }
+    std::fflush(stdout);
+    bad += rc == exit_ok ? 0 : 1;
+    // Bad input outranks any other failure, as in `turtlegas test`.
+    if (rc == exit_bad_input || (rc != exit_ok && worst == exit_ok)) worst = rc;
+  }
+  if (files.size() > 1) std::printf("%zu of %zu world files ok\n", files.size() - bad, files.size());
+  return worst;
 }
 
 }  // namespace turtlegas::apps

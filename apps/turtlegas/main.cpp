@@ -21,6 +21,7 @@
 #include "serve_command.hpp"
 #include "tag_command.hpp"
 #include "test_command.hpp"
+#include "version_info.hpp"
 #include "turtlegas/controllers/registry.hpp"
 
 namespace turtlegas::apps {
@@ -39,15 +40,20 @@ int run(int argc, char** argv) {
 
   CLI::App app{"turtlegas: a 2-D gas of discs and walls, and turtles with touch sensors (after MIT AI Memo 272)"};
   app.require_subcommand(1);
+  {
+    std::string version = version_text();
+    version.pop_back();  // CLI11 adds the newline
+    app.set_version_flag("--version", version, "Print the version, the commit, the build type and the compiler, and exit");
+  }
 
   std::vector<std::string> plugins;
   const char* plugin_help = "Load controllers from this shared-library plugin (repeatable)";
   RunCommandLine run_line;  // `turtlegas run` (run_command.hpp)
   add_run_command(app, run_line, plugins, plugin_help);
 
-  std::string check_world;
-  CLI::App* check = app.add_subcommand("check", "Load and validate a world file, and build it in both modes");
-  check->add_option("world", check_world, "World file (format turtlegas-world/1)")->required();
+  std::vector<std::string> check_worlds;
+  CLI::App* check = app.add_subcommand("check", "Load and validate world files, and build each in both modes");
+  check->add_option("worlds", check_worlds, "World files (format turtlegas-world/1)")->required();
   check->add_option("--plugin", plugins, plugin_help);
 
   CLI::App* list = app.add_subcommand("controllers", "List the controllers world files can name, with their params");
@@ -75,8 +81,8 @@ int run(int argc, char** argv) {
     turtle::Registry registry = controllers::builtin_registry();
     load_plugins(plugins, registry);
     if (*list) return controllers_command(registry);
-    if (*check) return check_command(check_world, registry);
-    if (*test) return test_command(test_opt, registry);
+    if (*check) return check_command(check_worlds, registry);
+    if (*test) return test_command(test_opt, registry, plugins);
     if (*tag) return run_tag_command(tag_opt, registry);
     if (*serve) return serve_command(serve_opt, registry);
     return run_command(run_line.options(), registry);

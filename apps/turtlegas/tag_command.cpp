@@ -6,8 +6,12 @@
 #include <stdexcept>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+
 #include "output_file.hpp"
 #include "cli_common.hpp"
+#include "option_checks.hpp"
 
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/tag_tournament.hpp"
@@ -26,6 +30,14 @@ CLI::App* add_tag_command(CLI::App& app, TagCommandOptions& options) {
   tag->add_option("--mode", options.mode, "exact (event-driven) or step (the memo's fixed steps)")
       ->check(CLI::IsMember(sim::mode_names))
       ->capture_default_str();
+  tag->add_option("--params", options.params,
+                  "A param for every turtle a controller drives, controller.key=value (value: JSON, else a string); "
+                  "repeatable");
+  tag->add_option("--stack-kib", options.stack_kib, "Each turtle program's stack, KiB (a guard page is added)")
+      ->capture_default_str();
+  tag->add_option("--program-budget", options.program_budget,
+                  "Wall-clock seconds a turtle program may run without issuing a command before the round stops")
+      ->capture_default_str();
   return tag;
 }
 
@@ -43,6 +55,21 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
   t.rounds = options.rounds;
   t.until = options.until;
   t.server.mode = sim::mode_from_string(options.mode).value_or(sim::Mode::exact);  // CLI11 checked it
+  check_count("--rounds", options.rounds, 1, 100000000);
+  check_seconds("--until", options.until, false);
+  check_stack_kib(options.stack_kib);
+  check_program_budget(options.program_budget);
+  t.server.stack_bytes = options.stack_kib * 1024;
+  t.server.program_budget = options.program_budget;
+  for (const std::string& p : options.params) {
+    const std::size_t dot = p.find('.'), eq = p.find('=');
+    if (dot == std::string::npos || eq == std::string::npos || dot == 0 || eq < dot + 2)
+      throw BadInput("--params " + p + ": write controller.key=value, e.g. --params tag_chaser.lunge=30");
+    const std::string name = p.substr(0, dot), key = p.substr(dot + 1, eq - dot - 1), text = p.substr(eq + 1);
+    nlohmann::json value = nlohmann::json::parse(text, nullptr, false);
+    if (value.is_discarded()) value = text;  // a bare word is a string
+    t.params[name][key] = value;
+  }
 
   // Opened before the rounds are played, so a bad path costs nothing; renamed into place only
   // when written whole.
@@ -58,6 +85,8 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
   std::printf("%s: %zu rounds of %g s, %zu turtles\n", options.world.c_str(), t.rounds, t.until,
               scene.def.turtles.size());
   std::fputs(world::ranking_table(result).c_str(), stdout);
+  for (const std::string& note : result.notes)
+    if (note.find("do not divide") != std::string::npos) spdlog::warn("{}", note);
   if (json_file) {
     json_file->stream() << world::to_json(result).dump(2) << '\n';
     json_file->commit();

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -19,6 +20,9 @@ struct TagCommandOptions {
   double until = 60.0;
   std::string json_out;
   std::string mode = "exact";
+  std::vector<std::string> params;  ///< "controller.key=value", repeatable
+  std::size_t stack_kib = 32;       ///< each turtle program's stack
+  double program_budget = 2.0;      ///< wall-clock seconds a program may run without a command
 };
 
 /// Adds the `tag` subcommand, its options bound to `options`.

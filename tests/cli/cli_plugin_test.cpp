@@ -1,9 +1,13 @@
 // SPDX-License-Identifier: MIT
 // Controllers loaded from shared-library plugins (`--plugin`), built by CMake with
 // turtlegas_add_plugin: the example of docs/controllers.md, and a busy loop.
+#include <sys/wait.h>
+
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -81,4 +85,133 @@ TEST_CASE("plugins: a file that is not a plugin is bad input") {
   const Result not_plugin = run(dir.path, {"controllers", "--plugin", feeler_world});
   CHECK(not_plugin.code == 2);
   CHECK(contains(not_plugin.err, "--plugin " + feeler_world + ": cannot load it"));
+}
+
+// `turtlegas test` runs each world in a process of its own (the test plugin's misbehaving
+// programs), a few at a time, and reports in JUnit XML and TAP 13.
+namespace {
+
+/// A test world of one turtle running `controller`, passing when the turtle stays in the room.
+std::string one_turtle_test(const std::string& controller) {
+  return R"({"format": "turtlegas-world/1", "arena": {"width": 100, "height": 100, "boundary": "walls"},
+    "turtles": [{"id": "t", "pos": [50, 50], "controller": ")" +
+         controller + R"("}],
+    "expect": [{"until": 5}, {"inside": [[0, 0], [100, 100]], "who": "*"}]})";
+}
+
+/// Runs python3 on `script` with `arg`; its exit code (0: the script's checks held).
+int python(const TempDir& dir, const std::string& script, const std::string& arg) {
+  const fs::path py = dir.write("check.py", script);
+  const std::string cmd = "python3 " + quote(py.string()) + " " + quote(arg) + " >" +
+                          quote((dir.path / "py.txt").string()) + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+TEST_CASE("test: a crash, an abort and an exit fail their own world by name; the others go on") {
+  TempDir dir;
+  std::vector<std::string> args = {"test"};
+  for (const char* c : {"chatty", "segfaulter", "aborter", "exiter", "back_and_forth"}) {
+    const std::string name = std::string(c) + ".json";
+    dir.write(name, one_turtle_test(c == std::string("back_and_forth") ? "chatty" : c));
+    args.push_back((dir.path / name).string());
+  }
+  args.insert(args.end(), {"--jobs", "2", "--plugin", TEST_PLUGIN});
+  const Result r = run(dir.path, args);
+  INFO(r.out << r.err);
+  CHECK(r.code == 1);
+  // In the order given, whatever order the processes end in.
+  const std::size_t chatty = r.out.find("PASS " + (dir.path / "chatty.json").string());
+  const std::size_t seg = r.out.find("FAIL " + (dir.path / "segfaulter.json").string() + ": its process ended");
+  const std::size_t abrt = r.out.find("FAIL " + (dir.path / "aborter.json").string() + ": its process ended");
+  const std::size_t ex = r.out.find("FAIL " + (dir.path / "exiter.json").string() + ": its process ended");
+  const std::size_t last = r.out.find("PASS " + (dir.path / "back_and_forth.json").string());
+  REQUIRE(chatty != std::string::npos);
+  REQUIRE(seg != std::string::npos);
+  REQUIRE(abrt != std::string::npos);
+  REQUIRE(ex != std::string::npos);
+  REQUIRE(last != std::string::npos);
+  CHECK((chatty < seg && seg < abrt && abrt < ex && ex < last));
+  CHECK(contains(r.out, "exit code 7"));
+#if !defined(__SANITIZE_ADDRESS__)  // AddressSanitizer turns the fault into its own report and exit
+  CHECK(contains(r.out, "killed by signal 11"));
+  CHECK(contains(r.out, "killed by signal 6"));
+#endif
+  CHECK(contains(r.out, "2 passed, 3 failed, 0 could not run"));
+  // The passing worlds' log lines come through on stderr.
+  CHECK(contains(r.err, "hello from chatty"));
+}
+
+TEST_CASE("test: --timeout kills a hung world; --quiet drops the log lines; --tap is TAP 13") {
+  TempDir dir;
+  const fs::path spin = dir.write("spinner.json", one_turtle_test("spinner"));
+  const fs::path chatty = dir.write("chatty.json", one_turtle_test("chatty"));
+  // A program budget far past the timeout: only --timeout can stop the busy loop.
+  const Result r = run(dir.path, {"test", spin.string(), chatty.string(), "--timeout", "1", "--program-budget", "600",
+                                  "--plugin", TEST_PLUGIN, "--quiet", "--tap", "--jobs", "2"});
+  INFO(r.out << r.err);
+  CHECK(r.code == 1);
+  CHECK(r.out.rfind("TAP version 13\n1..2\n", 0) == 0);
+  CHECK(contains(r.out, "not ok 1 - " + spin.string() + "\n  ---\n  message: \"still running after --timeout 1 s; killed\""));
+  CHECK(contains(r.out, "  severity: fail\n"));
+  CHECK(contains(r.out, "ok 2 - " + chatty.string() + " (1 assertion"));
+  CHECK(contains(r.out, "# 1 passed, 1 failed, 0 could not run"));
+  CHECK_FALSE(contains(r.err, "hello from chatty"));
+}
+
+TEST_CASE("test: --junit writes JUnit XML that python3's xml parser reads, one testcase per world") {
+  TempDir dir;
+  const fs::path chatty = dir.write("chatty.json", one_turtle_test("chatty"));
+  const fs::path seg = dir.write("seg.json", one_turtle_test("segfaulter"));
+  const fs::path broken = dir.write("broken.json", R"({"format": "turtlegas-world/1", "bals": []})");
+  const fs::path xml = dir.path / "report.xml";
+  const Result r = run(dir.path, {"test", chatty.string(), seg.string(), broken.string(), "--plugin", TEST_PLUGIN,
+                                  "--junit", xml.string()});
+  INFO(r.out << r.err);
+  CHECK(r.code == 2);  // a world that cannot run outranks a failure
+  REQUIRE(fs::exists(xml));
+  const std::string script = R"(import sys, xml.etree.ElementTree as ET
+root = ET.parse(sys.argv[1]).getroot()
+assert root.tag == "testsuites", root.tag
+suites = root.findall("testsuite")
+assert len(suites) == 1
+s = suites[0]
+assert (s.get("tests"), s.get("failures"), s.get("errors")) == ("3", "1", "1"), s.attrib
+cases = s.findall("testcase")
+assert [c.get("name").rsplit("/", 1)[-1] for c in cases] == ["chatty.json", "seg.json", "broken.json"]
+for c in cases:
+    float(c.get("time"))
+assert cases[0].find("failure") is None and cases[0].find("error") is None
+assert "hello from chatty & <friends>" in cases[0].find("system-err").text
+f = cases[1].find("failure")
+assert f is not None and "its process ended without a result" in f.get("message"), f
+e = cases[2].find("error")
+assert e is not None and "unknown key" in e.get("message"), e
+print("ok")
+)";
+  CHECK(python(dir, script, xml.string()) == 0);
+  INFO(read(dir.path / "py.txt"));
+  CHECK(contains(read(dir.path / "py.txt"), "ok"));
+}
+
+TEST_CASE("test: numeric options out of range are bad input") {
+  TempDir dir;
+  const fs::path chatty = dir.write("chatty.json", one_turtle_test("chatty"));
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"--jobs", "0"}, "--jobs must be from 1 to 1024 (got 0)"},
+      {{"--timeout", "-1"}, "--timeout must be a finite time >= 0"},
+      {{"--timeout", "nan"}, "--timeout must be a finite time >= 0"},
+      {{"--stack-kib", "4"}, "--stack-kib must be from 16 to 1048576 (got 4)"},
+      {{"--program-budget", "0"}, "--program-budget must be a finite time > 0"},
+  };
+  for (const auto& [opts, message] : cases) {
+    std::vector<std::string> args = {"test", chatty.string(), "--plugin", TEST_PLUGIN};
+    args.insert(args.end(), opts.begin(), opts.end());
+    const Result r = run(dir.path, args);
+    INFO(opts.front() << ": " << r.err);
+    CHECK(r.code == 2);
+    CHECK(contains(r.err, message));
+  }
 }

@@ -2,6 +2,7 @@
 // `turtlegas tag` as a user runs it: the table, the JSON, determinism and bad input.
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -37,7 +38,7 @@ TEST_CASE("turtlegas tag prints a ranking and writes it as JSON, the same every 
 
   const Result bad = run(dir, {"tag", "worlds/tag.json", "--controllers", "tag_chaser,wandr"});
   CHECK(bad.code == 2);
-  CHECK(bad.err.find("--controllers: controller 'wandr' is not registered; known: script, ") != std::string::npos);
+  CHECK(bad.err.find("--controllers: controller 'wandr' is not registered; known: mirror, script, ") != std::string::npos);
   CHECK(bad.err.find("wander; did you mean 'wander'?") != std::string::npos);
   const Result missing = run(dir, {"tag", "worlds/nope.json", "--controllers", "tag_chaser"});
   CHECK(missing.code == 2);
@@ -61,6 +62,38 @@ TEST_CASE("turtlegas tag --json checks its path before playing, and leaves no fi
   for (const auto& entry : fs::directory_iterator(dir)) {  // only run()'s captures of the output
     const std::string name = entry.path().filename().string();
     CHECK((name == "stdout.txt" || name == "stderr.txt"));
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("turtlegas tag: intervals, the pairwise table, notes, --params and range checks", "[cli][tag]") {
+  const fs::path dir = fs::temp_directory_path() / ("turtlegas-cli-tag-stats-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const Result r = run(dir, {"tag", "worlds/tag.json", "--controllers", "tag_chaser,tag_evader", "--rounds", "5",
+                             "--until", "10", "--params", "tag_chaser.lunge=25", "--params", "tag_evader.flee=true",
+                             "--stack-kib", "64", "--program-budget", "5"});
+  INFO(r.out << r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("+/- 95%") != std::string::npos);
+  CHECK(r.out.find("row minus column") != std::string::npos);
+  // 5 rounds, 2 controllers: a warning on stderr, and the note under the table.
+  CHECK(r.err.find("5 rounds do not divide among 2 controllers") != std::string::npos);
+  CHECK(r.out.find("note: 5 rounds do not divide") != std::string::npos);
+  const std::vector<std::pair<std::vector<std::string>, std::string>> bad = {
+      {{"--params", "lunge=25"}, "--params lunge=25: write controller.key=value"},
+      {{"--params", "wander.step=3"}, "'wander' is not one of --controllers"},
+      {{"--stack-kib", "8"}, "--stack-kib must be from 16"},
+      {{"--program-budget", "-1"}, "--program-budget must be a finite time > 0"},
+      {{"--rounds", "0"}, "--rounds must be from 1"},
+      {{"--until", "0"}, "--until must be a finite time > 0"},
+  };
+  for (const auto& [extra, message] : bad) {
+    std::vector<std::string> args = {"tag", "worlds/tag.json", "--controllers", "tag_chaser,tag_evader"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const Result b = run(dir, args);
+    INFO(extra.front() << ": " << b.err);
+    CHECK(b.code == 2);
+    CHECK(b.err.find(message) != std::string::npos);
   }
   fs::remove_all(dir);
 }

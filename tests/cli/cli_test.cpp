@@ -110,6 +110,49 @@ TEST_CASE("cli: check") {
   CHECK(shipped.code == 0);
 }
 
+TEST_CASE("cli: check takes many files, goes on past a bad one, and counts them") {
+  TempDir dir;
+  const fs::path good = dir.write("box.json", box_world);
+  const fs::path bad = dir.write("bad.json", R"({"format": "turtlegas-world/1", "bals": []})");
+  const std::string gas = std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/gas.json";
+  const Result all_good = run(dir, {"check", good.string(), gas});
+  INFO(all_good.err);
+  CHECK(all_good.code == 0);
+  CHECK(contains(all_good.out, "box.json: ok"));
+  CHECK(contains(all_good.out, "gas.json: ok"));
+  CHECK(contains(all_good.out, "2 of 2 world files ok"));
+  // The bad file in the middle: reported on stderr, the one after it still checked, exit 2.
+  const Result one_bad = run(dir, {"check", good.string(), bad.string(), gas});
+  CHECK(one_bad.code == 2);
+  CHECK(contains(one_bad.err, "bad.json: /bals: unknown key \"bals\""));
+  CHECK(contains(one_bad.out, "gas.json: ok"));
+  CHECK(contains(one_bad.out, "2 of 3 world files ok"));
+  const Result missing = run(dir, {"check", (dir.path / "nope.json").string(), good.string()});
+  CHECK(missing.code == 2);
+  CHECK(contains(missing.err, "nope.json: no such file"));
+  CHECK(contains(missing.out, "1 of 2 world files ok"));
+}
+
+TEST_CASE("cli: --version names the version, the commit, the build type and the compiler") {
+  TempDir dir;
+  const Result r = run(dir, {"--version"});
+  INFO(r.err);
+  CHECK(r.code == 0);
+  const std::string first = r.out.substr(0, r.out.find('\n'));
+  CHECK(first == "turtlegas 0.1.0");
+  CHECK(contains(r.out, "\ncommit "));
+  CHECK_FALSE(contains(r.out, "commit \n"));
+  CHECK(contains(r.out, "\nbuild "));
+#if defined(__GNUC__) && !defined(__clang__)
+  CHECK(contains(r.out, "GNU " + std::to_string(__GNUC__) + "."));
+#endif
+#if defined(NDEBUG)
+  CHECK(contains(r.out, "build Release"));
+#else
+  CHECK(contains(r.out, "build Debug"));
+#endif
+}
+
 TEST_CASE("cli: a run writes events, state and stats") {
   TempDir dir;
   const fs::path w = dir.write("box.json", box_world);
@@ -323,7 +366,7 @@ TEST_CASE("cli: turtle input errors exit with 2 and say why") {
       const Result r = command == std::string("run") ? run(dir, {"run", w.string(), "--until", "1"})
                                                      : run(dir, {"check", w.string()});
       CHECK(r.code == 2);
-      CHECK(contains(r.err, w.string() + ": /turtles/1/controller: controller 'wandr' is not registered; known: script, "
+      CHECK(contains(r.err, w.string() + ": /turtles/1/controller: controller 'wandr' is not registered; known: mirror, script, "
                                          "spiral, square, tag_chaser, tag_evader, tag_random, wall_follower, wander; "
                                          "did you mean 'wander'?"));
     }

@@ -6,6 +6,8 @@
 //   big_frame  calls a function with a 200 KiB local array (a frame far larger than the guard page)
 //   bad_amount forward(NaN) or right(inf), as params.call says
 //   crasher    after params.after seconds: a null dereference, abort() or exit(7) (params.how)
+//   segfaulter, aborter, exiter: drive a little, then crash in that way (`turtlegas test` fails that world)
+//   chatty     logs a line, then drives back and forth (a passing world with a log)
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -29,7 +31,15 @@ using turtlegas::turtle::Turtle;
 
 }  // namespace
 
+namespace {
+
+int* volatile g_nowhere = nullptr;
+
+}  // namespace
+
 extern "C" void turtlegas_register(turtlegas::turtle::Registry& registry) {
+  using turtlegas::turtle::Params;
+  using turtlegas::turtle::Turtle;
   registry.add(
       "spinner",
       [](Turtle& t, const Params&) {
@@ -73,7 +83,7 @@ extern "C" void turtlegas_register(turtlegas::turtle::Registry& registry) {
         t.wait(p.get("after", 0.5));
         const std::string how = p.get<std::string>("how", "null");
         if (how == "null") {
-          volatile int* volatile nowhere = nullptr;
+          volatile int* volatile g_nowhere = nullptr;
           *nowhere = 1;
         }
         if (how == "abort") std::abort();
@@ -81,4 +91,35 @@ extern "C" void turtlegas_register(turtlegas::turtle::Registry& registry) {
         t.forward(10);
       },
       "crashes the process after a while, for tests");
+  registry.add(
+      "segfaulter",
+      [](Turtle& t, const Params&) {
+        t.forward(10);
+        *g_nowhere = 1;
+      },
+      "a crash, for tests");
+  registry.add(
+      "aborter",
+      [](Turtle& t, const Params&) {
+        t.forward(10);
+        std::abort();
+      },
+      "std::abort(), for tests");
+  registry.add(
+      "exiter",
+      [](Turtle& t, const Params&) {
+        t.forward(10);
+        std::exit(7);
+      },
+      "std::exit(7), for tests");
+  registry.add(
+      "chatty",
+      [](Turtle& t, const Params&) {
+        t.log("hello from chatty & <friends>");
+        for (;;) {
+          t.forward(10);
+          t.back(10);
+        }
+      },
+      "a log line, then back and forth, for tests");
 }

@@ -195,3 +195,42 @@ TEST_CASE("a tag game must name a turtle as it", "[runtime][tag]") {
   WorldServer s(d, {script("[]"), script("[]")}, base_registry());
   CHECK_THROWS_WITH(s.set_game(std::make_unique<TagGame>(TagRules{"t9", 2.0})), Catch::Contains("'t9'"));
 }
+
+TEST_CASE("a player reads the game's rules, its radius, speed and turn rate, and dt", "[runtime][tag]") {
+  sim::WorldDef d = arena();
+  d.dt = 0.05;
+  d.turtles.push_back(body("t1", {100, 200}, 90));
+  d.turtles.push_back(body("t2", {300, 200}, 90));
+  d.turtles[1].radius = 7.5;
+  d.turtles[1].speed = 42.0;
+  d.turtles[1].turn_rate = M_PI;  // 180 degrees/s
+  nlohmann::json seen;
+  Registry r = base_registry();
+  r.add("reader", [&seen](Turtle& t, const Params&) {
+    seen = {{"rules", t.game_rules()}, {"radius", t.radius()}, {"speed", t.speed()}, {"turn_rate", t.turn_rate()},
+            {"dt", t.dt()}};
+    // The same through a mirror: none of these is reflected.
+    const Turtle m = t.mirrored();
+    seen["mirror_same"] = m.radius() == t.radius() && m.speed() == t.speed() && m.dt() == t.dt() &&
+                          m.game_rules() == t.game_rules();
+    t.wait(100);
+  });
+  TurtleProgram reader;
+  reader.controller = "reader";
+  SECTION("in a tag game") {
+    WorldServer s(d, {script(R"([["wait", 100]])"), reader}, r);
+    s.set_game(std::make_unique<TagGame>(TagRules{"t1", 3.25}));
+    s.run_until(0.2);
+    CHECK(seen.at("rules") == nlohmann::json{{"kind", "tag"}, {"no_tag_back", 3.25}});
+    CHECK(seen.at("radius") == 7.5);
+    CHECK(seen.at("speed") == 42.0);
+    CHECK(seen.at("turn_rate").get<double>() == Approx(180.0).epsilon(1e-15));
+    CHECK(seen.at("dt") == 0.05);
+    CHECK(seen.at("mirror_same") == true);
+  }
+  SECTION("without a game") {
+    WorldServer s(d, {script(R"([["wait", 100]])"), reader}, r);
+    s.run_until(0.2);
+    CHECK(seen.at("rules") == nlohmann::json::object());
+  }
+}

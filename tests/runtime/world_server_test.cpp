@@ -301,15 +301,15 @@ TEST_CASE("an unknown controller names the known ones", "[runtime]") {
   sim::WorldDef d = arena();
   d.turtles.push_back(body("t", {100, 100}, 0));
   CHECK_THROWS_WITH(WorldServer(d, {program("wandr")}, base_registry()),
-                    Catch::Equals("turtle 't': controller 'wandr' is not registered; known: script"));
+                    Catch::Equals("turtle 't': controller 'wandr' is not registered; known: mirror, script"));
   // A close misspelling of a registered name is suggested (fewer than 3 edits), a far one not.
   Registry r = base_registry();
   r.add("wander", [](Turtle&, const Params&) {});
-  CHECK(r.not_registered("wandr") == "controller 'wandr' is not registered; known: script, wander; did you mean 'wander'?");
-  CHECK(r.not_registered("scirpt") == "controller 'scirpt' is not registered; known: script, wander; did you mean 'script'?");
-  CHECK(r.not_registered("spiral") == "controller 'spiral' is not registered; known: script, wander");
+  CHECK(r.not_registered("wandr") == "controller 'wandr' is not registered; known: mirror, script, wander; did you mean 'wander'?");
+  CHECK(r.not_registered("scirpt") == "controller 'scirpt' is not registered; known: mirror, script, wander; did you mean 'script'?");
+  CHECK(r.not_registered("spiral") == "controller 'spiral' is not registered; known: mirror, script, wander");
   CHECK_THROWS_WITH(r.require("wandr", "--controllers"),
-                    "--controllers: controller 'wandr' is not registered; known: script, wander; did you mean 'wander'?");
+                    "--controllers: controller 'wandr' is not registered; known: mirror, script, wander; did you mean 'wander'?");
   CHECK_NOTHROW(r.require("wander"));
 }
 

@@ -2,7 +2,9 @@
 // The world file's `game` key, worlds/tag.json and tag tournaments.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/turtle/tag_game.hpp"
@@ -104,13 +106,17 @@ TEST_CASE("a tag tournament is deterministic and reports every field", "[world][
   std::size_t turtle_rounds = 0;
   for (std::size_t k = 0; k < 3; ++k) {
     const auto& row = j.at("ranking")[k];
-    for (const char* key : {"rank", "controller", "rounds", "mean_time_it", "tags", "tags_per_round", "starts_it", "faults"})
+    for (const char* key : {"rank", "controller", "rounds", "turtle_rounds", "mean_time_it", "time_it_ci95", "tags",
+                            "tags_per_round", "tags_per_round_ci95", "starts_it", "faults"})
       CHECK(row.contains(key));
     CHECK(row.at("rank") == k + 1);
     if (k > 0) CHECK(row.at("mean_time_it").get<double>() >= j.at("ranking")[k - 1].at("mean_time_it").get<double>());
-    turtle_rounds += row.at("rounds").get<std::size_t>();
+    CHECK(row.at("rounds") == 6);  // rounds per controller: 5 turtles, 3 controllers, each plays every round
+    turtle_rounds += row.at("turtle_rounds").get<std::size_t>();
   }
   CHECK(turtle_rounds == 6 * scene.def.turtles.size());
+  CHECK(j.at("pairwise").size() == 3);
+  CHECK(j.contains("method"));
   REQUIRE(j.at("round_results").size() == 6);
   for (std::size_t r = 0; r < 6; ++r) {
     const auto& round = j.at("round_results")[r];
@@ -127,4 +133,73 @@ TEST_CASE("a tag tournament is deterministic and reports every field", "[world][
   options.controllers = {"tag_chaser", "nobody"};
   CHECK_THROWS_WITH(tw::run_tag_tournament(scene, "worlds/tag.json", options, registry),
                     Catch::Contains("controller 'nobody' is not registered; known: "));
+}
+
+TEST_CASE("t quantiles: the table and the expansion beyond it", "[world][tag]") {
+  CHECK(tw::t_quantile_975(1) == Approx(12.706204736).epsilon(1e-9));
+  CHECK(tw::t_quantile_975(5) == Approx(2.570581836).epsilon(1e-9));
+  CHECK(tw::t_quantile_975(5.7) == tw::t_quantile_975(5));  // fractional df rounded down: wider
+  // Beyond the table (reference values from the t distribution's quantile function).
+  CHECK(tw::t_quantile_975(31) == Approx(2.039513446).epsilon(2e-7));
+  CHECK(tw::t_quantile_975(60) == Approx(2.000297822).epsilon(1e-7));
+  CHECK(tw::t_quantile_975(120) == Approx(1.979930405).epsilon(1e-8));
+  CHECK(tw::t_quantile_975(1e6) == Approx(1.959966).epsilon(1e-6));
+  CHECK_THROWS(tw::t_quantile_975(0.5));
+}
+
+TEST_CASE("a tournament's intervals are t-intervals over the rounds each controller played", "[world][tag]") {
+  const tt::Registry registry = turtlegas::controllers::builtin_registry();
+  const tw::Scene scene = tw::load_scene("worlds/tag.json", registry);
+  tw::TournamentOptions options;
+  options.controllers = {"tag_chaser", "tag_evader", "tag_random"};
+  options.rounds = 12;
+  options.until = 20.0;
+  const tw::TournamentResult a = tw::run_tag_tournament(scene, "worlds/tag.json", options, registry);
+  // Recomputed here from the rounds: per round, the mean over the controller's turtles.
+  for (const tw::TournamentRow& row : a.ranking) {
+    INFO(row.controller);
+    std::vector<double> x;
+    for (const auto& r : a.rounds) {
+      double sum = 0;
+      int n = 0;
+      for (std::size_t i = 0; i < r.controllers.size(); ++i)
+        if (r.controllers[i] == row.controller) sum += r.score.time_it[i], ++n;
+      if (n > 0) x.push_back(sum / n);
+    }
+    REQUIRE(x.size() == 12);
+    CHECK(row.rounds == 12);
+    CHECK(row.starts_it == 4);  // 12 rounds, 3 controllers: each starts as "it" 4 times
+    double m = 0;
+    for (double v : x) m += v;
+    m /= 12;
+    double ss = 0;
+    for (double v : x) ss += (v - m) * (v - m);
+    const double hw = 2.200985160 * std::sqrt(ss / 11) / std::sqrt(12.0);  // t(0.975, 11)
+    CHECK(row.mean_time_it == Approx(m).epsilon(1e-12));
+    CHECK(row.time_it.half_width == Approx(hw).epsilon(1e-9));
+  }
+  CHECK(a.notes.size() <= 2);
+  for (const std::string& n : a.notes) CHECK_THAT(n, Catch::Contains("cannot be told apart at 95 %"));
+  for (const tw::Comparison& c : a.pairwise) {
+    CHECK(c.significant == (std::abs(c.difference.mean) > c.difference.half_width));
+    CHECK(c.difference.half_width > 0);
+  }
+
+  // Rounds that do not divide among the controllers: a note says the starts are unbalanced.
+  options.rounds = 4;
+  const tw::TournamentResult b = tw::run_tag_tournament(scene, "worlds/tag.json", options, registry);
+  REQUIRE(!b.notes.empty());
+  CHECK_THAT(b.notes.front(), Catch::Contains("4 rounds do not divide among 3 controllers"));
+  CHECK_THAT(tw::ranking_table(b), Catch::Contains("note: 4 rounds do not divide"));
+
+  // --params: a controller's param on every turtle it drives changes the play; an unknown
+  // controller there is an error.
+  options.rounds = 3;
+  const tw::TournamentResult plain = tw::run_tag_tournament(scene, "worlds/tag.json", options, registry);
+  options.params["tag_random"] = {{"leg", 5.0}};
+  const tw::TournamentResult short_legs = tw::run_tag_tournament(scene, "worlds/tag.json", options, registry);
+  CHECK(tw::to_json(plain).at("round_results") != tw::to_json(short_legs).at("round_results"));
+  options.params["wander"] = nlohmann::json::object();
+  CHECK_THROWS_WITH(tw::run_tag_tournament(scene, "worlds/tag.json", options, registry),
+                    Catch::Contains("--params wander.*: 'wander' is not one of --controllers"));
 }

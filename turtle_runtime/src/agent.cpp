@@ -104,27 +104,28 @@ namespace {
 }  // namespace
 
 // Negative amounts are directions: forward(-d) is back(d) and right(-a) is left(a), as in Logo
-// and in the script controller; a wait cannot be negative.
+// and in the script controller; a wait cannot be negative. Through a mirror, a right turn is a
+// left one (negated exactly, so that mirror twins stay exact).
 Result Turtle::forward(double distance) {
   if (!std::isfinite(distance)) [[unlikely]] bad_amount(*agent_, "forward", distance, "the distance must be a finite number of units");
-  return agent_->issue({sim::TurtleCommand::Kind::move, distance});
+  return seen(agent_->issue({sim::TurtleCommand::Kind::move, distance}));
 }
 Result Turtle::back(double distance) {
   if (!std::isfinite(distance)) [[unlikely]] bad_amount(*agent_, "back", distance, "the distance must be a finite number of units");
-  return agent_->issue({sim::TurtleCommand::Kind::move, -distance});
+  return seen(agent_->issue({sim::TurtleCommand::Kind::move, -distance}));
 }
 Result Turtle::right(double degrees) {
   if (!std::isfinite(degrees)) [[unlikely]] bad_amount(*agent_, "right", degrees, "the angle must be a finite number of degrees");
-  return agent_->issue({sim::TurtleCommand::Kind::turn, sim::to_radians(degrees)});
+  return seen(agent_->issue({sim::TurtleCommand::Kind::turn, sim::to_radians(mirror_.on ? -degrees : degrees)}));
 }
 Result Turtle::left(double degrees) {
   if (!std::isfinite(degrees)) [[unlikely]] bad_amount(*agent_, "left", degrees, "the angle must be a finite number of degrees");
-  return agent_->issue({sim::TurtleCommand::Kind::turn, sim::to_radians(-degrees)});
+  return seen(agent_->issue({sim::TurtleCommand::Kind::turn, sim::to_radians(mirror_.on ? degrees : -degrees)}));
 }
 Result Turtle::wait(double seconds) {
   if (!(seconds >= 0.0 && std::isfinite(seconds))) [[unlikely]]
     bad_amount(*agent_, "wait", seconds, "the time must be a finite number of seconds >= 0");
-  return agent_->issue({sim::TurtleCommand::Kind::wait, seconds});
+  return seen(agent_->issue({sim::TurtleCommand::Kind::wait, seconds}));
 }
 void Turtle::yield() { agent_->issue({sim::TurtleCommand::Kind::stop, 0.0}); }
 void Turtle::pen_up() { agent_->pen_down = false; }
@@ -139,19 +140,44 @@ void Turtle::pen_down(PenMode mode) {
 }
 PenMode Turtle::pen_mode() const { return agent_->pen_mode; }
 bool Turtle::pen_is_down() const { return agent_->pen_down; }
-void Turtle::on_touch(std::function<void(const Touch&)> handler) { agent_->handler = std::move(handler); }
+void Turtle::on_touch(std::function<void(const Touch&)> handler) {
+  if (mirror_.on && handler) {
+    agent_->handler = [h = std::move(handler), agent = agent_](const Touch& t) { h(reflected(t, *agent)); };
+  } else {
+    agent_->handler = std::move(handler);
+  }
+}
 void Turtle::on_message(std::function<void(const Message&)> handler) { agent_->message_handler = std::move(handler); }
 bool Turtle::it() const { return agent_->it; }
 double Turtle::odometer() const { return agent_->odometer; }
-double Turtle::heading() const { return sim::wrap_degrees(sim::to_degrees(agent_->server->world.turtle(agent_->index).heading)); }
+double Turtle::heading() const {
+  const double h = sim::to_degrees(agent_->server->world.turtle(agent_->index).heading);
+  return sim::wrap_degrees(mirror_.on ? 2.0 * mirror_.axis - h : h);
+}
 std::optional<sim::Vec2> Turtle::position() const {
   if (!agent_->program.gps) return std::nullopt;
-  return agent_->server->world.turtle(agent_->index).pos;
+  const sim::Vec2 p = agent_->server->world.turtle(agent_->index).pos;
+  if (!mirror_.on) return p;
+  if (!mirror_.through) return std::nullopt;
+  // Reflected across the line through `through` along the axis: p' = 2 (foot of p) - p.
+  const double a = sim::to_radians(mirror_.axis);
+  const sim::Vec2 d{std::sin(a), std::cos(a)};
+  const sim::Vec2 q = p - *mirror_.through;
+  const double along = q.x * d.x + q.y * d.y;
+  return sim::Vec2{mirror_.through->x + 2.0 * along * d.x - q.x, mirror_.through->y + 2.0 * along * d.y - q.y};
 }
 double Turtle::time() const { return agent_->server->world.time(); }
 const std::string& Turtle::id() const { return agent_->id; }
 double Turtle::uniform() { return static_cast<double>(agent_->rng() >> 11) * 0x1.0p-53; }
 void Turtle::log(const std::string& message) { spdlog::info("turtle '{}' t={:.6g}: {}", agent_->id, time(), message); }
+
+double Turtle::radius() const { return agent_->server->def.turtles[agent_->index].radius; }
+double Turtle::speed() const { return agent_->server->def.turtles[agent_->index].speed; }
+double Turtle::turn_rate() const { return sim::to_degrees(agent_->server->def.turtles[agent_->index].turn_rate); }
+double Turtle::dt() const { return agent_->server->def.dt; }
+nlohmann::json Turtle::game_rules() const {
+  return agent_->server->game ? agent_->server->game->rules_for_players() : nlohmann::json::object();
+}
 
 std::vector<Touch> Turtle::touching() const {
   // Contacts in force, with their sensors worked out for the heading the turtle has now.
@@ -160,7 +186,36 @@ std::vector<Touch> Turtle::touching() const {
   for (const sim::TurtleContact& c : agent_->in_contact)
     out.push_back(detail::make_touch(c, heading_deg, agent_->program.sensors, agent_->sensor_names,
                                      agent_->server->other_id(c.kind, c.other)));
+  if (mirror_.on)
+    for (Touch& t : out) t = reflected(t, *agent_);
   return out;
+}
+
+Turtle Turtle::mirrored(double axis_degrees, std::optional<sim::Vec2> through) const {
+  if (!std::isfinite(axis_degrees) || (through && (!std::isfinite(through->x) || !std::isfinite(through->y))))
+    throw std::invalid_argument("Turtle::mirrored: the mirror line's heading and point must be finite numbers");
+  Turtle m = *this;
+  if (!mirror_.on) {
+    m.mirror_ = {true, axis_degrees, through};
+    return m;
+  }
+  // Lines of headings a and a + 180 are the same line.
+  if (std::remainder(axis_degrees - mirror_.axis, 180.0) != 0.0)
+    throw std::invalid_argument("Turtle::mirrored: a mirrored turtle mirrored across another line is a rotation, not a mirror");
+  m.mirror_ = {};
+  return m;
+}
+
+Touch Turtle::reflected(const Touch& t, const Agent& agent) {
+  Touch r = t;
+  r.bearing = t.bearing == 0.0 ? 0.0 : 360.0 - t.bearing;  // t.bearing is in [0, 360)
+  r.sensors = detail::sensors_for(agent.program.sensors, r.bearing);
+  return r;
+}
+
+Result Turtle::seen(Result r) const {
+  if (!mirror_.on || !r.touched()) return r;
+  return Result(r.done(), reflected(r.touch(), *agent_));
 }
 
 }  // namespace turtlegas::turtle

@@ -10,6 +10,8 @@
 #include "turtlegas/sim/format.hpp"
 #include "turtlegas/sim/suggest.hpp"
 
+#include "mirror_controller.hpp"
+
 namespace turtlegas::turtle {
 namespace {
 
@@ -199,6 +201,8 @@ Registry base_registry() {
   // A script's place is its command index and the time: re-running it from the start replays it.
   script.restartable = true;
   r.add("script", script_controller, std::move(script));
+  r.add("mirror", detail::mirror_controller,
+        "runs another controller as its mirror image (of, params, axis, through, twin: share its random stream)");
   return r;
 }
 

@@ -9,11 +9,13 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <spdlog/spdlog.h>
 
 #include "agent.hpp"
 #include "fiber.hpp"
+#include "mirror_controller.hpp"
 #include "server_impl.hpp"
 #include "turtlegas/sim/angles.hpp"
 #include "turtlegas/turtle/event_names.hpp"
@@ -83,6 +85,13 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
     const Controller* controller = a->remote ? nullptr : registry.find(a->program.controller);
     if (!controller && !a->remote)  // Registry::require's message; its context built only when it is needed
       throw std::invalid_argument("turtle '" + a->id + "': " + registry.not_registered(a->program.controller));
+    Controller composed;  // a mirror: the controller it mirrors, through Turtle::mirrored
+    if (a->program.controller == "mirror") {
+      std::vector<std::string> ids;
+      for (const auto& t : def.turtles) ids.push_back(t.id);
+      composed = detail::compose_mirror(registry, a->program.params, a->id, ids);
+      controller = &composed;
+    }
     if (a->program.sensors.empty() || a->program.sensors.size() > 64)
       throw std::invalid_argument("turtle '" + a->id + "' needs 1 to 64 sensors (has " +
                                   std::to_string(a->program.sensors.size()) + ")");
@@ -99,7 +108,9 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
       a->pen_mode = PenMode::wall;
     }
     if (a->pen_down) a->trail.push_back(def.turtles[k].pos);
-    a->rng.seed_with(def.seed ^ fnv1a(a->id));
+    // Its own stream, or (a mirror with a twin) the twin's, so that a randomised program has an
+    // exact mirror image.
+    a->rng.seed_with(def.seed ^ fnv1a(detail::stream_owner(a->program.controller, a->program.params, a->id)));
     impl_->agents.push_back(std::move(a));
   }
   impl_->world.set_event_log(&impl_->sim_log);

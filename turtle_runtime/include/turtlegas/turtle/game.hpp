@@ -43,6 +43,8 @@ class Game {
   virtual void referee(double t, std::span<const sim::TurtleContact> contacts, GameHost& host) = 0;
   /// The score so far, at time t (>= the last referee call), as JSON.
   virtual nlohmann::json score(double t) const = 0;
+  /// The rules, as the players may read them (Turtle::game_rules()): a JSON object with "kind".
+  virtual nlohmann::json rules_for_players() const { return nlohmann::json::object(); }
 };
 
 }  // namespace turtlegas::turtle

@@ -42,6 +42,10 @@ class TagGame final : public Game {
   void referee(double t, std::span<const sim::TurtleContact> contacts, GameHost& host) override;
   /// {"kind": "tag", "t", "it", "turtles": [{"id", "time_it", "tags", "tagged"}]}
   nlohmann::json score(double t) const override;
+  /// {"kind": "tag", "no_tag_back": seconds}
+  nlohmann::json rules_for_players() const override {
+    return {{"kind", "tag"}, {"no_tag_back", rules_.no_tag_back}};
+  }
 
   /// The score at time t; time_it sums to t minus the start time.
   TagScore tally(double t) const;

@@ -203,8 +203,40 @@ class Turtle {
   /// A line for the run's log, tagged with the turtle's id.
   void log(const std::string& message);
 
+  /// What a program may plan with, from the world file: the turtle's radius (units), speed
+  /// (units/s) and turn rate (degrees/s), and the world's control step dt (s).
+  double radius() const;
+  double speed() const;
+  double turn_rate() const;
+  double dt() const;
+  /// The rules of the world's game as JSON; {} when the world has no game. The tag game gives
+  /// {"kind": "tag", "no_tag_back": <seconds>}.
+  nlohmann::json game_rules() const;
+
+  /// This turtle seen through a mirror whose line has heading `axis_degrees` (Logo degrees; 0, the
+  /// default, is a vertical line), to run a program as its own mirror image (the `mirror`
+  /// controller). The handle it returns exchanges left and right, and reflects across the line
+  /// the heading (heading() is 2 axis - the real heading), every touch (bearing b seen as 360 - b,
+  /// sensors those of the reflected bearing: Result::touch(), on_touch, touching()) and, when
+  /// `through` names a point of the line, position() (without it a mirrored position() is
+  /// nullopt). Distances, times, messages, the pen and uniform() are the turtle's own. Mirrored
+  /// again across the same line, it is the turtle itself; across another line it throws
+  /// std::invalid_argument (two reflections make a rotation, which is not a mirror).
+  Turtle mirrored(double axis_degrees = 0.0, std::optional<sim::Vec2> through = std::nullopt) const;
+  /// Whether this handle sees the turtle through a mirror (mirrored()).
+  bool is_mirrored() const { return mirror_.on; }
+
  private:
+  struct MirrorView {
+    bool on = false;
+    double axis = 0.0;  ///< the mirror line's heading, degrees
+    std::optional<sim::Vec2> through;
+  };
+  /// A touch as the program behind a mirror sees it.
+  static Touch reflected(const Touch& t, const Agent& agent);
+  Result seen(Result r) const;
   Agent* agent_;
+  MirrorView mirror_;
 };
 
 /// A controller program.
