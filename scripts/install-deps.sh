@@ -8,6 +8,7 @@ packages=(
   nlohmann-json3-dev libspdlog-dev libcli11-dev catch2
   libboost-dev libboost-context-dev
   python3
+  clang libclang-rt-14-dev clang-tidy   # the clang and fuzz presets, scripts/tidy.sh
 )
 
 missing=()
