@@ -37,6 +37,7 @@ LAYERS = {
     "apps": 6,            # the programs (the turtlegas CLI)
     "bench": 7,           # benchmarks and tests see everything, private headers included
     "tests": 7,
+    "fuzz": 7,            # the libFuzzer harnesses, like the tests
 }
 
 # What a controller may include from the layers below it: the controller API and the registry.

@@ -9,6 +9,7 @@ packages=(
   libboost-dev libboost-context-dev
   python3
   dpkg-dev binutils   # the Debian package: cpack (dpkg-shlibdeps), tests/package/deb_test.py (readelf)
+  clang libclang-rt-14-dev clang-tidy   # the clang and fuzz presets, scripts/tidy.sh
 )
 
 missing=()

@@ -501,7 +501,11 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     formats::write_svg(svg_file->stream(), server ? formats::snapshot_of(*server, def) : formats::snapshot_of(world, def));
     svg_file->commit();
   }
-  if (!opt.checkpoint.empty()) write_checkpoint_at(world.time(), stopped.empty() ? "the end of the run" : stopped);
+  // A resumed run stopped while it was still replaying has got no further than its checkpoint:
+  // the checkpoint (perhaps the very file resumed from) is left as it was.
+  const bool short_of_resume = resume && world.time() < resume->t;
+  if (!opt.checkpoint.empty() && !short_of_resume)
+    write_checkpoint_at(world.time(), stopped.empty() ? "the end of the run" : stopped);
   if (opt.stats) print_summary(run, world, scene, server.get());
   if (end.first == Stop::until) return exit_ok;
   spdlog::warn("{}: stopped at t = {} s of {} ({}); the outputs are written up to there{}", opt.world,

@@ -577,3 +577,15 @@ TEST_CASE("robust: a long run on a terminal shows a progress line with events/s 
   CHECK(contains(seen, "events/s"));
   CHECK(contains(seen, "ETA"));
 }
+
+TEST_CASE("robust: a resumed run stopped during its replay leaves the checkpoint as it was") {
+  // Before: the stopped run wrote its own, earlier, checkpoint over the one it was resuming.
+  TempDir dir;
+  const std::string c = (dir.path / "c.json").string(), w = worlds + "gas.json";
+  REQUIRE(run(dir, {"run", w, "--until", "2", "--checkpoint", c}).code == 0);
+  const std::string before = read(c);
+  const Result r = run(dir, {"run", w, "--until", "4", "--resume", c, "--checkpoint", c, "--max-events", "10"});
+  INFO(r.err);
+  CHECK(r.code == 3);
+  CHECK(read(c) == before);
+}

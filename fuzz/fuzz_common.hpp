@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: MIT
+// What the libFuzzer harnesses share: the registry (built-in controllers), and a bounded run of a
+// scene, so that a harness reaches the engine and the runtime, not only the loader, and a slow
+// scene costs a bounded number of events rather than a timeout.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string_view>
+
+#include "turtlegas/controllers/registry.hpp"
+#include "turtlegas/sim/world.hpp"
+#include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/world/scene.hpp"
+
+namespace turtlegas::fuzz {
+
+inline const turtle::Registry& registry() {
+  static const turtle::Registry r = controllers::builtin_registry();
+  return r;
+}
+
+/// Bounds of a fuzzed run: at most this many engine events, this much simulated time, and this
+/// many control steps (a tiny dt would otherwise cost its steps however few events they hold).
+inline constexpr std::uint64_t max_events = 20000;
+inline constexpr double max_time = 5.0;
+inline constexpr double max_steps = 500;
+/// Scenes with more bodies are loaded but not run: a run's cost grows with them (step mode moves
+/// every ball every step), and a large scene reaches nothing a small one does not.
+inline constexpr std::size_t max_bodies = 1000;
+
+/// Runs the scene in `mode` in chunks until one of the bounds; the invariants a run must keep
+/// (no NaN in positions) abort, which libFuzzer reports as a crash.
+inline void bounded_run(const world::Scene& scene, sim::Mode mode) {
+  if (scene.def.balls.size() + scene.def.turtles.size() > max_bodies) return;
+  const double steps = max_time / scene.def.dt;
+  const double until = steps > max_steps ? max_steps * scene.def.dt : max_time;
+  const double chunk = until / 64.0;
+  if (!(chunk > 0.0)) return;
+  auto check = [](const sim::World& w) {
+    for (std::size_t i = 0; i < w.ball_count(); ++i) {
+      const sim::BallState b = w.ball(i);
+      if (b.alive && !(std::isfinite(b.pos.x) && std::isfinite(b.pos.y))) __builtin_trap();
+    }
+  };
+  if (scene.def.turtles.empty()) {
+    sim::WorldDef def = scene.def;
+    sim::World world(std::move(def), mode);
+    for (double t = chunk; t <= until && world.stats().events < max_events; t += chunk) world.advance_to(t);
+    check(world);
+    return;
+  }
+  turtle::ServerOptions options;
+  options.mode = mode;
+  options.program_budget = 1.0;
+  const std::unique_ptr<turtle::WorldServer> server = world::make_server(scene, registry(), options);
+  try {
+    for (double t = chunk; t <= until && server->world().stats().events < max_events; t += chunk) server->run_until(t);
+  } catch (const turtle::BusyLoopError&) {
+    return;  // a controller's own busy loop: the documented end of a run
+  }
+  check(server->world());
+}
+
+}  // namespace turtlegas::fuzz
