@@ -9,6 +9,7 @@ packages=(
   libboost-dev libboost-context-dev
   python3
   dpkg-dev binutils   # the Debian package: cpack (dpkg-shlibdeps), tests/package/deb_test.py (readelf)
+  libopenmpi-dev openmpi-bin   # turtlegas sweep under mpirun (optional at build time; its test runs mpirun)
 )
 
 missing=()
