@@ -447,7 +447,7 @@ int run_local(const SweepOptions& options, const turtle::Registry&, const std::v
   run_children(args, options.jobs, options.timeout, [&](std::size_t i, ChildResult&& r) {
     const std::size_t k = pending[i];
     const json j = json::parse(r.report, nullptr, false);
-    if (r.exited && r.exit_code == 0 && !j.is_discarded() && j.value("run", std::size_t(-1)) == k) {
+    if (!r.timed_out && r.exited && r.exit_code == 0 && !j.is_discarded() && j.value("run", std::size_t(-1)) == k) {
       std::string line = r.report;
       while (!line.empty() && line.back() == '\n') line.pop_back();
       journal.record(line);
@@ -455,7 +455,7 @@ int run_local(const SweepOptions& options, const turtle::Registry&, const std::v
       if (!options.quiet) spdlog::info("sweep: run {} done ({} of {})", k, results.size(), spec.runs);
     } else {
       ++failed;
-      std::string why = r.timed_out ? "killed after --timeout" : r.how_it_ended();
+      std::string why = r.timed_out ? "ran past --timeout" : r.how_it_ended();
       spdlog::error("sweep: run {} failed: {}{}{}", k, why, r.err.empty() ? "" : "\n", r.err);
     }
   });
