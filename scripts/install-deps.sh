@@ -10,6 +10,7 @@ packages=(
   python3
   dpkg-dev binutils   # the Debian package: cpack (dpkg-shlibdeps), tests/package/deb_test.py (readelf)
   clang libclang-rt-14-dev clang-tidy   # the clang and fuzz presets, scripts/tidy.sh
+  libopenmpi-dev openmpi-bin   # turtlegas sweep under mpirun (optional at build time; its test runs mpirun)
 )
 
 missing=()

@@ -184,7 +184,9 @@ void run_children(const std::vector<std::vector<std::string>>& args, std::size_t
         }
         for (int& fd : r.fds) close_fd(fd);
         r.result.seconds = std::chrono::duration<double>(Clock::now() - r.start).count();
-        r.result.timed_out = r.killed;
+        // A child that used up its time fails as timed out even if it ended before the kill came:
+        // under load the parent may look late, and the outcome must not depend on when it looked.
+        r.result.timed_out = r.killed || (timeout_seconds > 0.0 && r.result.seconds >= timeout_seconds);
         if (WIFEXITED(r.status)) {
           r.result.exited = true;
           r.result.exit_code = WEXITSTATUS(r.status);

@@ -30,7 +30,8 @@ std::string self_executable();
 /// Runs `self_executable() args[i]...` for every i, at most `jobs` at once (jobs >= 1), each with
 /// stdin /dev/null, stdout, stderr and descriptor 3 captured, and killed (SIGKILL, its whole
 /// process group) once it has run `timeout_seconds` of wall clock (<= 0: no limit). `on_done(i,
-/// result)` is called in the parent as each child ends, in the order they end. Throws
+/// result)` is called in the parent as each child ends, in the order they end (a child found ended
+/// after its timeout had passed counts as timed out, killed or not). Throws
 /// std::runtime_error when a child cannot be started at all (fork or pipe fail).
 void run_children(const std::vector<std::vector<std::string>>& args, std::size_t jobs, double timeout_seconds,
                   const std::function<void(std::size_t, ChildResult&&)>& on_done);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The turtlegas command-line program: `turtlegas run`, `check`, `controllers`, `test` and `tag`,
+// The turtlegas command-line program: `turtlegas run`, `check`, `controllers`, `test`, `tag` and `sweep`,
 // one file each (see design.md, "Command line", for the contract they keep). This file parses the
 // command line and hands over.
 #include <exception>
@@ -19,6 +19,7 @@
 #include "plugins.hpp"
 #include "run_command.hpp"
 #include "serve_command.hpp"
+#include "sweep_command.hpp"
 #include "tag_command.hpp"
 #include "test_command.hpp"
 #include "version_info.hpp"
@@ -70,6 +71,9 @@ int run(int argc, char** argv) {
   ServeCommandOptions serve_opt;  // `turtlegas serve` (serve_command.hpp)
   CLI::App* serve = add_serve_command(app, serve_opt);
   serve->add_option("--plugin", plugins, plugin_help);
+  SweepOptions sweep_opt;  // `turtlegas sweep` (sweep_command.hpp)
+  CLI::App* sweep = add_sweep_command(app, sweep_opt);
+  sweep->add_option("--plugin", plugins, plugin_help);
 
   try {
     app.parse(argc, argv);
@@ -85,6 +89,7 @@ int run(int argc, char** argv) {
     if (*test) return test_command(test_opt, registry, plugins);
     if (*tag) return run_tag_command(tag_opt, registry);
     if (*serve) return serve_command(serve_opt, registry);
+    if (*sweep) return sweep_command(sweep_opt, registry, plugins);
     return run_command(run_line.options(), registry);
   } catch (const BadInput& e) {
     spdlog::error("{}", e.what());

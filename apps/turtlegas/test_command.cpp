@@ -40,6 +40,7 @@ struct Outcome {
   std::size_t assertions = 0;
   double seconds = 0.0;
   std::string log;      ///< the child's stdout and stderr
+  std::string type = "expect";  ///< JUnit's failure type: expect, crash or timeout
 };
 
 const char* status_word(Outcome::Status s) {
@@ -133,6 +134,7 @@ Outcome outcome_of(const std::string& file, const TestOptions& options, ChildRes
     std::snprintf(msg, sizeof msg, "still running after --timeout %g s; killed", options.timeout);
     o.status = Outcome::Status::fail;
     o.message = msg;
+    o.type = "timeout";
     return o;
   }
   try {
@@ -145,6 +147,7 @@ Outcome outcome_of(const std::string& file, const TestOptions& options, ChildRes
   } catch (const json::exception&) {
     // No report: the world's process crashed, or a program ended it (exit, abort).
     o.status = Outcome::Status::fail;
+    o.type = "crash";
     o.message = "its process ended without a result: " + r.how_it_ended() + " (" + file + " ran in a process of its own)";
     return o;
   }
@@ -223,7 +226,7 @@ std::string junit_xml(const std::vector<std::string>& files, const std::vector<O
     if (o.status != Outcome::Status::pass) {
       const char* tag = o.status == Outcome::Status::fail ? "failure" : "error";
       x += std::string("      <") + tag + " message=\"" + xml_text(o.message) + "\" type=\"" +
-           (o.status == Outcome::Status::fail ? "expect" : "bad-input") + "\">" + xml_text(o.message) + "</" + tag +
+           (o.status == Outcome::Status::fail ? o.type : std::string("bad-input")) + "\">" + xml_text(o.message) + "</" + tag +
            ">\n";
     }
     if (!o.log.empty()) x += "      <system-err>" + xml_text(capped(o.log)) + "</system-err>\n";

@@ -187,6 +187,7 @@ assert cases[0].find("failure") is None and cases[0].find("error") is None
 assert "hello from chatty & <friends>" in cases[0].find("system-err").text
 f = cases[1].find("failure")
 assert f is not None and "its process ended without a result" in f.get("message"), f
+assert f.get("type") == "crash", f.get("type")
 e = cases[2].find("error")
 assert e is not None and "unknown key" in e.get("message"), e
 print("ok")
