@@ -433,11 +433,22 @@ struct Node {
 // positive, negative or monotone without such a fall holds no fall (of the exact g, deeper than the
 // evaluation error) and is dropped; every other node is split, leftmost first, so the first fall is
 // found first. Nodes narrower than 4 eps t_end are decided by their end points' signs alone: a dip
-// missed there is shallower than M_hi (4 eps t_end)^2 / 2. Splits are capped at kMaxSplits (then
-// every node is decided by its ends), so a call costs at most ~kMaxSplits evaluations.
+// missed there is shallower than M_hi (4 eps t_end)^2 / 2.
+//
+// A call stops after kMaxSplits splits, but never by deciding a node on its ends: the nodes are
+// taken leftmost first, so when it stops at node [a, b] every node left of a has been dropped (proven
+// free of a fall) and [t_begin, a] holds none. It returns {kNever, a}: "nothing up to a", and the
+// caller continues from there (toi_field_disc_disc_bracketed re-centres the flights at a; the engine
+// could re-predict there instead). It stops only when a > t_begin, so each call makes progress
+// (a node whose left end is still t_begin can be split only by halving, at most ~50 times down to
+// 4 eps t_end, or trimmed from the right, by a quarter each time: a bounded number of splits).
+// The stack cannot overflow: it holds one right sibling per halving on the path to the current
+// node (a trim replaces a node by one), and a path has at most log2(1 / (4 eps)) = 50 halvings
+// before its nodes are below 4 eps t_end; 160 entries leave room to spare (if it ever were full the
+// call would stop at the node, as above, rather than decide it on its ends).
 constexpr int kMaxSplits = 4000;
 
-double bracketed_search(const PairGap& pg, double t_begin, const PairSample& s_begin, double t_end) {
+PartialToi bracketed_search(const PairGap& pg, double t_begin, const PairSample& s_begin, double t_end) {
   const double A = pg.acc_bound();
   const double h_min = 4.0 * kEps * t_end;
   Node stack[160];
@@ -447,6 +458,7 @@ double bracketed_search(const PairGap& pg, double t_begin, const PairSample& s_b
   constexpr double kInflate = 1.0 + 1e-12;  // the bounds' own rounding
   while (top > 0) {
     const Node nd = stack[--top];
+    if ((splits >= kMaxSplits || top + 2 > 160) && nd.a > t_begin) return {kNever, nd.a};
     const double h = nd.b - nd.a;
     const PairSample& sa = nd.sa;
     const PairSample& sb = nd.sb;
@@ -456,10 +468,12 @@ double bracketed_search(const PairGap& pg, double t_begin, const PairSample& s_b
     const double m_hi = kInflate * (2.0 * V * V + 2.0 * R * A);
     const bool falling = sa.dg + sa.edg + m_hi * h < 0.0 || sb.dg + sb.edg + m_lo * h < 0.0;
     const bool rising = sa.dg - sa.edg - m_lo * h > 0.0 || sb.dg - sb.edg - m_hi * h > 0.0;
-    const bool can_split = h > h_min && splits < kMaxSplits && top + 2 <= 160;
+    const bool can_split = h > h_min && top + 2 <= 160;
     const bool fall_between = sa.g >= 0.0 && sb.g < 0.0;
     auto refine = [&] {
-      return refine_fall_newton([&](double t) { return pg.gap_d(t); }, nd.a, GapD{sa.g, sa.dg}, nd.b, GapD{sb.g, sb.dg});
+      return PartialToi{
+          refine_fall_newton([&](double t) { return pg.gap_d(t); }, nd.a, GapD{sa.g, sa.dg}, nd.b, GapD{sb.g, sb.dg}),
+          t_end};
     };
     if (fall_between && (falling || !can_split)) return refine();
     if (!fall_between && (falling || rising || !can_split)) continue;
@@ -488,7 +502,7 @@ double bracketed_search(const PairGap& pg, double t_begin, const PairSample& s_b
     stack[top++] = {m, nd.b, sm, sb};
     stack[top++] = {nd.a, m, sa, sm};
   }
-  return kNever;
+  return {kNever, t_end};
 }
 
 // The time after which two envelopes are apart for good (the larger root of |dc + du t| = reach,
@@ -543,13 +557,13 @@ double toi_field_disc_disc_rotating(Vec2 r, Vec2 dv, double w, double sigma, dou
 }
 
 // ---- Two discs, any flights --------------------------------------------------------------------
-double toi_field_disc_disc_bracketed(Vec2 r, const FieldFlight& f1, const FieldFlight& f2, double sigma,
-                                     double horizon) {
-  if (!(horizon >= 0.0)) return kNever;
+PartialToi toi_field_disc_disc_partial(Vec2 r, const FieldFlight& f1, const FieldFlight& f2, double sigma,
+                                       double horizon) {
+  if (!(horizon >= 0.0)) return {kNever, horizon};
   {
     const PairGap pg0(r, f1, f2, sigma);
     const PairSample s0 = pg0.sample(0.0);
-    if (s0.g <= 0.0 && (s0.dg < 0.0 || (s0.dg == 0.0 && pg0.curvature0() < 0.0))) return 0.0;
+    if (s0.g <= 0.0 && (s0.dg < 0.0 || (s0.dg == 0.0 && pg0.curvature0() < 0.0))) return {0.0, 0.0};
   }
   // Where both bodies have envelopes, nothing can happen before they can touch nor after they have
   // parted for good: search only in between.
@@ -559,12 +573,37 @@ double toi_field_disc_disc_bracketed(Vec2 r, const FieldFlight& f1, const FieldF
   pg.set_envelopes(e1, e2, sigma);
   if (e1.bounded && e2.bounded) {
     const double part = envelopes_part(e1, e2);
-    if (part < 0.0) return kNever;
+    if (part < 0.0) return {kNever, horizon};
     t_end = std::min(t_end, part);
     t_begin = quiet_time_pair(e1, e2);
   }
-  if (!std::isfinite(t_end) || !(t_begin < t_end)) return kNever;
-  return bracketed_search(pg, t_begin, pg.sample(t_begin), t_end);
+  if (!std::isfinite(t_end) || !(t_begin < t_end)) return {kNever, horizon};
+  PartialToi res = bracketed_search(pg, t_begin, pg.sample(t_begin), t_end);
+  if (res.t == kNever && res.reached >= t_end) res.reached = horizon;  // complete: nothing up to the horizon
+  return res;
+}
+
+double toi_field_disc_disc_bracketed(Vec2 r, const FieldFlight& f1, const FieldFlight& f2, double sigma,
+                                     double horizon) {
+  // One search at a time, each proving [0, reached] free of a contact; a search that stops short
+  // is continued from where it stopped, with both flights re-centred there (positions relative to
+  // each other, so nothing large is added to anything small).
+  // At most kMaxContinuations searches (some 2.6e5 splits): a horizon of very many periods of a
+  // circle that keeps coming near without touching would otherwise cost without bound. Past that
+  // it answers kNever, as it does when the time can no longer advance in double.
+  constexpr int kMaxContinuations = 64;
+  double t0 = 0.0;
+  FieldFlight g1 = f1, g2 = f2;
+  for (int k = 0; k < kMaxContinuations; ++k) {
+    const PartialToi p = toi_field_disc_disc_partial(r, g1, g2, sigma, horizon - t0);
+    if (p.t != kNever) return t0 + p.t;
+    if (!(p.reached < horizon - t0) || !(p.reached > 0.0) || !(t0 + p.reached > t0)) return kNever;
+    r += field_displacement(g2, p.reached) - field_displacement(g1, p.reached);
+    g1.v = field_velocity(g1, p.reached);
+    g2.v = field_velocity(g2, p.reached);
+    t0 += p.reached;
+  }
+  return kNever;
 }
 
 double toi_field_disc_disc(Vec2 r, const FieldFlight& f1, const FieldFlight& f2, double sigma, double horizon) {
@@ -621,7 +660,7 @@ double toi_field_disc_segment(Vec2 rel, const FieldFlight& f, const Segment& s, 
       double k = -1.0;
       if (foot0 < 0.0 && foot_step > 0.0) k = std::ceil(-foot0 / foot_step);
       if (foot0 > s.len && foot_step < 0.0) k = std::ceil((foot0 - s.len) / -foot_step);
-      if (k < 1.0) continue;
+      if (k < 1.0 || !(k + 1.0 > k)) continue;  // (a k beyond 2^53 periods is no time a double can tell)
       // Rounding of foot_0 + k step against the evaluated foot: look at k - 1, k, k + 1.
       for (double kk = std::max(1.0, k - 1.0); kk <= k + 1.0; kk += 1.0) {
         const double tk = time_k(kk);

@@ -210,6 +210,30 @@ std::optional<DefProblem> check_balls(const WorldDef& def) {
   return std::nullopt;
 }
 
+/// A rotating or deforming wall under a magnetic field, with charged balls: no solver meets a
+/// gyrating ball with a turning segment (a translating wall is a fixed one in its own frame, with
+/// the field E + u x B there, and is served).
+std::optional<DefProblem> check_field_walls(const WorldDef& def) {
+  if (def.effects.magnetic == 0.0) return std::nullopt;
+  const bool charged = std::any_of(def.balls.begin(), def.balls.end(), [](const BallDef& b) { return b.charge != 0.0; });
+  if (!charged) return std::nullopt;
+  for (std::size_t i = 0; i < def.walls.size(); ++i) {
+    const WallDef& w = def.walls[i];
+    Vec2 d_prev = w.to - w.from;
+    for (std::size_t k = 0; k < w.keys.size(); ++k) {
+      const Vec2 d = w.keys[k].to - w.keys[k].from;
+      if (!(d == d_prev))
+        return problem(Where::wall, i, "keys",
+                       wall_name(w, i) + " keyframe " + std::to_string(k) +
+                           " turns or stretches the wall, which effects.magnetic with charged balls does not support "
+                           "(exact flights meet only fixed and translating walls under a magnetic field); keep to - from "
+                           "the same in every keyframe, or set effects.magnetic to 0");
+      d_prev = d;
+    }
+  }
+  return std::nullopt;
+}
+
 std::optional<DefProblem> check_turtles(const WorldDef& def) {
   const Discs d{def};
   for (std::size_t i = 0; i < def.turtles.size(); ++i) {
@@ -404,6 +428,7 @@ std::optional<DefProblem> validate(const WorldDef& def) {
   if (auto p = check_scalars(def)) return p;
   if (auto p = check_walls(def)) return p;
   if (auto p = check_balls(def)) return p;
+  if (auto p = check_field_walls(def)) return p;
   if (auto p = check_turtles(def)) return p;
   // Bodies, and wall ends (two per wall, the arena's four included), are indexed with 29 bits.
   const std::size_t bodies = def.balls.size() + def.turtles.size();

@@ -864,3 +864,47 @@ TEST_CASE("no NaN and no negative time over the issue's whole field range", "[fi
     }
   }
 }
+
+TEST_CASE("the bracketed search continues past its split budget instead of deciding on the ends", "[field][toi][cap]") {
+  // Two drift-free circles of radius 1, rates 1 and sqrt 2 (incommensurate), centres 2.2 - 1e-6
+  // apart, sigma 0.2: the discs come within 1e-6 of touching every time the phases nearly line
+  // up, and touch only when they line up closely enough, first at t = 7470.7. Over a horizon of
+  // 1e4 the search needs more than its budget of splits; the old code then decided every piece by
+  // its end points' signs and returned "never" (checked against the code before the change).
+  const double D = 2.2 - 1e-6, sigma = 0.2;
+  const FieldFlight f1{{0.0, -1.0}, {}, 1.0};
+  const FieldFlight f2{{0.0, -std::sqrt(2.0)}, {}, std::sqrt(2.0)};
+  const Vec2 r{D, 0.0};
+  const PartialToi part = toi_field_disc_disc_partial(r, f1, f2, sigma, 1e4);
+  CHECK(part.t == kNever);
+  CHECK(part.reached > 0.0);
+  CHECK(part.reached < 1e4);  // the budget ran out: this scene exercises the continuation
+
+  const double t = toi_field_disc_disc_bracketed(r, f1, f2, sigma, 1e4);
+  REQUIRE(t < 1e4);
+  // Reference: windows of 50 s, each searched completely (never stopping short), the flights
+  // re-centred at each window's end.
+  double t0 = 0.0, ref = kNever;
+  Vec2 rr = r;
+  FieldFlight g1 = f1, g2 = f2;
+  while (t0 < 1e4) {
+    const PartialToi w = toi_field_disc_disc_partial(rr, g1, g2, sigma, 50.0);
+    REQUIRE((w.t != kNever || w.reached == 50.0));
+    if (w.t != kNever) {
+      ref = t0 + w.t;
+      break;
+    }
+    rr += field_displacement(g2, 50.0) - field_displacement(g1, 50.0);
+    g1.v = field_velocity(g1, 50.0);
+    g2.v = field_velocity(g2, 50.0);
+    t0 += 50.0;
+  }
+  REQUIRE(ref != kNever);
+  CHECK(t == Approx(ref).epsilon(1e-12));
+  CHECK(t == Approx(7470.7072814554).epsilon(1e-11));
+  // The oracle (long double, each body on its own flight) puts the discs at contact there.
+  const P2 x1 = ld_pos({}, f1, t), x2 = ld_pos(r, f2, t);
+  const L dist = ld_norm(P2{x2.x - x1.x, x2.y - x1.y});
+  CHECK(static_cast<double>(dist - sigma) == Approx(0.0).margin(1e-9));
+  CHECK(dist >= sigma - 1e-12L);
+}

@@ -175,12 +175,20 @@ TEST_CASE("later features are reserved, not unknown") {
   }
 }
 
-TEST_CASE("fields that are not simulated yet are refused") {
-  CHECK_ERROR(world(R"(, "effects": {"electric": [1, 0]})"), "/effects/electric",
-              "effects.electric is not simulated yet (only gravity is); remove it or set it to [0, 0]");
-  CHECK_ERROR(world(R"(, "effects": {"magnetic": 0.5})"), "/effects/magnetic",
-              "effects.magnetic is not simulated yet (only gravity is); remove it or set it to 0");
-  CHECK_NOTHROW(tw::parse_world(world(R"(, "effects": {"electric": [0, 0], "magnetic": 0})"), "w.json"));
+TEST_CASE("electric and magnetic fields and charges are read") {
+  const sim::WorldDef def = tw::parse_world(
+      world(R"(, "effects": {"electric": [1, -2], "magnetic": 0.5},
+        "balls": [{"id": "b", "pos": [100, 100], "radius": 1, "charge": -3}],
+        "gas": [{"count": 3, "radius": 1, "speed": 1, "charge": 2, "mass": 4, "region": [[0, 0], [50, 50]]}])"),
+      "w.json");
+  CHECK(def.effects.electric == sim::Vec2{1, -2});
+  CHECK(def.effects.magnetic == 0.5);
+  REQUIRE(def.balls.size() == 4);
+  CHECK(def.balls[0].charge == -3);
+  for (std::size_t k = 1; k < 4; ++k) CHECK(def.balls[k].charge == 2);
+  CHECK_ERROR(world(R"(, "effects": {"magnetic": "strong"})"), "/effects/magnetic", "expected a number");
+  CHECK_ERROR(world(R"(, "gas": [{"count": 1, "radius": 1, "speed": 1, "charge": "plus"}])"), "/gas/0/charge",
+              "expected a number");
 }
 
 TEST_CASE("bad values") {

@@ -126,6 +126,7 @@ sim::BallDef make_ball(const GasSpec& gas, std::size_t k, Vec2 pos, Vec2 vel) {
   b.vel = vel;
   b.radius = gas.radius;
   b.mass = gas.mass;
+  b.charge = gas.charge;
   b.layers = gas.layers;
   return b;
 }

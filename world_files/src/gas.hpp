@@ -14,6 +14,7 @@ struct GasSpec {
   std::size_t count = 0;
   double radius = 1.0;  ///< world units, > 0
   double mass = 1.0;
+  double charge = 0.0;  ///< every ball's
   double speed = 0.0;   ///< units/s, >= 0: every ball gets exactly this speed
   sim::Vec2 lo, hi;     ///< the region's corners, lo < hi
   std::uint64_t seed = 1;

@@ -119,16 +119,10 @@ void Reader::read_effects(const json& v, sim::EffectsDef& e) {
   expect_object(v, path, "effects");
   check_keys(v, path, "effects", {"gravity", "electric", "magnetic", "restitution", "ball_ball", "tc"});
   if (const json* g = find(v, "gravity")) e.gravity = vec2(*g, at(path, "gravity"));
-  if (const json* el = find(v, "electric")) {
-    e.electric = vec2(*el, at(path, "electric"));
-    if (e.electric != Vec2{})
-      fail(at(path, "electric"), "effects.electric is not simulated yet (only gravity is); remove it or set it to [0, 0]");
-  }
-  if (const json* m = find(v, "magnetic")) {
-    e.magnetic = number(*m, at(path, "magnetic"));
-    if (e.magnetic != 0.0)
-      fail(at(path, "magnetic"), "effects.magnetic is not simulated yet (only gravity is); remove it or set it to 0");
-  }
+  // The fields act on charged balls only (a ball's `charge`, a gas's `charge`): dv/dt = g + (q/m) E
+  // + (q Bz / m) (v.y, -v.x), docs/physics.md.
+  if (const json* el = find(v, "electric")) e.electric = vec2(*el, at(path, "electric"));
+  if (const json* m = find(v, "magnetic")) e.magnetic = number(*m, at(path, "magnetic"));
   if (const json* r = find(v, "restitution")) {
     e.restitution = number(*r, at(path, "restitution"));
     if (!(e.restitution >= 0.0 && e.restitution <= 1.0))

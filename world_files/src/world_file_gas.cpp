@@ -19,7 +19,7 @@ std::vector<GasSpec> Reader::read_gases(const json& v, const sim::WorldDef& def)
     const std::string p = at(path, k);
     const json& g = v[k];
     expect_object(g, p, "a gas");
-    check_keys(g, p, "a gas", {"count", "radius", "mass", "speed", "region", "seed", "id_prefix", "category", "collides_with"});
+    check_keys(g, p, "a gas", {"count", "radius", "mass", "charge", "speed", "region", "seed", "id_prefix", "category", "collides_with"});
     GasSpec gas;
     const std::uint64_t count = natural(require(g, p, "count", "a gas"), at(p, "count"));
     constexpr std::uint64_t max_count = 100'000'000;
@@ -29,6 +29,7 @@ std::vector<GasSpec> Reader::read_gases(const json& v, const sim::WorldDef& def)
     gas.count = static_cast<std::size_t>(count);
     gas.radius = positive(require(g, p, "radius", "a gas"), at(p, "radius"), "radius");
     if (const json* x = find(g, "mass")) gas.mass = positive(*x, at(p, "mass"), "mass");
+    if (const json* x = find(g, "charge")) gas.charge = number(*x, at(p, "charge"));
     gas.speed = number(require(g, p, "speed", "a gas"), at(p, "speed"));
     if (gas.speed < 0.0) fail(at(p, "speed"), "speed must be >= 0 (got " + num(gas.speed) + "); directions are random");
     gas.lo = {0.0, 0.0};

@@ -179,8 +179,13 @@ class Engine final : public EngineBase {
   }
   void repredict(std::uint32_t i) {
     const CellXY c = cell_xy(bodies_.body[i].cell);
-    predict(i, c.ix, c.iy);
-    if constexpr (!kStep) predict_crossing(i, c.ix, c.iy);  // crossing times depend on the velocity just changed
+    if constexpr (F::kBoundedHorizon) {
+      predict_crossing(i, c.ix, c.iy);  // first: it is the prediction's horizon
+      predict(i, c.ix, c.iy);
+    } else {
+      predict(i, c.ix, c.iy);
+      if constexpr (!kStep) predict_crossing(i, c.ix, c.iy);  // crossing times depend on the velocity just changed
+    }
     schedule(i);
   }
   /// Body i's course changed outside a collision (a command, a push): predictions made with it
@@ -243,7 +248,7 @@ Engine<F, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<Ba
   if (auto problem = validate(def)) throw std::invalid_argument(problem->message);
   const EffectsDef& fx = def.effects;
   motion_ = Motion<F, kExtras>(def);
-  if constexpr (kStep) kick_ = Kick(fx);
+  if constexpr (kStep) kick_ = Kick(def);
   restitution_.e = fx.restitution;
   restitution_.tc = fx.tc;
   restitution_.inelastic = fx.restitution < 1.0;
@@ -283,8 +288,13 @@ Engine<F, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<Ba
     begin_step();
   } else {
     for (std::uint32_t i = 0; i < n; ++i) {
-      predict(i);
-      predict_crossing(i);
+      if constexpr (F::kBoundedHorizon) {
+        predict_crossing(i);
+        predict(i);
+      } else {
+        predict(i);
+        predict_crossing(i);
+      }
       schedule(i);
     }
   }
@@ -298,8 +308,18 @@ void Engine<F, kBallBall, kStep, kExtras>::predict(std::uint32_t i, int ix, int 
   // turtle whose command starts or ends without moving it keeps the collisions predicted for it.
   p.t_coll = kNever;
   p.kind = Partner::none;
-  if constexpr (!kStep) look_around<kBallBall>(look(), grid_, i, bi, ix, iy, p);
-  else look_along_step<kBallBall>(look(), grid_, step_, dt_, i, bi, ix, iy, p);
+  if constexpr (F::kBoundedHorizon) {
+    // Curved flights look no further than the cell exit (or the flight's re-plan time), when the
+    // body predicts afresh anyway: the bracketed searches need a finite horizon, and every search
+    // is cheaper for it. Nothing found leaves no candidate.
+    p.t_coll = p.t_cross;
+    look_around<kBallBall>(look(), grid_, i, bi, ix, iy, p);
+    if (p.kind == Partner::none) p.t_coll = kNever;
+  } else if constexpr (!kStep) {
+    look_around<kBallBall>(look(), grid_, i, bi, ix, iy, p);
+  } else {
+    look_along_step<kBallBall>(look(), grid_, step_, dt_, i, bi, ix, iy, p);
+  }
 }
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>

@@ -10,10 +10,18 @@ namespace {
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
 void Engine<F, kBallBall, kStep, kExtras>::cross(std::uint32_t i) {
+  const int dir = bodies_.pending[i].cross_dir;
+  if constexpr (F::kBoundedHorizon) {
+    if (dir == kReplan) {
+      // The prediction's horizon, not a crossing: the body stays in its cell and looks again.
+      sync(i);
+      repredict(i);
+      return;
+    }
+  }
   ++record_.stats.cell_crossings;
   sync(i);
   Body& b = bodies_.body[i];
-  const int dir = bodies_.pending[i].cross_dir;
   auto [ix, iy] = cell_xy(b.cell);
   ix += dir == 0 ? -1 : (dir == 1 ? 1 : 0);
   iy += dir == 2 ? -1 : (dir == 3 ? 1 : 0);
@@ -32,8 +40,14 @@ void Engine<F, kBallBall, kStep, kExtras>::cross(std::uint32_t i) {
   }
   unlink(i);
   link(i, static_cast<std::uint32_t>(grid_.index(ix, iy)));
-  look_at_strip<kBallBall>(look(), grid_, i, b, dir, ix, iy, bodies_.pending[i]);
-  predict_crossing(i, ix, iy);
+  if constexpr (F::kBoundedHorizon) {
+    // The old prediction looked only as far as this crossing: predict afresh from the new cell.
+    predict_crossing(i, ix, iy);
+    predict(i, ix, iy);
+  } else {
+    look_at_strip<kBallBall>(look(), grid_, i, b, dir, ix, iy, bodies_.pending[i]);
+    predict_crossing(i, ix, iy);
+  }
   schedule(i);
 }
 

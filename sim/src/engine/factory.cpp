@@ -4,7 +4,7 @@
 //
 // sim/CMakeLists.txt reads the rows of TURTLEGAS_ENGINE_VARIANTS below and compiles each in a
 // translation unit of its own (engine_variants/*.cpp in the build tree: an explicit
-// instantiation of make_variant), so the twelve build in parallel. A row that is not listed is
+// instantiation of make_variant), so the sixteen build in parallel. A row that is not listed is
 // not compiled; a scene that would need it is a bug here, reported as such.
 #include <stdexcept>
 #include <string>
@@ -25,6 +25,10 @@
   ROW(GravityFlight, balls_meet, exact, extras) \
   ROW(GravityFlight, balls_pass, exact, plain) \
   ROW(GravityFlight, balls_pass, exact, extras) \
+  ROW(ChargedFlight, balls_meet, exact, plain) \
+  ROW(ChargedFlight, balls_meet, exact, extras) \
+  ROW(ChargedFlight, balls_pass, exact, plain) \
+  ROW(ChargedFlight, balls_pass, exact, extras) \
   ROW(FreeFlight, balls_meet, step, plain)     \
   ROW(FreeFlight, balls_meet, step, extras)    \
   ROW(FreeFlight, balls_pass, step, plain)     \

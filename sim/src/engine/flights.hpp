@@ -19,12 +19,18 @@
 #include <concepts>
 #include <cstdint>
 #include <string_view>
+#include <vector>
 
 #include "records.hpp"
+#include "turtlegas/sim/field_toi.hpp"
 #include "turtlegas/sim/toi.hpp"
 #include "turtlegas/sim/world_def.hpp"
 
 namespace turtlegas::sim::detail {
+
+/// Whether some charged ball feels an electric or magnetic field: then only ChargedFlight (exact
+/// mode) or a Kick with species (step mode) flies the scene right.
+bool charges_feel_fields(const WorldDef& def);
 
 /// The cell a body is in, as the times it would leave it are measured against.
 struct CellBox {
@@ -67,14 +73,16 @@ concept Flight = std::constructible_from<F, const WorldDef&> &&
   { f.vel(ball, v, dt) } -> std::same_as<Vec2>;
   /// When the ball, at x with velocity v, leaves the cell `box`.
   { f.cell_exit(ball, x, v, box) } -> std::same_as<CellExit>;
-  /// Two balls, `other` at x and v relative to `ball`: when their distance falls to sigma.
-  { f.toi_balls(ball, other, x, v, sigma, t_max) } -> std::same_as<double>;
-  /// The ball at x relative to a point that flies straight, v relative to it: when their distance
-  /// falls to sigma (a wall end, a moving wall's end, a turtle's centre).
-  { f.toi_point(ball, x, v, sigma, t_max) } -> std::same_as<double>;
-  /// The ball at x relative to segment s's first end, v relative to the segment (which may
-  /// translate): when it touches the segment's interior.
-  { f.toi_segment(ball, x, v, s, sigma) } -> std::same_as<double>;
+  /// Two balls, `other` at x relative to `ball`, flying at v (ball) and w (other): when their
+  /// distance falls to sigma.
+  { f.toi_balls(ball, other, x, v, w, sigma, t_max) } -> std::same_as<double>;
+  /// The ball at x relative to a point that flies straight at w, v relative to it: when their
+  /// distance falls to sigma (a wall end, a moving wall's end, a turtle's centre). (Under a
+  /// magnetic field the point's own velocity matters: it is a field in the point's frame.)
+  { f.toi_point(ball, x, v, w, sigma, t_max) } -> std::same_as<double>;
+  /// The ball at x relative to segment s's first end, v relative to the segment, which translates
+  /// at w: when it touches the segment's interior.
+  { f.toi_segment(ball, x, v, w, s, sigma, t_max) } -> std::same_as<double>;
   /// The same for a segment whose ends move apart (d0 + w t from its first end).
   { f.toi_deforming_segment(ball, x, v, d0, w, sigma, t_max) } -> std::same_as<double>;
   /// Whether the ball flies straight, and so whether its motion relative to something that flies
@@ -88,12 +96,23 @@ concept Flight = std::constructible_from<F, const WorldDef&> &&
   { f.normal_accel(ball, v, x) } -> std::same_as<double>;
   /// The ball's potential energy per unit mass at x (energy()).
   { f.potential(ball, x) } -> std::same_as<double>;
+  /// Whether balls fly curves whose times of impact need a finite horizon (the bracketed
+  /// searches): then a prediction looks no further than the cell exit (or the re-plan time the
+  /// flight's cell_exit gives, direction kReplan), and a cell crossing predicts afresh in the whole
+  /// new neighbourhood instead of keeping the old prediction beside the new strip's.
+  { F::kBoundedHorizon } -> std::convertible_to<bool>;
 };
+
+/// A cell "exit" that is a re-plan: the body stays in its cell and predicts afresh.
+inline constexpr std::uint8_t kReplan = 4;
 
 /// Straight-line flight: no field acts between events.
 struct FreeFlight {
   static constexpr std::string_view kName = "free";
-  static bool fits(const WorldDef& def) { return def.effects.gravity.x == 0.0 && def.effects.gravity.y == 0.0; }
+  static constexpr bool kBoundedHorizon = false;
+  static bool fits(const WorldDef& def) {
+    return def.effects.gravity.x == 0.0 && def.effects.gravity.y == 0.0 && !charges_feel_fields(def);
+  }
   FreeFlight() = default;
   explicit FreeFlight(const WorldDef&) {}
 
@@ -102,11 +121,13 @@ struct FreeFlight {
   CellExit cell_exit(std::uint32_t, Vec2 x, Vec2 v, const CellBox& b) const {
     return earlier_exit(straight_exit(x.x, v.x, b.x_lo, b.x_hi), straight_exit(x.y, v.y, b.y_lo, b.y_hi));
   }
-  double toi_balls(std::uint32_t, std::uint32_t, Vec2 r, Vec2 v, double sigma, double) const {
-    return toi_disc_disc(r, v, sigma);
+  double toi_balls(std::uint32_t, std::uint32_t, Vec2 r, Vec2 vi, Vec2 vj, double sigma, double) const {
+    return toi_disc_disc(r, vj - vi, sigma);
   }
-  double toi_point(std::uint32_t, Vec2 rel, Vec2 v, double sigma, double) const { return toi_disc_point(rel, v, sigma); }
-  double toi_segment(std::uint32_t, Vec2 rel, Vec2 v, const Segment& s, double radius) const {
+  double toi_point(std::uint32_t, Vec2 rel, Vec2 v, Vec2, double sigma, double) const {
+    return toi_disc_point(rel, v, sigma);
+  }
+  double toi_segment(std::uint32_t, Vec2 rel, Vec2 v, Vec2, const Segment& s, double radius, double) const {
     return toi_disc_segment(rel, v, Vec2{}, s, radius);
   }
   double toi_deforming_segment(std::uint32_t, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const {
@@ -121,7 +142,8 @@ struct FreeFlight {
 /// Parabolic flight under a uniform acceleration shared by all balls (gravity).
 struct GravityFlight {
   static constexpr std::string_view kName = "gravity";
-  static bool fits(const WorldDef&) { return true; }
+  static constexpr bool kBoundedHorizon = false;
+  static bool fits(const WorldDef& def) { return !charges_feel_fields(def); }
   GravityFlight() = default;
   explicit GravityFlight(const WorldDef& def) : a(def.effects.gravity) {}
 
@@ -132,13 +154,13 @@ struct GravityFlight {
     return earlier_exit(axis_exit(x.x, v.x, a.x, b.x_lo, b.x_hi), axis_exit(x.y, v.y, a.y, b.y_lo, b.y_hi));
   }
   /// Both balls fall alike, so their relative motion is a straight line.
-  double toi_balls(std::uint32_t, std::uint32_t, Vec2 r, Vec2 v, double sigma, double) const {
-    return toi_disc_disc(r, v, sigma);
+  double toi_balls(std::uint32_t, std::uint32_t, Vec2 r, Vec2 vi, Vec2 vj, double sigma, double) const {
+    return toi_disc_disc(r, vj - vi, sigma);
   }
-  double toi_point(std::uint32_t, Vec2 rel, Vec2 v, double sigma, double t_max) const {
+  double toi_point(std::uint32_t, Vec2 rel, Vec2 v, Vec2, double sigma, double t_max) const {
     return toi_disc_point_accel(rel, v, a, sigma, t_max);
   }
-  double toi_segment(std::uint32_t, Vec2 rel, Vec2 v, const Segment& s, double radius) const {
+  double toi_segment(std::uint32_t, Vec2 rel, Vec2 v, Vec2, const Segment& s, double radius, double) const {
     return toi_disc_segment(rel, v, a, s, radius);
   }
   double toi_deforming_segment(std::uint32_t, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const {
@@ -150,7 +172,92 @@ struct GravityFlight {
   double potential(std::uint32_t, Vec2 x) const { return -dot(a, x); }
 };
 
-static_assert(Flight<FreeFlight> && Flight<GravityFlight>);
+/// Flight under gravity, electric and magnetic fields (field_flight.hpp, field_toi.hpp): each ball
+/// flies a parabola, a circle or a trochoid, by its charge-to-mass ratio. Balls are grouped into
+/// species of equal (a, w), a = g + (q/m) E and w = q Bz / m, kept here by ball index (built only
+/// for the scenes that need this flight: Record stays 128 bytes); species 0 is the uncharged {g, 0}.
+///   - Pairs of one species: the relative motion is a rotation, closed form (22 ns). Pairs of
+///     different species: the bracketed search, which needs a finite horizon (kBoundedHorizon).
+///   - An uncharged ball (w == 0) takes today's parabola and today's time-of-impact functions.
+///   - A moving point or a translating wall at u: the ball's flight in its frame has a + w J(u)
+///     (E' = E + u x B), in_moving_frame. Rotating or deforming walls under B: refused by
+///     validate() (no solver); with w == 0 the parabola's deforming-segment solver.
+///   - "Just collided, skip this pair" holds only for straight relative motion (the field
+///     functions never return the contact just resolved, so not skipping is always safe).
+class ChargedFlight {
+ public:
+  static constexpr std::string_view kName = "fields";
+  static constexpr bool kBoundedHorizon = true;
+  static bool fits(const WorldDef&) { return true; }
+  ChargedFlight() = default;
+  explicit ChargedFlight(const WorldDef& def);
+
+  struct Species {
+    Vec2 a;          ///< g + (q/m) E
+    double w = 0.0;  ///< q Bz / m
+  };
+  const Species& species(std::uint32_t ball) const { return species_[of_[ball]]; }
+  std::size_t species_count() const { return species_.size(); }
+  FieldFlight flight(std::uint32_t ball, Vec2 v) const {
+    const Species& s = species(ball);
+    return {v, s.a, s.w};
+  }
+
+  Vec2 pos(std::uint32_t ball, Vec2 x, Vec2 v, double dt) const {
+    const Species& s = species(ball);
+    if (s.w == 0.0) return x + dt * v + (0.5 * dt * dt) * s.a;
+    return x + field_displacement({v, s.a, s.w}, dt);
+  }
+  Vec2 vel(std::uint32_t ball, Vec2 v, double dt) const {
+    const Species& s = species(ball);
+    if (s.w == 0.0) return v + dt * s.a;
+    return field_velocity({v, s.a, s.w}, dt);
+  }
+  CellExit cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const CellBox& b) const;
+  double toi_balls(std::uint32_t i, std::uint32_t j, Vec2 r, Vec2 vi, Vec2 vj, double sigma, double t_max) const {
+    const Species& si = species(i);
+    if (of_[i] == of_[j]) return toi_field_disc_disc_rotating(r, vj - vi, si.w, sigma, t_max);
+    const Species& sj = species(j);
+    return toi_field_disc_disc(r, {vi, si.a, si.w}, {vj, sj.a, sj.w}, sigma, t_max);
+  }
+  double toi_point(std::uint32_t ball, Vec2 rel, Vec2 v, Vec2 u, double sigma, double t_max) const {
+    const Species& s = species(ball);
+    if (s.w == 0.0) return s.a == Vec2{} ? toi_disc_point(rel, v, sigma) : toi_disc_point_accel(rel, v, s.a, sigma, t_max);
+    return toi_field_disc_point(rel, {v, s.a + s.w * turn_cw(u), s.w}, sigma, t_max);
+  }
+  double toi_segment(std::uint32_t ball, Vec2 rel, Vec2 v, Vec2 u, const Segment& seg, double radius,
+                     double t_max) const {
+    const Species& s = species(ball);
+    if (s.w == 0.0) return toi_disc_segment(rel, v, s.a, seg, radius);
+    return toi_field_disc_segment(rel, {v, s.a + s.w * turn_cw(u), s.w}, seg, radius, t_max);
+  }
+  double toi_deforming_segment(std::uint32_t ball, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const;
+  bool straight(std::uint32_t ball) const {
+    const Species& s = species(ball);
+    return s.w == 0.0 && s.a == Vec2{};
+  }
+  bool straight_pair(std::uint32_t i, std::uint32_t j) const {
+    const Species& si = species(i);
+    const Species& sj = species(j);
+    return si.w == 0.0 && sj.w == 0.0 && si.a == sj.a;
+  }
+  /// a.n + w n.J(v): the magnetic part depends only on v's tangential part, which a bounce keeps,
+  /// so this is also the pull on the ball's flight after the bounce.
+  double normal_accel(std::uint32_t ball, Vec2 v, Vec2 n) const {
+    const Species& s = species(ball);
+    return dot(s.a + s.w * turn_cw(v), n);
+  }
+  double potential(std::uint32_t ball, Vec2 x) const { return -dot(species(ball).a, x); }
+
+ private:
+  std::vector<Species> species_;
+  std::vector<std::uint32_t> of_;  ///< each ball's species
+  /// Some pair needs the bracketed search (two species, or a charged ball and turtles): then a
+  /// drift-free circle that never leaves its cell re-plans every few periods (cell_exit).
+  bool bracketed_pairs_ = false;
+};
+
+static_assert(Flight<FreeFlight> && Flight<GravityFlight> && Flight<ChargedFlight>);
 
 /// How every body flies: balls by the scene's flight, turtles (ids from `balls` on, kExtras only)
 /// always in straight lines. The one place where motion tells balls and turtles apart.
@@ -175,11 +282,12 @@ class Motion {
     return flight_.cell_exit(id, x, v, b);
   }
   /// Body id (a ball or a turtle) at rel from a point that flies straight, v relative to it.
-  double toi_point(std::uint32_t id, Vec2 rel, Vec2 v, double sigma, double t_max) const {
-    return is_turtle(id) ? toi_disc_point(rel, v, sigma) : flight_.toi_point(id, rel, v, sigma, t_max);
+  double toi_point(std::uint32_t id, Vec2 rel, Vec2 v, Vec2 u, double sigma, double t_max) const {
+    return is_turtle(id) ? toi_disc_point(rel, v, sigma) : flight_.toi_point(id, rel, v, u, sigma, t_max);
   }
-  double toi_segment(std::uint32_t id, Vec2 rel, Vec2 v, const Segment& s, double radius) const {
-    return is_turtle(id) ? toi_disc_segment(rel, v, Vec2{}, s, radius) : flight_.toi_segment(id, rel, v, s, radius);
+  double toi_segment(std::uint32_t id, Vec2 rel, Vec2 v, Vec2 u, const Segment& s, double radius, double t_max) const {
+    return is_turtle(id) ? toi_disc_segment(rel, v, Vec2{}, s, radius)
+                         : flight_.toi_segment(id, rel, v, u, s, radius, t_max);
   }
   double toi_deforming_segment(std::uint32_t id, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const {
     return is_turtle(id) ? toi_disc_deforming_segment(rel, v, Vec2{}, d0, w, radius, t_max)

@@ -40,8 +40,8 @@ template <Flight F, bool kExtras>
   const double dtj = l.now - bj.t;
   const F& f = l.motion.flight();
   const Vec2 r = f.pos(j, bj.x, bj.v, dtj) + shift - bi.x;
-  const Vec2 v = f.vel(j, bj.v, dtj) - bi.v;
-  const double t = l.now + f.toi_balls(i, j, r, v, bi.r + bj.r, p.t_coll - l.now);
+  const Vec2 vj = f.vel(j, bj.v, dtj);
+  const double t = l.now + f.toi_balls(i, j, r, bi.v, vj, bi.r + bj.r, p.t_coll - l.now);
   if (t < p.t_coll) {
     // Checked only for a winner: most candidates miss, and last[j] is a cache miss.
     if (f.straight_pair(i, j) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
@@ -82,7 +82,7 @@ template <Flight F, bool kExtras>
   const Body& bj = l.bodies.body[j];
   const Vec2 rel = bi.x - (bj.x + (l.now - bj.t) * bj.v + shift);
   const Vec2 v = bi.v - bj.v;
-  const double t = l.now + l.motion.toi_point(i, rel, v, bi.r + bj.r, p.t_coll - l.now);
+  const double t = l.now + l.motion.toi_point(i, rel, v, bj.v, bi.r + bj.r, p.t_coll - l.now);
   if (t < p.t_coll) {
     if (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
         l.bodies.last[j] == LastPartner::of(Partner::body, i))
@@ -101,7 +101,7 @@ template <Flight F, bool kExtras>
   const F& f = l.motion.flight();
   const Vec2 rel = f.pos(j, bj.x, bj.v, dtj) + shift - bi.x;
   const Vec2 v = f.vel(j, bj.v, dtj) - bi.v;
-  const double t = l.now + f.toi_point(j, rel, v, bi.r + bj.r, p.t_coll - l.now);
+  const double t = l.now + f.toi_point(j, rel, v, bi.v, bi.r + bj.r, p.t_coll - l.now);
   if (t < p.t_coll) {
     if (f.straight(j) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
         l.bodies.last[j] == LastPartner::of(Partner::body, i))
@@ -156,7 +156,7 @@ template <Flight F, bool kExtras>
   if (!l.meets_wall(i, w) || (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::wall, w))) return;
   const Segment& s = l.walls.segments[w];
   // Relative to the wall's first end, so walls far from the origin lose nothing.
-  const double t = l.now + l.motion.toi_segment(i, bi.x - (s.p1 + shift), bi.v, s, bi.r);
+  const double t = l.now + l.motion.toi_segment(i, bi.x - (s.p1 + shift), bi.v, Vec2{}, s, bi.r, p.t_coll - l.now);
   if (t < p.t_coll) p.take(t, Partner::wall, w);
 }
 
@@ -207,7 +207,7 @@ template <Flight F, bool kExtras>
                  Pending& p) {
   if (!l.meets_end(i, e) || (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::end, e))) return;
   const Vec2 rel = bi.x - (l.walls.ends[e].p + shift);
-  const double t = l.now + l.motion.toi_point(i, rel, bi.v, bi.r, p.t_coll - l.now);
+  const double t = l.now + l.motion.toi_point(i, rel, bi.v, Vec2{}, bi.r, p.t_coll - l.now);
   if (t < p.t_coll) p.take(t, Partner::end, e);
 }
 
@@ -254,7 +254,7 @@ template <Flight F, bool kExtras>
     // Turning or stretching: no straight-line argument rules out meeting the same wall again.
     t_wall = l.now + l.motion.toi_deforming_segment(i, bi.x - p1, v, m.d_at(l.now), m.w, bi.r, horizon - l.now);
   } else if (!(l.motion.straight(i) && last == LastPartner::of(Partner::wall, w))) {
-    t_wall = l.now + l.motion.toi_segment(i, bi.x - p1, v, s, bi.r);
+    t_wall = l.now + l.motion.toi_segment(i, bi.x - p1, v, m.u, s, bi.r, horizon - l.now);
   }
   if (t_wall < p.t_coll && t_wall <= horizon) p.take(t_wall, Partner::wall, w);
   for (std::uint32_t which = 0; which < 2; ++which) {
@@ -263,7 +263,7 @@ template <Flight F, bool kExtras>
     // Each end moves in a straight line, so its contacts have the closed forms of a fixed point.
     const Vec2 e = m.end_at(s, which == 1, l.now);
     const Vec2 ve = which == 0 ? v : v - m.w;  // the body's velocity relative to that end
-    const double t = l.now + l.motion.toi_point(i, bi.x - e, ve, bi.r, horizon - l.now);
+    const double t = l.now + l.motion.toi_point(i, bi.x - e, ve, which == 0 ? m.u : m.u + m.w, bi.r, horizon - l.now);
     if (t < p.t_coll && t <= horizon) p.take(t, Partner::moving_end, code);
   }
 }

@@ -33,6 +33,20 @@ double toi_field_disc_disc(Vec2 r, const FieldFlight& f1, const FieldFlight& f2,
 double toi_field_disc_disc_bracketed(Vec2 r, const FieldFlight& f1, const FieldFlight& f2, double sigma,
                                      double horizon);
 
+/// One bounded-cost search of toi_field_disc_disc_bracketed: `t` the first contact (kNever: none
+/// found) and `reached`, the time up to which [0, reached] is proven free of a contact. A search
+/// that needed more than a few thousand splits stops with t = kNever and reached < horizon (and
+/// reached > 0: each call makes progress); continuing from `reached` (flights re-centred there)
+/// finds what lies beyond. toi_field_disc_disc_bracketed does exactly that, up to 64 searches
+/// (about 2.6e5 splits; before, it decided every piece on its ends after 4000 splits); past them
+/// it answers kNever. The engine keeps its horizons far below that (2^30 periods at most).
+struct PartialToi {
+  double t = kNever;
+  double reached = 0.0;
+};
+PartialToi toi_field_disc_disc_partial(Vec2 r, const FieldFlight& f1, const FieldFlight& f2, double sigma,
+                                       double horizon);
+
 /// A disc at rel = x - s.p1 on flight f touching the interior of segment s (either face; the foot
 /// of the contact on the segment, ends included). The signed distance n.x(t) is a constant plus
 /// a drift term (n.u_d) t plus a sinusoid: without normal drift (cross(n, a) == 0) each face's
