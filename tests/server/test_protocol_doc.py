@@ -184,5 +184,27 @@ def test_binary_frames():
         s.stop()
 
 
+def test_region():
+    """b1 starts at (400, 300), b2 at (420, 100): a region around b1 carries b1 alone."""
+    with Server(world("protocol_room.json"), "--paused") as s:
+        for w, fmt in ((World.connect("127.0.0.1", s.line_port), "json"), (World.connect_ws("127.0.0.1", s.http_port), "binary")):
+            sub = w.subscribe(rate=20, fmt=fmt, region=[300, 200, 500, 400])
+            check(sub["region"] == [300, 200, 500, 400], "subscribed with the region: %r" % sub)
+            check(w.frames.get(timeout=10)["type"] == "snapshot", "the snapshot (all balls)")
+            f = w.frames.get(timeout=10)
+            if fmt == "json":
+                check(f["balls"]["index"] == [0] and f["balls"]["pos"] == [400, 300] and len(f["balls"]["vel"]) == 2,
+                      "JSON: b1 only: %r" % f["balls"])
+            else:
+                check(list(f["index"]) == [0] and list(f["pos"]) == [400.0, 300.0], "binary: b1 only: %r" % (f,))
+            for bad, code in (([1, 2, 3], "wrong_type"), ([5, 0, 1, 10], "bad_value"), ("all", "wrong_type")):
+                try:
+                    w.request({"type": "subscribe", "region": bad})
+                    check(False, "region %r refused" % (bad,))
+                except Exception as e:
+                    check(e.reply["code"] == code and e.reply["field"] == "/region", "%r: %r" % (bad, e.reply))
+        s.stop()
+
+
 if __name__ == "__main__":
-    main([test_doc_examples_over_lines, test_doc_examples_over_websocket, test_binary_frames])
+    main([test_doc_examples_over_lines, test_doc_examples_over_websocket, test_binary_frames, test_region])
