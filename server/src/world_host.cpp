@@ -593,6 +593,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
 
   if (type == "pause" || type == "resume" || type == "step" || type == "speed" || type == "run_until") {
     require_live();
+    if (type == "pause" || type == "resume") pause_at_.reset();  // both cancel a run_until's stop
     if (type == "pause") {
       paused_ = true;
       steps_left_ = 0;
@@ -601,6 +602,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
       steps_left_ = 0;
       reanchor();
     } else if (type == "step") {
+      pause_at_.reset();
       double n = 1;
       if (auto v = optional_number(m, "steps", R"({"type": "step", "steps": 1})")) n = *v;
       if (!(n >= 1 && n <= 1e6 && n == std::floor(n)))

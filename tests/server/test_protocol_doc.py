@@ -206,5 +206,30 @@ def test_region():
         s.stop()
 
 
+def test_resume_cancels_run_until():
+    """A resume after run_until runs on past its time (the doc session above raced with it)."""
+    with Server(world("protocol_room.json"), "--paused", "--speed", "max") as s:
+        w = World.connect("127.0.0.1", s.line_port)
+        check(w.run_until(0.5)["status"]["until"] == 0.5, "run_until sets the stop")
+        r = w.resume()
+        check(r["status"]["until"] is None and not r["status"]["paused"], "resume cancels it: %r" % r["status"])
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline and w.ping()["t"] <= 1.0:
+            time.sleep(0.02)
+        check(w.ping()["t"] > 1.0, "the world ran past 0.5")
+        w.run_until(w.ping()["t"] + 0.5)
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline and not (w.status and w.status["paused"]):
+            try:
+                n = w.notices.get(timeout=1)
+                if n.get("type") == "status":
+                    w.status = n["status"]
+            except Exception:
+                pass
+        check(w.status["paused"], "run_until alone pauses at its time: %r" % w.status)
+        s.stop()
+
+
 if __name__ == "__main__":
-    main([test_doc_examples_over_lines, test_doc_examples_over_websocket, test_binary_frames, test_region])
+    main([test_doc_examples_over_lines, test_doc_examples_over_websocket, test_binary_frames, test_region,
+          test_resume_cancels_run_until])
