@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   nlohmann-json3-dev libspdlog-dev libcli11-dev catch2
-  libboost-dev libboost-context-dev
+  libboost-dev libboost-context-dev   # libboost-dev: Asio and Beast (header-only) for server/
   python3
   dpkg-dev binutils   # the Debian package: cpack (dpkg-shlibdeps), tests/package/deb_test.py (readelf)
   clang libclang-rt-14-dev clang-tidy   # the clang and fuzz presets, scripts/tidy.sh

@@ -200,6 +200,10 @@ def decode_binary_frame(data):
     version, flags, seq, n, m, tail = struct.unpack_from("<HHIIII", data, 4)
     t, wall, step = struct.unpack_from("<ddQ", data, 24)
     off = 48
+    index = None
+    if flags & 4:  # a region: the balls' indices first
+        index = struct.unpack_from("<%dI" % n, data, off)
+        off += 4 * n
     pos = struct.unpack_from("<%df" % (2 * n), data, off)
     off += 8 * n
     vel = None
@@ -212,7 +216,7 @@ def decode_binary_frame(data):
     off += 4 * m
     rest = json.loads(data[off:off + tail].decode("utf-8"))
     return {"version": version, "paused": bool(flags & 1), "seq": seq, "t": t, "wall": wall, "step": step,
-            "pos": pos, "vel": vel, "turtles": turtles, "turtle_flags": tflags, "tail": rest,
+            "index": index, "pos": pos, "vel": vel, "turtles": turtles, "turtle_flags": tflags, "tail": rest,
             "size": off + tail}
 
 
@@ -360,9 +364,12 @@ class World:
     def load(self, file):
         return self.request({"type": "load", "file": file})
 
-    def subscribe(self, rate=30, events=(), fmt="json", velocities=True):
+    def subscribe(self, rate=30, events=(), fmt="json", velocities=True, region=None):
         ev = events if isinstance(events, str) else list(events)
-        return self.request({"type": "subscribe", "rate": rate, "events": ev, "format": fmt, "velocities": velocities})
+        m = {"type": "subscribe", "rate": rate, "events": ev, "format": fmt, "velocities": velocities}
+        if region is not None:
+            m["region"] = list(region)
+        return self.request(m)
 
     def snapshot(self):
         return self.request({"type": "snapshot"})

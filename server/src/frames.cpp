@@ -53,24 +53,47 @@ void append_walls(std::string& out, const turtle::WorldServer& server, std::size
   out += ']';
 }
 
-void append_balls(std::string& out, const sim::World& world, bool velocities) {
+/// The balls a frame of `kind` carries: all, or those in its region (from World's public
+/// accessors, O(N) per frame; a query on the engine's grid would make it O(region)).
+std::vector<std::uint32_t> balls_in(const sim::World& world, const FrameKind& kind) {
+  std::vector<std::uint32_t> out;
   const std::size_t n = world.ball_count();
-  std::string dead;
-  out += "{\"pos\": [";
+  if (!kind.region) return out;
+  const auto [x0, y0, x1, y1] = *kind.region;
   for (std::size_t i = 0; i < n; ++i) {
     const sim::BallState b = world.ball(i);
-    if (i > 0) out += ", ";
+    if (b.alive && b.pos.x >= x0 && b.pos.x <= x1 && b.pos.y >= y0 && b.pos.y <= y1) out.push_back(static_cast<std::uint32_t>(i));
+  }
+  return out;
+}
+
+/// The balls object; with `indexed`, only the balls of `which` and their indices.
+void append_balls(std::string& out, const sim::World& world, bool velocities, bool indexed = false,
+                  const std::vector<std::uint32_t>& which = {}) {
+  const std::size_t n = indexed ? which.size() : world.ball_count();
+  auto index = [&](std::size_t k) { return indexed ? which[k] : k; };
+  std::string dead;
+  out += '{';
+  if (indexed) {
+    out += "\"index\": [";
+    for (std::size_t k = 0; k < n; ++k) out += (k > 0 ? ", " : "") + std::to_string(which[k]);
+    out += "], ";
+  }
+  out += "\"pos\": [";
+  for (std::size_t k = 0; k < n; ++k) {
+    const sim::BallState b = world.ball(index(k));
+    if (k > 0) out += ", ";
     append_number(out, b.pos.x);
     out += ", ";
     append_number(out, b.pos.y);
-    if (!b.alive) dead += (dead.empty() ? "" : ", ") + std::to_string(i);
+    if (!b.alive) dead += (dead.empty() ? "" : ", ") + std::to_string(index(k));
   }
   out += ']';
   if (velocities) {
     out += ", \"vel\": [";
-    for (std::size_t i = 0; i < n; ++i) {
-      const sim::BallState b = world.ball(i);
-      if (i > 0) out += ", ";
+    for (std::size_t k = 0; k < n; ++k) {
+      const sim::BallState b = world.ball(index(k));
+      if (k > 0) out += ", ";
       append_number(out, b.alive ? b.vel.x : 0.0);
       out += ", ";
       append_number(out, b.alive ? b.vel.y : 0.0);
@@ -116,6 +139,8 @@ void put(std::string& out, T v) {
 std::string FrameKind::key() const {
   std::string k = std::to_string(rate) + (binary ? "/b" : "/j") + (velocities ? "/v" : "/-") + (all_events ? "/all" : "/");
   for (const std::string& e : events) k += e + ",";
+  if (region)
+    for (double v : *region) k += "/" + std::to_string(v);
   return k;
 }
 
@@ -205,7 +230,7 @@ std::shared_ptr<const std::string> FrameStream::build(const turtle::WorldServer&
     s = "{\"type\": \"frame\", \"seq\": " + std::to_string(built);
     append_clock(s, server, clock);
     s += ", \"balls\": ";
-    append_balls(s, world, kind_.velocities);
+    append_balls(s, world, kind_.velocities, kind_.region.has_value(), balls_in(world, kind_));
     s += ", \"turtles\": [";
     for (std::size_t i = 0; i < server.turtle_count(); ++i) {
       if (i > 0) s += ", ";
@@ -230,12 +255,16 @@ std::shared_ptr<const std::string> FrameStream::build(const turtle::WorldServer&
   tail += "], \"walls_from\": " + std::to_string(walls_from) + ", \"walls\": ";
   append_walls(tail, server, walls_from);
   tail += '}';
-  const std::size_t n = world.ball_count(), m = server.turtle_count();
+  const std::vector<std::uint32_t> which = balls_in(world, kind_);
+  const bool indexed = kind_.region.has_value();
+  const std::size_t n = indexed ? which.size() : world.ball_count(), m = server.turtle_count();
+  auto index = [&](std::size_t k) { return indexed ? which[k] : k; };
   std::string& s = *out;
-  s.reserve(48 + n * (kind_.velocities ? 16 : 8) + m * 16 + tail.size());
+  s.reserve(48 + n * (kind_.velocities ? 20 : 12) + m * 16 + tail.size());
   s.append("TGF1", 4);
   put<std::uint16_t>(s, 1);
-  put<std::uint16_t>(s, static_cast<std::uint16_t>((clock.paused ? 1u : 0u) | (kind_.velocities ? 2u : 0u)));
+  put<std::uint16_t>(s, static_cast<std::uint16_t>((clock.paused ? 1u : 0u) | (kind_.velocities ? 2u : 0u) |
+                                                   (indexed ? 4u : 0u)));
   put<std::uint32_t>(s, static_cast<std::uint32_t>(built));
   put<std::uint32_t>(s, static_cast<std::uint32_t>(n));
   put<std::uint32_t>(s, static_cast<std::uint32_t>(m));
@@ -244,14 +273,16 @@ std::shared_ptr<const std::string> FrameStream::build(const turtle::WorldServer&
   put<double>(s, clock.wall);
   put<std::uint64_t>(s, server.step());
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (std::size_t i = 0; i < n; ++i) {
-    const sim::BallState b = world.ball(i);
+  if (indexed)
+    for (std::uint32_t i : which) put<std::uint32_t>(s, i);
+  for (std::size_t k = 0; k < n; ++k) {
+    const sim::BallState b = world.ball(index(k));
     put<float>(s, b.alive ? static_cast<float>(b.pos.x) : nan);
     put<float>(s, b.alive ? static_cast<float>(b.pos.y) : nan);
   }
   if (kind_.velocities)
-    for (std::size_t i = 0; i < n; ++i) {
-      const sim::BallState b = world.ball(i);
+    for (std::size_t k = 0; k < n; ++k) {
+      const sim::BallState b = world.ball(index(k));
       put<float>(s, b.alive ? static_cast<float>(b.vel.x) : 0.0f);
       put<float>(s, b.alive ? static_cast<float>(b.vel.y) : 0.0f);
     }

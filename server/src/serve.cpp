@@ -92,19 +92,19 @@ int serve(ServeOptions options, const turtle::Registry& registry, world::Scene s
       grace.async_wait([&](boost::system::error_code) { ioc.stop(); });
     });
   };
+  // The simulation on the calling (main) thread, as `turtlegas run` has it: the fibers' signal
+  // handling (an alternate signal stack, the busy-loop watchdog; turtle_runtime/src/fiber.cpp)
+  // then lives on a thread that never exits before the process does. I/O on a thread of its own.
+  std::thread io([&] { ioc.run(); });
   int code = 0;
-  std::exception_ptr failure;
-  std::thread sim([&] {
-    try {
-      code = host.run();
-    } catch (...) {
-      failure = std::current_exception();
-      asio::post(ioc, [&] { ioc.stop(); });
-    }
-  });
-  ioc.run();
-  sim.join();
-  if (failure) std::rethrow_exception(failure);
+  try {
+    code = host.run();
+  } catch (...) {
+    asio::post(ioc, [&] { ioc.stop(); });
+    io.join();
+    throw;
+  }
+  io.join();
   return code;
 }
 

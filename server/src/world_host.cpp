@@ -540,6 +540,16 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
         throw RequestError("unsupported", "/format: binary frames need a WebSocket; TCP lines carry \"json\" frames", "/format");
     }
     if (auto v = optional_bool(m, "velocities", ex)) k.velocities = *v;
+    if (auto r = m.find("region"); r != m.end()) {
+      constexpr const char* why = "/region must be [x0, y0, x1, y1], four finite numbers with x0 < x1 and y0 < y1";
+      if (!r->is_array() || r->size() != 4 || !std::all_of(r->begin(), r->end(), [](const json& x) { return x.is_number(); }))
+        throw RequestError("wrong_type", why, "/region");
+      std::array<double, 4> box{};
+      for (std::size_t q = 0; q < 4; ++q) box[q] = (*r)[q].get<double>();
+      if (!std::all_of(box.begin(), box.end(), [](double x) { return std::isfinite(x); }) || !(box[0] < box[2]) || !(box[1] < box[3]))
+        throw RequestError("bad_value", why, "/region");
+      k.region = box;
+    }
     if (auto e = m.find("events"); e != m.end()) {
       if (e->is_string() && e->get<std::string>() == "all") {
         k.all_events = true;
@@ -564,6 +574,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     r["events"] = k.all_events ? json("all") : json(k.events);
     r["format"] = k.binary ? "binary" : "json";
     r["velocities"] = k.velocities;
+    if (k.region) r["region"] = *k.region;
     reply(c, r);
     reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"]));
     return;
@@ -582,6 +593,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
 
   if (type == "pause" || type == "resume" || type == "step" || type == "speed" || type == "run_until") {
     require_live();
+    if (type == "pause" || type == "resume") pause_at_.reset();  // both cancel a run_until's stop
     if (type == "pause") {
       paused_ = true;
       steps_left_ = 0;
@@ -590,6 +602,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
       steps_left_ = 0;
       reanchor();
     } else if (type == "step") {
+      pause_at_.reset();
       double n = 1;
       if (auto v = optional_number(m, "steps", R"({"type": "step", "steps": 1})")) n = *v;
       if (!(n >= 1 && n <= 1e6 && n == std::floor(n)))

@@ -12,7 +12,7 @@ import subprocess
 import sys
 import tempfile
 
-from harness import ROOT, Server, check, main, world
+from harness import BIN, ROOT, Server, check, main, world
 
 
 def get(port, path, method="GET", headers=None):
@@ -75,5 +75,20 @@ def test_example_program():
         check(s.wait(30) == 0, "and the server exits 0")
 
 
+def test_bad_command_lines_exit_2():
+    bad_world = tempfile.NamedTemporaryFile("w", suffix=".json", delete=False)
+    bad_world.write('{"format": "turtlegas-world/1", "balls": [{"id": "b", "pos": [1, 1], "radius": -1}]}')
+    bad_world.close()
+    try:
+        for args, words in (([bad_world.name], "/balls/0/radius"), ([world("protocol_room.json"), "--speed", "0"], "--speed"),
+                            ([world("protocol_room.json"), "--bind", "0.0.0.0"], "--token"),
+                            ([world("protocol_room.json"), "--bind", "nowhere"], "--bind"),
+                            ([world("protocol_room.json"), "--save-dir", "/nonexistent/dir"], "--save-dir")):
+            r = subprocess.run([BIN, "serve", *args, "--port", "0"], capture_output=True, text=True, timeout=60)
+            check(r.returncode == 2 and words in r.stderr, "exit 2 naming %s: %d %r" % (words, r.returncode, r.stderr))
+    finally:
+        os.unlink(bad_world.name)
+
+
 if __name__ == "__main__":
-    main([test_http_routes, test_example_program])
+    main([test_http_routes, test_example_program, test_bad_command_lines_exit_2])

@@ -184,5 +184,52 @@ def test_binary_frames():
         s.stop()
 
 
+def test_region():
+    """b1 starts at (400, 300), b2 at (420, 100): a region around b1 carries b1 alone."""
+    with Server(world("protocol_room.json"), "--paused") as s:
+        for w, fmt in ((World.connect("127.0.0.1", s.line_port), "json"), (World.connect_ws("127.0.0.1", s.http_port), "binary")):
+            sub = w.subscribe(rate=20, fmt=fmt, region=[300, 200, 500, 400])
+            check(sub["region"] == [300, 200, 500, 400], "subscribed with the region: %r" % sub)
+            check(w.frames.get(timeout=10)["type"] == "snapshot", "the snapshot (all balls)")
+            f = w.frames.get(timeout=10)
+            if fmt == "json":
+                check(f["balls"]["index"] == [0] and f["balls"]["pos"] == [400, 300] and len(f["balls"]["vel"]) == 2,
+                      "JSON: b1 only: %r" % f["balls"])
+            else:
+                check(list(f["index"]) == [0] and list(f["pos"]) == [400.0, 300.0], "binary: b1 only: %r" % (f,))
+            for bad, code in (([1, 2, 3], "wrong_type"), ([5, 0, 1, 10], "bad_value"), ("all", "wrong_type")):
+                try:
+                    w.request({"type": "subscribe", "region": bad})
+                    check(False, "region %r refused" % (bad,))
+                except Exception as e:
+                    check(e.reply["code"] == code and e.reply["field"] == "/region", "%r: %r" % (bad, e.reply))
+        s.stop()
+
+
+def test_resume_cancels_run_until():
+    """A resume after run_until runs on past its time (the doc session above raced with it)."""
+    with Server(world("protocol_room.json"), "--paused", "--speed", "max") as s:
+        w = World.connect("127.0.0.1", s.line_port)
+        check(w.run_until(0.5)["status"]["until"] == 0.5, "run_until sets the stop")
+        r = w.resume()
+        check(r["status"]["until"] is None and not r["status"]["paused"], "resume cancels it: %r" % r["status"])
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline and w.ping()["t"] <= 1.0:
+            time.sleep(0.02)
+        check(w.ping()["t"] > 1.0, "the world ran past 0.5")
+        w.run_until(w.ping()["t"] + 0.5)
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline and not (w.status and w.status["paused"]):
+            try:
+                n = w.notices.get(timeout=1)
+                if n.get("type") == "status":
+                    w.status = n["status"]
+            except Exception:
+                pass
+        check(w.status["paused"], "run_until alone pauses at its time: %r" % w.status)
+        s.stop()
+
+
 if __name__ == "__main__":
-    main([test_doc_examples_over_lines, test_doc_examples_over_websocket, test_binary_frames])
+    main([test_doc_examples_over_lines, test_doc_examples_over_websocket, test_binary_frames, test_region,
+          test_resume_cancels_run_until])

@@ -4,7 +4,9 @@
 // and handed to every subscriber of that kind as one immutable buffer.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <optional>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -25,6 +27,8 @@ struct FrameKind {
   bool all_events = false;
   std::vector<std::string> events;  ///< sorted, when not all_events
   bool velocities = true;
+  /// Only the balls whose centres lie in [x0, x1] x [y0, y1] (docs/protocol.md, "region").
+  std::optional<std::array<double, 4>> region;
   std::string key() const;
   bool wants(std::string_view event_kind) const;
 };

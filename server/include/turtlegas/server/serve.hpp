@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `turtlegas serve`'s engine room: the listeners (HTTP + WebSocket, TCP lines), the io_context on
-// the calling thread, the world host on the simulation thread, SIGINT/SIGTERM.
+// a thread of its own, the world host on the calling thread (the simulation thread), SIGINT/SIGTERM.
 #pragma once
 
 #include <filesystem>
