@@ -13,6 +13,7 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+source "$root/bench/bench_lib.sh"
 build=${BUILD_DIR:-$root/build-bench}
 quick=0
 if [[ ${1:-} == --quick ]]; then quick=1; fi
@@ -43,10 +44,4 @@ start=$SECONDS
 mv "$results.tmp" "$results"
 echo "$(( SECONDS - start )) s; results in $results" >&2
 
-if (( quick )); then
-  python3 "$root/bench/make_accuracy.py" "$results" --machine "$machine"
-else
-  python3 "$root/bench/make_accuracy.py" "$results" --machine "$machine" --doc "$root/docs/performance.md" \
-    --svg "$root/docs/bench/accuracy.svg"
-  echo "tables and plot updated in docs/performance.md" >&2
-fi
+report make_accuracy.py "$results" "$machine" "$quick" "$root/docs/bench/accuracy.svg"
