@@ -247,6 +247,7 @@ def run_box2d(a, out):
         if not sph.exists():
             state = scene.state(tg_build / "turtlegas", 0.0, work / f"walled_{base}.state.json")
             write_sph(sph, scene.width, scene.height, state["balls"], scene.radius)
+            (work / f"walled_{base}.state.json").unlink()
         cases[point] = (scene, world_path, sph, dt, max(10, round(a.ball_steps / scene.n)))
     for rnd in range(a.rounds):
         for point in a.box2d_points:
