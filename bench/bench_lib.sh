@@ -2,18 +2,18 @@
 #
 # What the bench/run_*.sh scripts share; they source this file.
 
-# report SCRIPT RESULTS MACHINE QUICK [SVG]: the tables of RESULTS by bench/SCRIPT, on standard
-# output when QUICK is 1, otherwise into docs/performance.md between the script's GENERATED markers
-# (and the plot into SVG).
+# report SCRIPT RESULTS MACHINE QUICK SVG [PLOT OPTIONS...]: the tables of RESULTS by bench/SCRIPT,
+# on standard output when QUICK is 1, otherwise into docs/performance.md between the script's
+# GENERATED markers, and the plot into SVG (with further plots named by the options).
 report() {
-  local script=$1 results=$2 machine=$3 quick=$4 svg=${5:-}
+  local script=$1 results=$2 machine=$3 quick=$4 svg=$5
+  shift 5
   local root
   root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
   if (( quick )); then
     python3 "$root/bench/$script" "$results" --machine "$machine"
   else
-    python3 "$root/bench/$script" "$results" --machine "$machine" --doc "$root/docs/performance.md" \
-      ${svg:+--svg "$svg"}
+    python3 "$root/bench/$script" "$results" --machine "$machine" --doc "$root/docs/performance.md" --svg "$svg" "$@"
     echo "tables updated in docs/performance.md" >&2
   fi
 }

@@ -207,10 +207,7 @@ def line_plot(path, title, y_label, lines, legend_width=190):
             svg.append(f'<line x1="{left}" y1="{y:.1f}" x2="{width - right}" y2="{y:.1f}" '
                        f'stroke="{"#ccc" if m == 1 else "#eee"}"/>')
             svg.append(f'<text x="{left - 6}" y="{y + 4:.1f}" text-anchor="end">{si(v)}</text>')
-    for e in range(x0, x1 + 1):
-        x = px(10**e)
-        svg.append(f'<line x1="{x:.1f}" y1="{top}" x2="{x:.1f}" y2="{height - bottom}" stroke="#ccc"/>')
-        svg.append(f'<text x="{x:.1f}" y="{height - bottom + 18}" text-anchor="middle">10^{e}</text>')
+    svg += x_decades(x0, x1, px, top, height - bottom, "#ccc", lambda e: f"10^{e}")
     svg.append(f'<text x="{(left + width - right) / 2:.0f}" y="{height - 15}" text-anchor="middle">N (balls)</text>')
     svg.append(f'<text transform="translate(18,{(top + height - bottom) / 2:.0f}) rotate(-90)" '
                f'text-anchor="middle">{y_label}</text>')
@@ -232,16 +229,30 @@ def line_plot(path, title, y_label, lines, legend_width=190):
     pathlib.Path(path).write_text("\n".join(svg) + "\n")
 
 
+def x_decades(x0, x1, px, y_top, y_bottom, stroke, label):
+    """A vertical grid line and its label below the axis at each decade 10^x0 ... 10^x1 of a log
+    axis mapped by px; label(e) is the text for 10^e."""
+    out = []
+    for e in range(x0, x1 + 1):
+        x = px(10.0**e)
+        out.append(f'<line x1="{x:.1f}" y1="{y_top}" x2="{x:.1f}" y2="{y_bottom}" stroke="{stroke}"/>')
+        out.append(f'<text x="{x:.1f}" y="{y_bottom + 18}" text-anchor="middle">{label(e)}</text>')
+    return out
+
+
 class Report:
     """The command line the report scripts share (RESULTS [--machine M] [--doc D] [--svg S]), the
     results and machine files read, and the header and placement of the generated text."""
 
-    def __init__(self, description):
+    def __init__(self, description, options=()):
+        """options: more optional arguments (names such as "--svg-box2d") a script takes."""
         ap = argparse.ArgumentParser(description=description)
         ap.add_argument("results")
         ap.add_argument("--machine")
         ap.add_argument("--doc")
         ap.add_argument("--svg")
+        for name in options:
+            ap.add_argument(name)
         self.args = ap.parse_args()
         self.rows = load(self.args.results)
         self.machine = json.loads(pathlib.Path(self.args.machine).read_text()) if self.args.machine else {}
