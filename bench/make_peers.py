@@ -23,6 +23,7 @@ BEGIN = "<!-- BEGIN GENERATED: bench/make_peers.py -->"
 END = "<!-- END GENERATED: bench/make_peers.py -->"
 TARGET_EDMD = 1.5    # issue 15, target 1: turtlegas / best peer, collisions per CPU-second
 TARGET_BOX2D = 1.5   # target 4: step mode's ball-steps within 1.5x of Box2D's body-steps
+TARGET_SCALING = 2.5  # target 2: cost per collision at N = 10^6 within 2.5x of N = 10^3
 COLOURS = {0.05: "#1f77b4", 0.3: "#d62728", 0.45: "#2ca02c"}
 
 
@@ -147,7 +148,29 @@ def box2d_table(pts):
                      "cpu/wall (median)"], out)
 
 
-def targets(edmd, box2d):
+def scaling_table(pts):
+    """Per density: cost per collision (CPU) at the smallest and the largest N, their ratio per round."""
+    out = []
+    for phi in sorted({round(p.first["phi"], 3) for p in pts}):
+        series = sorted((p for p in pts if round(p.first["phi"], 3) == phi), key=lambda p: p.first["N"])
+        small, large = series[0], series[-1]
+        ns = {r["round"]: r["ns_per_collision"] for r in small.rows}
+        ratios = [r["ns_per_collision"] / ns[r["round"]] for r in large.rows if r["round"] in ns]
+        m = statistics.median(ratios)
+        out.append([f"{phi:.2f}", f"{med(r['ns_per_collision'] for r in small.rows):.0f}",
+                    f"{med(r['ns_per_collision'] for r in large.rows):.0f}",
+                    f"**{m:.2f}** ({min(ratios):.2f}–{max(ratios):.2f})", "met" if m <= TARGET_SCALING else "not met",
+                    fixed(med(r["bytes_per_ball"] for r in large.rows), 0),
+                    fixed(med(r["engine_bytes_per_ball"] for r in large.rows), 0),
+                    "met" if med(r["bytes_per_ball"] for r in large.rows) <= 200 else "not met",
+                    fixed(med(r.get("cpu_over_wall") for p in (small, large) for r in p.rows), 2)])
+    n_small, n_large = n_label(pts[0].first["N"]), n_label(pts[-1].first["N"])
+    return md_table(["φ", f"CPU ns / collision, N = {n_small}", f"N = {n_large}",
+                     f"{n_large} ÷ {n_small} (median of rounds; range)", f"≤ {TARGET_SCALING:g}×",
+                     f"bytes/ball at {n_large} (process)", "(engine)", "≤ 200", "cpu/wall (median)"], out)
+
+
+def targets(edmd, box2d, scaling):
     lines = []
     if edmd:
         rs = [(statistics.median(p.ratios("turtlegas", best_peer(p))), p) for p in edmd if best_peer(p)]
@@ -162,6 +185,13 @@ def targets(edmd, box2d):
         lines.append(f"- step mode's ball-steps within {TARGET_BOX2D:g}× of Box2D's body-steps at the same dt: met at "
                      f"**{met} of {len(rs)}**; lowest **{worst:.2f}** (N = {n_label(wp.first['N'])}, "
                      f"φ = {wp.first['phi']:.2f}, dt = 1/{round(1 / wp.first['dt'])})")
+    for phi in sorted({round(p.first["phi"], 3) for p in scaling}):
+        series = sorted((p for p in scaling if round(p.first["phi"], 3) == phi), key=lambda p: p.first["N"])
+        ns = {r["round"]: r["ns_per_collision"] for r in series[0].rows}
+        m = statistics.median(r["ns_per_collision"] / ns[r["round"]] for r in series[-1].rows if r["round"] in ns)
+        lines.append(f"- cost per collision at N = {n_label(series[-1].first['N'])} within {TARGET_SCALING:g}× of "
+                     f"N = {n_label(series[0].first['N'])} at φ = {phi:.2f}: **{m:.2f}** — "
+                     + ("met" if m <= TARGET_SCALING else "not met"))
     return "\n".join(lines)
 
 
@@ -195,8 +225,14 @@ def main():
                   "standard error of turtlegas's ten equal spans):", "", physics_table(edmd, starts), ""]
     if box2d:
         parts += ["### Step mode against Box2D (walled gas, same start)", "", box2d_table(box2d), ""]
-    if edmd or box2d:
-        parts += ["### Targets", "", targets(edmd, box2d), ""]
+    scaling = points(rows, "scaling", "ns_per_collision")
+    if scaling:
+        rounds = max(r["round"] for p in scaling for r in p.rows) + 1
+        parts += [f"### Scaling: turtlegas alone, walled gas, N = {n_label(scaling[0].first['N'])} and "
+                  f"{n_label(scaling[-1].first['N'])} alternating ({rounds} rounds, gas_bench's default budget)", "",
+                  scaling_table(scaling), ""]
+    if edmd or box2d or scaling:
+        parts += ["### Targets", "", targets(edmd, box2d, scaling), ""]
     if report.args.svg and edmd:
         svg_plot(edmd, report.args.svg)
         parts += [f"![collisions per CPU-second against N]({report.rel(report.args.svg)})", ""]

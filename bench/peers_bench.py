@@ -6,6 +6,7 @@
         [--sets edmd,box2d] [--points N1e4_phi0p05,...] [--rounds 5] [--collisions 3e6]
         [--peers cell_tuned_o3,cell_tuned_ofast] [--per-disc 10] [--core 1]
         [--box2d BIN] [--box2d-points N1e4_phi0p05_dt60,...] [--ball-steps 3e6]
+        [--scaling-points N1e3_phi0p05,N1e6_phi0p05,...] [--scaling-rounds 3]
 
 bench/run_peers.sh builds everything and calls this; see docs/performance.md, "Side by side with
 the best event-driven code".
@@ -23,6 +24,9 @@ first, then last: A B, B A, ...), so that neither program always follows the oth
 Set box2d: turtlegas step mode (gas_bench --mode step) against Box2D (bench/box2d_gas.cpp) on the
 walled scenes worlds/bench/gas_<N>_<phi>.json at dt = 1/n (point names end in _dt<n>), both from
 the scene's generated start, --ball-steps ball-steps (body-steps) each, interleaved the same way.
+
+Set scaling: turtlegas alone on the walled scenes at N = 10^3 and 10^6 (gas_bench's default budget),
+alternating, for the cost per collision at 10^6 against 10^3 and the bytes per ball.
 
 Every run is pinned with taskset to --core (empty: not pinned) and timed by its own CPU clock
 over the simulation loop alone (turtlegas: thread CPU inside advance_to; EDMD: process CPU of its
@@ -275,6 +279,30 @@ def run_box2d(a, out):
                       f"(cpu/wall {line['cpu_over_wall']:.2f}, load {load:.1f})", file=sys.stderr, flush=True)
 
 
+def run_scaling(a, out):
+    """turtlegas alone on the walled scenes worlds/bench/gas_<point>.json with gas_bench's default
+    budget (max(5e6, 10 N) collisions), the points of one density in alternating order each round:
+    cost per collision in CPU time at each N, and memory per ball."""
+    gas_bench = pathlib.Path(a.tg_build) / "bench" / "gas_bench"
+    for rnd in range(a.scaling_rounds):
+        order = a.scaling_points if rnd % 2 == 0 else a.scaling_points[::-1]
+        for slot, point in enumerate(order):
+            n, phi, _ = point_params(point)
+            load = load_average()
+            raw, shown = run_json([gas_bench, ROOT / "worlds" / "bench" / f"gas_{point}.json", "--max-wall", "3000"], a.core)
+            line = {"set": "scaling", "point": point, "N": raw["N"], "phi": raw["phi"], "round": rnd, "slot": slot,
+                    "load_average": load, "program": "turtlegas", "cmd": shown, "collisions": raw["collisions"],
+                    "events": raw["events"], "cpu_seconds": raw["cpu_seconds"], "wall_seconds": raw["wall_seconds"],
+                    "cpu_over_wall": raw["cpu_seconds"] / raw["wall_seconds"],
+                    "ns_per_collision": 1e9 * raw["cpu_seconds"] / raw["collisions"],
+                    "bytes_per_ball": raw["bytes_per_ball"], "engine_bytes_per_ball": raw["engine_bytes_per_ball"],
+                    "raw": raw}
+            emit(out, line)
+            print(f"round {rnd} {point} {line['ns_per_collision']:6.0f} CPU ns/collision, "
+                  f"{line['bytes_per_ball']:.0f} B/ball (cpu/wall {line['cpu_over_wall']:.2f}, load {load:.1f})",
+                  file=sys.stderr, flush=True)
+
+
 def emit(out, line):
     out.write(json.dumps(line) + "\n")
     out.flush()
@@ -286,7 +314,7 @@ def main():
     ap.add_argument("--peer-build", required=True, help="where smallenburg_edmd/build.sh put the peers")
     ap.add_argument("--work", required=True, help="starts and scratch files (kept: starts are reused)")
     ap.add_argument("--out", required=True)
-    ap.add_argument("--sets", default="edmd,box2d")
+    ap.add_argument("--sets", default="edmd,box2d,scaling")
     ap.add_argument("--points", default="N1e4_phi0p05,N1e4_phi0p30,N1e4_phi0p45,N1e5_phi0p05,N1e5_phi0p30,"
                     "N1e5_phi0p45,N1e6_phi0p05,N1e6_phi0p30,N1e6_phi0p45")
     ap.add_argument("--rounds", type=int, default=5)
@@ -297,9 +325,12 @@ def main():
     ap.add_argument("--box2d", help="the box2d_gas program (set box2d)")
     ap.add_argument("--box2d-points", default="N1e4_phi0p05_dt60,N1e4_phi0p30_dt60,N1e4_phi0p05_dt600,N1e4_phi0p30_dt600")
     ap.add_argument("--ball-steps", type=float, default=3e6, help="ball-steps (body-steps) per timed run, set box2d")
+    ap.add_argument("--scaling-points", default="N1e3_phi0p05,N1e6_phi0p05,N1e3_phi0p30,N1e6_phi0p30")
+    ap.add_argument("--scaling-rounds", type=int, default=3)
     a = ap.parse_args()
     a.points = [p for p in a.points.split(",") if p]
     a.box2d_points = [p for p in a.box2d_points.split(",") if p]
+    a.scaling_points = [p for p in a.scaling_points.split(",") if p]
     sets = [s for s in a.sets.split(",") if s]
     if "box2d" in sets and not a.box2d:
         sys.exit("peers_bench: set box2d needs --box2d BIN")
@@ -309,6 +340,8 @@ def main():
             run_edmd(a, out)
         if "box2d" in sets:
             run_box2d(a, out)
+        if "scaling" in sets:
+            run_scaling(a, out)
 
 
 if __name__ == "__main__":
