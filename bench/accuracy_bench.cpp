@@ -5,7 +5,8 @@
 // simulated second.
 //
 //   accuracy_bench [--ballistic WORLD.json] [--gas WORLD.json] [--until T] [--dts 10,30,...]
-//                  [--min-cpu SECONDS]
+//                  [--min-cpu SECONDS] [--walled WORLD.json ...] [--walled-dts 60,600,...]
+//                  [--ball-seconds B] [--state-dir DIR]
 //
 // - ballistic (default worlds/bench/accuracy_ballistic.json): balls that do not meet each other,
 //   under gravity, in a box with walls; each ball's trajectory is known in closed form
@@ -20,19 +21,35 @@
 // few milliseconds is not measured once against the clock's and the scheduler's granularity.
 // Progress goes to stderr.
 //
+// - walled (any number of --walled scenes; none by default): a plain gas of equal discs in a box
+//   with walls, no field (worlds/bench/gas_N*_phi*.json), the scene turtlegas is set beside Box2D
+//   on (bench/box2d_gas.cpp, run by bench/run_accuracy.sh). Both modes are exact without a field,
+//   up to round-off, which chaos amplifies: two exact runs that differ only in round-off part
+//   company after a few collisions per ball. So positions are compared at a short horizon H, about
+//   one collision per ball (1/Gamma for Enskog's collision rate per disc, rounded to a whole number
+//   of 1/60 s): step mode's against exact mode's; exact mode's against a twin exact run with cells
+//   1.5 times as wide, whose balls are brought up to date at other moments (an estimate of its
+//   round-off error, there being no closed form). The energy error is taken at T = max(H, B / N)
+//   (B = --ball-seconds, default 1e4, rounded up to a whole number of 1/60 s), the cost over all of
+//   T. Step mode runs dt = 1/n for each n of --walled-dts (default 60,200,600,2000,6000). With
+//   --state-dir, DIR/<world>.start.sph and DIR/<world>.reference.sph hold the start and exact
+//   mode's state at H ("a x y radius vx vy" per ball, the EDMD peers' format) for Box2D.
 // Every line has scene, world (its name), world_file, N, mode, dt (null in exact mode),
 // sim_seconds, cpu_seconds, wall_seconds, repeats, cpu_per_sim_second (the cost), collisions,
 // ball_ball, ball_wall, events, steps, max_contact_overlap, energy_start, energy_end and
 // energy_error = |E(T) - E(0)| / |E(0)| (World::energy(): kinetic plus potential, zero at y = 0).
 // Ballistic lines add max_position_error and rms_position_error (units) and rms_ball_energy_error
 // (each ball's own relative energy error, RMS over the balls); gas lines add the signed
-// energy_drift.
+// energy_drift; walled lines add energy_drift, horizon, max_position_error and rms_position_error
+// at H, position_reference, enskog_rate and cell_size.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -62,10 +79,28 @@ struct Options {
   double until = 20.0;
   std::vector<int> dts{10, 30, 100, 300, 1000, 3000};  ///< step mode runs dt = 1/n for each n
   double min_cpu = 1.0;
+  std::vector<std::filesystem::path> walled;
+  std::vector<int> walled_dts{60, 200, 600, 2000, 6000};
+  double ball_seconds = 1e4;
+  std::filesystem::path state_dir;
 };
 
 const turtlegas::bench::Usage usage("accuracy_bench [--ballistic WORLD.json] [--gas WORLD.json] [--until T]"
-                                    " [--dts 10,30,100,...] [--min-cpu SECONDS]");
+                                    " [--dts 10,30,100,...] [--min-cpu SECONDS] [--walled WORLD.json ...]"
+                                    " [--walled-dts 60,600,...] [--ball-seconds B] [--state-dir DIR]");
+
+/// "10,30,100" as whole numbers n up to 1e7 (step mode's dt = 1/n), for the option named.
+std::vector<int> dt_list(std::string_view option, const std::string& text) {
+  std::vector<int> out;
+  std::stringstream list(text);
+  for (std::string item; std::getline(list, item, ',');) {
+    const double n = usage.positive(option, item);
+    if (n != std::floor(n) || n > 1e7)
+      usage.error(std::string(option) + " takes whole numbers n up to 1e7 (dt = 1/n), got '" + item + "'");
+    out.push_back(static_cast<int>(n));
+  }
+  return out;
+}
 
 Options parse_options(int argc, char** argv) {
   Options o;
@@ -84,13 +119,15 @@ Options parse_options(int argc, char** argv) {
     } else if (arg == "--min-cpu") {
       o.min_cpu = usage.positive(arg, value());
     } else if (arg == "--dts") {
-      o.dts.clear();
-      std::stringstream list(value());
-      for (std::string item; std::getline(list, item, ',');) {
-        const double n = usage.positive("--dts", item);
-        if (n != std::floor(n) || n > 1e7) usage.error("--dts takes whole numbers n up to 1e7 (dt = 1/n), got '" + item + "'");
-        o.dts.push_back(static_cast<int>(n));
-      }
+      o.dts = dt_list(arg, value());
+    } else if (arg == "--walled") {
+      o.walled.emplace_back(value());
+    } else if (arg == "--walled-dts") {
+      o.walled_dts = dt_list(arg, value());
+    } else if (arg == "--ball-seconds") {
+      o.ball_seconds = usage.positive(arg, value());
+    } else if (arg == "--state-dir") {
+      o.state_dir = value();
     } else if (arg == "-h" || arg == "--help") {
       usage.error("accuracy_bench: accuracy against CPU time, exact and step mode");
     } else {
@@ -106,28 +143,42 @@ struct Run {
   double wall = 0.0;  ///< wall seconds of that repeat
   int repeats = 0;
   std::optional<sim::World> world;
+  std::vector<sim::BallState> at_horizon;  ///< the balls at the horizon, when one was asked for
 };
 
 /// Builds the scene in `mode` and runs it to `until`. Step mode stops a millionth of a step past the
 /// last boundary, so that the last step's kick has been applied however k dt rounds: the state is
-/// then the memo's x_k, v_k (both at t_k), not x_k with v_{k-1}.
-Run run(const sim::WorldDef& def, sim::Mode mode, double until, double min_cpu) {
+/// then the memo's x_k, v_k (both at t_k), not x_k with v_{k-1}. With a horizon (> 0) the run
+/// stops there on the way to take the balls' state, at exactly that time (only for scenes without
+/// a field, where there is no kick to wait for).
+Run run(const sim::WorldDef& def, sim::Mode mode, double until, double min_cpu, double horizon = 0.0) {
   Run best;
   double total = 0.0;
   const double end = mode == sim::Mode::exact ? until : (std::round(until / def.dt) + 1e-6) * def.dt;
   while (best.repeats < 20 && (best.repeats == 0 || total < min_cpu)) {
     sim::WorldDef copy = def;
     sim::World world(std::move(copy), mode);
-    const double cpu_start = thread_cpu_seconds();
-    const auto start = Clock::now();
-    world.advance_to(end);
-    const double cpu = thread_cpu_seconds() - cpu_start;
-    const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+    double cpu = 0.0, wall = 0.0;
+    auto timed_advance = [&](double t) {
+      const double cpu_start = thread_cpu_seconds();
+      const auto start = Clock::now();
+      world.advance_to(t);
+      cpu += thread_cpu_seconds() - cpu_start;
+      wall += std::chrono::duration<double>(Clock::now() - start).count();
+    };
+    std::vector<sim::BallState> at_horizon;
+    if (horizon > 0.0) {
+      timed_advance(horizon);
+      at_horizon.reserve(def.balls.size());
+      for (std::size_t i = 0; i < def.balls.size(); ++i) at_horizon.push_back(world.ball(i));
+    }
+    timed_advance(end);
     total += cpu;
     if (best.repeats == 0 || cpu < best.cpu) {
       best.cpu = cpu;
       best.wall = wall;
       best.world.emplace(std::move(world));
+      best.at_horizon = std::move(at_horizon);
     }
     ++best.repeats;
   }
@@ -241,10 +292,101 @@ void run_scene(std::string_view scene, const std::filesystem::path& file, const 
   }
 }
 
+/// Position error of `got` against `ref` (same balls, same order): max and RMS over the balls.
+std::pair<double, double> position_error(const std::vector<sim::BallState>& got, const std::vector<sim::BallState>& ref) {
+  double max_err = 0.0, sum2 = 0.0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    const double e = sim::norm(got[i].pos - ref[i].pos);
+    max_err = std::max(max_err, e);
+    sum2 += e * e;
+  }
+  return {max_err, std::sqrt(sum2 / static_cast<double>(ref.size()))};
+}
+
+/// Balls as the EDMD peers' .sph file (N, the box, "a x y radius vx vy"), exact doubles.
+void write_sph(const std::filesystem::path& path, const sim::WorldDef& def, const std::vector<sim::BallState>& balls) {
+  std::FILE* f = std::fopen(path.string().c_str(), "w");
+  if (!f) throw std::runtime_error(path.string() + ": cannot write");
+  std::fprintf(f, "%zu\n%.17g %.17g\n", balls.size(), def.arena.width, def.arena.height);
+  for (std::size_t i = 0; i < balls.size(); ++i)
+    std::fprintf(f, "a %.17g %.17g %.17g %.17g %.17g\n", balls[i].pos.x, balls[i].pos.y, def.balls[i].radius,
+                 balls[i].vel.x, balls[i].vel.y);
+  if (std::fclose(f) != 0) throw std::runtime_error(path.string() + ": cannot write");
+}
+
+/// The walled gas: exact mode, its twin with wider cells, and step mode at each of --walled-dts.
+void run_walled(const std::filesystem::path& file, const Options& opt) {
+  sim::WorldDef def = turtlegas::world::load_world_file(file);
+  if (def.name.empty()) def.name = file.stem().string();
+  const sim::EffectsDef& fx = def.effects;
+  const bool equal = !def.balls.empty() && std::all_of(def.balls.begin(), def.balls.end(), [&](const sim::BallDef& b) {
+    return b.radius == def.balls[0].radius && b.mass == def.balls[0].mass;
+  });
+  if (!fx.ball_ball || fx.gravity.x != 0.0 || fx.gravity.y != 0.0 || fx.restitution != 1.0 ||
+      def.arena.boundary != sim::Boundary::walls || !def.walls.empty() || !def.turtles.empty() || !equal)
+    throw std::invalid_argument(file.string() +
+                                ": a walled scene is a gas of equal balls (same radius and mass) with ball_ball on, "
+                                "no gravity, restitution 1, boundary walls and no walls or turtles of its own");
+  const auto n = static_cast<double>(def.balls.size());
+  const double r = def.balls[0].radius, m = def.balls[0].mass;
+  const double area = def.arena.width * def.arena.height;
+  const double phi = n * std::numbers::pi * r * r / area;
+  double kinetic = 0.0;
+  for (const sim::BallDef& b : def.balls) kinetic += 0.5 * b.mass * sim::norm2(b.vel);
+  // Enskog's collision rate per disc with Henderson's contact value (2-D: kT = mean kinetic energy).
+  const double kT = kinetic / n;
+  const double g = (1.0 - 7.0 * phi / 16.0) / ((1.0 - phi) * (1.0 - phi));
+  const double rate = 2.0 * (n / area) * 2.0 * r * std::sqrt(std::numbers::pi * kT / m) * g;
+  const double horizon = std::max(1.0, std::round(60.0 / rate)) / 60.0;
+  const double until = std::max(horizon, std::ceil(60.0 * opt.ball_seconds / n) / 60.0);
+
+  const double energy0 = sim::World(def, sim::Mode::exact).energy();
+  auto emit = [&](sim::Mode mode, const Run& r, std::pair<double, double> err, std::string_view reference) {
+    nlohmann::ordered_json out = common("walled", file, def, mode, r);
+    const double e1 = r.world->energy();
+    out["energy_start"] = energy0;
+    out["energy_end"] = e1;
+    out["energy_drift"] = (e1 - energy0) / std::abs(energy0);
+    out["energy_error"] = std::abs(e1 - energy0) / std::abs(energy0);
+    out["horizon"] = horizon;
+    out["max_position_error"] = err.first;
+    out["rms_position_error"] = err.second;
+    out["position_reference"] = reference;
+    out["enskog_rate"] = rate;
+    out["phi"] = phi;
+    out["cell_size"] = r.world->cell_size();
+    std::cout << out.dump() << std::endl;
+    std::cerr << "walled " << def.balls.size() << ' ' << mode_name(mode);
+    if (mode == sim::Mode::step) std::cerr << " dt=1/" << std::lround(1.0 / def.dt);
+    std::cerr << ": " << r.cpu << " cpu s, energy error " << out["energy_error"].get<double>() << ", RMS position error "
+              << err.second << " at " << horizon << " s\n";
+  };
+
+  const Run exact = run(def, sim::Mode::exact, until, opt.min_cpu, horizon);
+  sim::WorldDef twin = def;
+  twin.arena.cell = 1.5 * exact.world->cell_size();
+  const Run twin_run = run(twin, sim::Mode::exact, horizon, 0.0, horizon);
+  emit(sim::Mode::exact, exact, position_error(twin_run.at_horizon, exact.at_horizon),
+       "twin exact run, cells 1.5x as wide");
+  if (!opt.state_dir.empty()) {
+    std::filesystem::create_directories(opt.state_dir);
+    std::vector<sim::BallState> start;
+    for (const sim::BallDef& b : def.balls) start.push_back({b.pos, b.vel});
+    write_sph(opt.state_dir / (file.stem().string() + ".start.sph"), def, start);
+    write_sph(opt.state_dir / (file.stem().string() + ".reference.sph"), def, exact.at_horizon);
+  }
+  for (int k : opt.walled_dts) {
+    def.dt = 1.0 / k;
+    const Run step = run(def, sim::Mode::step, until, opt.min_cpu, horizon);
+    emit(sim::Mode::step, step, position_error(step.at_horizon, exact.at_horizon), "exact run");
+  }
+}
+
 int run_main(int argc, char** argv) {
   const Options opt = parse_options(argc, argv);
   run_scene("ballistic", opt.ballistic, opt);
   run_scene("gas", opt.gas, opt);
+  for (const auto& file : opt.walled) run_walled(file, opt);
   return 0;
 }
 

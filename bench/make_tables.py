@@ -165,12 +165,22 @@ def svg_plot(rows, path):
     for r in rows:
         if r["collisions"] > 0:
             series.setdefault((r["mode"], phi_key(r)), []).append((r["N"], r["ns_per_collision"]))
-    if not series:
+    colours = {("exact", 0.05): "#1f77b4", ("exact", 0.3): "#d62728", ("step", 0.05): "#2ca02c", ("step", 0.3): "#ff7f0e"}
+    lines = [(f"{key[0]}, φ = {key[1]:g}", colours.get(key, "#555"), key[0] == "step", pts)
+             for key, pts in sorted(series.items())]
+    line_plot(path, "turtlegas: wall-clock ns per collision (log-log)", "ns per collision", lines)
+
+
+def line_plot(path, title, y_label, lines, legend_width=190):
+    """A log-log plot against N, written as SVG by hand: lines are (label, colour, dashed, [(N, y)]),
+    drawn and listed in the legend in that order."""
+    lines = [line for line in lines if line[3]]
+    if not lines:
         return
-    width, height = 720, 460
-    left, right, top, bottom = 80, 190, 40, 60
-    ns_all = [v for pts in series.values() for _, v in pts]
-    n_all = [n for pts in series.values() for n, _ in pts]
+    width, height = 530 + legend_width, 460
+    left, right, top, bottom = 80, legend_width, 40, 60
+    ns_all = [v for *_, pts in lines for _, v in pts]
+    n_all = [n for *_, pts in lines for n, _ in pts]
     x0, x1 = math.floor(math.log10(min(n_all))), math.ceil(math.log10(max(n_all)))
     y0, y1 = math.floor(math.log10(min(ns_all))), math.ceil(math.log10(max(ns_all)))
     if x1 == x0:
@@ -184,11 +194,10 @@ def svg_plot(rows, path):
     def py(v):
         return height - bottom - (math.log10(v) - y0) / (y1 - y0) * (height - top - bottom)
 
-    colours = {("exact", 0.05): "#1f77b4", ("exact", 0.3): "#d62728", ("step", 0.05): "#2ca02c", ("step", 0.3): "#ff7f0e"}
     svg = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
            f'font-family="sans-serif" font-size="12">',
            f'<rect width="{width}" height="{height}" fill="white"/>',
-           f'<text x="{left}" y="22" font-size="14">turtlegas: wall-clock ns per collision (log-log)</text>']
+           f'<text x="{left}" y="22" font-size="14">{title}</text>']
     for e in range(y0, y1 + 1):
         for m in (1, 2, 5):
             v = m * 10**e
@@ -198,19 +207,15 @@ def svg_plot(rows, path):
             svg.append(f'<line x1="{left}" y1="{y:.1f}" x2="{width - right}" y2="{y:.1f}" '
                        f'stroke="{"#ccc" if m == 1 else "#eee"}"/>')
             svg.append(f'<text x="{left - 6}" y="{y + 4:.1f}" text-anchor="end">{si(v)}</text>')
-    for e in range(x0, x1 + 1):
-        x = px(10**e)
-        svg.append(f'<line x1="{x:.1f}" y1="{top}" x2="{x:.1f}" y2="{height - bottom}" stroke="#ccc"/>')
-        svg.append(f'<text x="{x:.1f}" y="{height - bottom + 18}" text-anchor="middle">10^{e}</text>')
+    svg += x_decades(x0, x1, px, top, height - bottom, "#ccc", lambda e: f"10^{e}")
     svg.append(f'<text x="{(left + width - right) / 2:.0f}" y="{height - 15}" text-anchor="middle">N (balls)</text>')
     svg.append(f'<text transform="translate(18,{(top + height - bottom) / 2:.0f}) rotate(-90)" '
-               f'text-anchor="middle">ns per collision</text>')
+               f'text-anchor="middle">{y_label}</text>')
     svg.append(f'<rect x="{left}" y="{top}" width="{width - left - right}" height="{height - top - bottom}" '
                f'fill="none" stroke="#333"/>')
-    for k, (key, pts) in enumerate(sorted(series.items())):
-        pts.sort()
-        colour = colours.get(key, "#555")
-        dash = ' stroke-dasharray="6,4"' if key[0] == "step" else ""
+    for k, (label, colour, dashed, pts) in enumerate(lines):
+        pts = sorted(pts)
+        dash = ' stroke-dasharray="6,4"' if dashed else ""
         d = " ".join(f"{px(n):.1f},{py(v):.1f}" for n, v in pts)
         svg.append(f'<polyline points="{d}" fill="none" stroke="{colour}" stroke-width="2"{dash}/>')
         for n, v in pts:
@@ -218,22 +223,36 @@ def svg_plot(rows, path):
         ly = top + 10 + 22 * k
         lx = width - right + 14
         svg.append(f'<line x1="{lx}" y1="{ly}" x2="{lx + 28}" y2="{ly}" stroke="{colour}" stroke-width="2"{dash}/>')
-        svg.append(f'<text x="{lx + 34}" y="{ly + 4}">{key[0]}, φ = {key[1]:g}</text>')
+        svg.append(f'<text x="{lx + 34}" y="{ly + 4}">{label}</text>')
     svg.append("</svg>")
     pathlib.Path(path).parent.mkdir(parents=True, exist_ok=True)
     pathlib.Path(path).write_text("\n".join(svg) + "\n")
+
+
+def x_decades(x0, x1, px, y_top, y_bottom, stroke, label):
+    """A vertical grid line and its label below the axis at each decade 10^x0 ... 10^x1 of a log
+    axis mapped by px; label(e) is the text for 10^e."""
+    out = []
+    for e in range(x0, x1 + 1):
+        x = px(10.0**e)
+        out.append(f'<line x1="{x:.1f}" y1="{y_top}" x2="{x:.1f}" y2="{y_bottom}" stroke="{stroke}"/>')
+        out.append(f'<text x="{x:.1f}" y="{y_bottom + 18}" text-anchor="middle">{label(e)}</text>')
+    return out
 
 
 class Report:
     """The command line the report scripts share (RESULTS [--machine M] [--doc D] [--svg S]), the
     results and machine files read, and the header and placement of the generated text."""
 
-    def __init__(self, description):
+    def __init__(self, description, options=()):
+        """options: more optional arguments (names such as "--svg-box2d") a script takes."""
         ap = argparse.ArgumentParser(description=description)
         ap.add_argument("results")
         ap.add_argument("--machine")
         ap.add_argument("--doc")
         ap.add_argument("--svg")
+        for name in options:
+            ap.add_argument(name)
         self.args = ap.parse_args()
         self.rows = load(self.args.results)
         self.machine = json.loads(pathlib.Path(self.args.machine).read_text()) if self.args.machine else {}

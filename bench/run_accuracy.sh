@@ -1,52 +1,89 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 #
-# Builds accuracy_bench (Release, build-bench/), runs it (exact mode and step mode at six dt on the
-# ballistic scene and the memo's gas under gravity, one process, about 30 s), writes the JSON lines
-# to docs/bench/accuracy-DATE-HOST-COMMIT.jsonl and regenerates the "What accuracy costs" tables and
-# the plot docs/bench/accuracy.svg in docs/performance.md.
+# Builds accuracy_bench (Release, build-bench/) and bench/box2d_gas.cpp (Box2D from Debian's
+# libbox2d-dev, installed if missing; into build-peers/), runs exact mode and step mode at six dt on
+# the ballistic scene and the memo's gas under gravity (one process, about 30 s), then exact mode,
+# step mode and Box2D at dt = 1/60 ... 1/6000 on the walled gas at N = 10^3, 10^4 and 10^5,
+# phi = 0.3 (about 10 minutes), writes the JSON lines to docs/bench/accuracy-DATE-HOST-COMMIT.jsonl
+# and regenerates the "What accuracy costs" tables and the plots docs/bench/accuracy.svg and
+# docs/bench/accuracy_box2d.svg in docs/performance.md.
 #
 #   bash bench/run_accuracy.sh           # the full set
-#   bash bench/run_accuracy.sh --quick   # T = 5 s, three dt: checks the script; leaves docs/ alone
+#   bash bench/run_accuracy.sh --quick   # T = 5 s, three dt, the walled gas at N = 10^3 only:
+#                                        # checks the script; leaves docs/ alone
 #
-# BUILD_DIR picks another build directory (an existing Release build is reused as it is).
+# BUILD_DIR picks another build directory (an existing Release build is reused as it is);
+# PEER_BUILD where box2d_gas goes (build-peers/).
 set -euo pipefail
 
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-build=${BUILD_DIR:-$root/build-bench}
-quick=0
-if [[ ${1:-} == --quick ]]; then quick=1; fi
+# The whole script is one function, read before any of it runs: editing the file during a long run
+# cannot change what the run does.
+main() {
+  root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+  source "$root/bench/bench_lib.sh"
+  build=${BUILD_DIR:-$root/build-bench}
+  quick=0
+  if [[ ${1:-} == --quick ]]; then quick=1; fi
 
-if [[ ! -f $build/CMakeCache.txt ]]; then
-  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DBUILD_TESTING=OFF > /dev/null
-fi
-cmake --build "$build" --target accuracy_bench
+  if [[ ! -f $build/CMakeCache.txt ]]; then
+    cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DBUILD_TESTING=OFF > /dev/null
+  fi
+  cmake --build "$build" --target accuracy_bench
 
-stamp=$(date -u +%Y-%m-%d)
-host=$(hostname -s 2>/dev/null || echo host)
-commit=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
-if (( quick )); then
-  out_dir=$build/quick
-  args=(--until 5 --dts 10,100,1000 --min-cpu 0.1)
-else
-  out_dir=$root/docs/bench
-  args=()
-fi
-mkdir -p "$out_dir"
-results=$out_dir/accuracy-$stamp-$host-$commit.jsonl
-machine=$out_dir/accuracy-$stamp-$host-$commit.machine.json
-bash "$root/bench/machine_json.sh" "$build" > "$machine"
+  stamp=$(date -u +%Y-%m-%d)
+  host=$(hostname -s 2>/dev/null || echo host)
+  commit=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
+  peer_build=${PEER_BUILD:-$root/build-peers}
+  box2d_build "$peer_build/box2d_gas"
+  states=$peer_build/accuracy-states
+  walled_dts=(60 200 600 2000 6000)
+  if (( quick )); then
+    out_dir=$build/quick
+    walled=(worlds/bench/gas_N1e3_phi0p30.json)
+    walled_dts=(60 600)
+    min_cpu=0.1
+    args=(--until 5 --dts 10,100,1000 --min-cpu "$min_cpu" --ball-seconds 2000)
+  else
+    out_dir=$root/docs/bench
+    walled=(worlds/bench/gas_N1e3_phi0p30.json worlds/bench/gas_N1e4_phi0p30.json worlds/bench/gas_N1e5_phi0p30.json)
+    min_cpu=1  # accuracy_bench's default
+    args=()
+  fi
+  for w in "${walled[@]}"; do args+=(--walled "$w"); done
+  args+=(--walled-dts "$(IFS=,; echo "${walled_dts[*]}")" --state-dir "$states")
+  mkdir -p "$out_dir"
+  results=$out_dir/accuracy-$stamp-$host-$commit.jsonl
+  machine=$out_dir/accuracy-$stamp-$host-$commit.machine.json
+  bash "$root/bench/machine_json.sh" "$build" > "$machine"
 
-start=$SECONDS
-# From the repository root: the bench's default world files are relative to it.
-(cd "$root" && "$build/bench/accuracy_bench" "${args[@]}") > "$results.tmp"
-mv "$results.tmp" "$results"
-echo "$(( SECONDS - start )) s; results in $results" >&2
+  start=$SECONDS
+  # From the repository root: the bench's default world files are relative to it.
+  (cd "$root" && "$build/bench/accuracy_bench" "${args[@]}") > "$results.tmp"
+  # Box2D on each walled scene from the same start, positions compared with exact mode's at the same
+  # horizon, the run as long as turtlegas's (both from accuracy_bench's exact-mode line), repeated
+  # like accuracy_bench's runs until they add up to min_cpu.
+  for w in "${walled[@]}"; do
+    stem=$(basename "$w" .json)
+    read -r horizon until < <(python3 -c 'import json, sys
+  for line in open(sys.argv[1]):
+      r = json.loads(line)
+      if r["scene"] == "walled" and r["mode"] == "exact" and r["world_file"] == sys.argv[2]:
+          print(repr(r["horizon"]), repr(r["sim_seconds"]))' "$results.tmp" "$w")
+    for n in "${walled_dts[@]}"; do
+      "$peer_build/box2d_gas" "$states/$stem.start.sph" --dt "$(python3 -c "print(repr(1 / $n))")" --until "$until" \
+        --reference "$states/$stem.reference.sph" --horizon "$horizon" --min-cpu "$min_cpu" --name "$w" >> "$results.tmp"
+      tail -n 1 "$results.tmp" | python3 -c 'import json, sys
+  r = json.load(sys.stdin)
+  print("walled %s box2d dt=1/%s: %.3g cpu s, energy error %.3g, RMS position error %.3g" % (sys.argv[1], sys.argv[2],
+        r["cpu_seconds"], r["energy_error"], r["rms_position_error"]))' "$stem" "$n" >&2
+    done
+  done
+  mv "$results.tmp" "$results"
+  echo "$(( SECONDS - start )) s; results in $results" >&2
 
-if (( quick )); then
-  python3 "$root/bench/make_accuracy.py" "$results" --machine "$machine"
-else
-  python3 "$root/bench/make_accuracy.py" "$results" --machine "$machine" --doc "$root/docs/performance.md" \
-    --svg "$root/docs/bench/accuracy.svg"
-  echo "tables and plot updated in docs/performance.md" >&2
-fi
+  report make_accuracy.py "$results" "$machine" "$quick" "$root/docs/bench/accuracy.svg" \
+    --svg-box2d "$root/docs/bench/accuracy_box2d.svg"
+}
+
+main "$@"

@@ -12,6 +12,7 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+source "$root/bench/bench_lib.sh"
 build=${BUILD_DIR:-$root/build-bench}
 quick=0
 if [[ ${1:-} == --quick ]]; then quick=1; fi
@@ -60,10 +61,4 @@ mv "$tmp" "$results"
 trap - EXIT
 echo "$(( SECONDS - start )) s; results in $results" >&2
 
-if (( quick )); then
-  python3 "$root/bench/make_tables.py" "$results" --machine "$machine"
-else
-  python3 "$root/bench/make_tables.py" "$results" --machine "$machine" --doc "$root/docs/performance.md" \
-    --svg "$root/docs/bench/ns_per_collision.svg"
-  echo "tables updated in docs/performance.md" >&2
-fi
+report make_tables.py "$results" "$machine" "$quick" "$root/docs/bench/ns_per_collision.svg"
