@@ -102,7 +102,7 @@ void WorldServer::Impl::run_program(Agent& a) {
     world.command_turtle(a.index, {sim::TurtleCommand::Kind::stop, 0.0});
     if (!fault.empty()) {
       spdlog::error("turtle '{}' stopped at t={:.6g}: {}", a.id, now, fault);
-      emit({now, "fault", a.id, {}, {}, 0.0, fault});
+      emit({now, "fault", a.id, {}, {}, 0.0, fault, {}});
     }
   };
   switch (outcome) {
@@ -159,7 +159,7 @@ void WorldServer::Impl::control_step() {
     Agent& a = *agents[c.turtle];
     Touch t = a.make_touch(c);
     if (log) {
-      LogEvent e{now, "touch", a.id, t.what, {}, t.bearing, {}};
+      LogEvent e{now, "touch", a.id, t.what, {}, t.bearing, {}, {}};
       for (std::size_t s = 0; s < a.program.sensors.size(); ++s)
         if (t.fired(s)) e.sensors.push_back(a.program.sensors[s].name);
       emit(std::move(e));
@@ -200,7 +200,7 @@ void WorldServer::Impl::drain_sim_events() {
     for (const sim::Event& e : sim_log) {
       const EventIds ids = name_event(e, names());
       emit({e.t, std::string(sim::to_string(e.kind)), std::string(ids.a), ids.b ? std::string(*ids.b) : std::string(),
-            {}, 0.0, {}});
+            {}, 0.0, {}, ids.c ? std::string(*ids.c) : std::string()});
     }
   sim_log.clear();
 }
