@@ -61,6 +61,14 @@ double choose_cell_size(const WorldDef& def, Mode mode) {
   }
   double cell = std::max(rule * (1.0 + 1e-9), preferred);
   cell = std::max(cell, std::sqrt(area / 4.0e7));  // keep the table under ~4e7 cells
+  // Keep the walls' lists under ~1e7 entries: a wall is listed in each cell it crosses (about
+  // length / cell + 2 of them) and again in the 3x3 neighbourhood of each, ten entries a cell.
+  // (A 1e15-long arena wall once crossed 3e7 cells and took 10 GB.) Never binding for walls of a
+  // sensible length: 4 x 1600 units of arena walls would need cells of 0.006.
+  double wall_length = 0.0;
+  for (const WallDef& w : def.walls) wall_length += norm(w.to - w.from);
+  if (def.arena.boundary == Boundary::walls) wall_length += 2.0 * (width + height);
+  cell = std::max(cell, 10.0 * wall_length / 1.0e7);
   // A periodic arena needs three cells across, so that no pair is seen through two images.
   if (def.arena.boundary == Boundary::periodic)
     cell = std::max(rule * (1.0 + 1e-9), std::min(cell, std::min(width, height) / 3.0));

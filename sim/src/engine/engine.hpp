@@ -269,9 +269,20 @@ Engine<F, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<Ba
   const std::size_t n = bodies_.size();
 
   grid_ = CellGrid(arena_.width, arena_.height, cell_, arena_.periodic(), walls_.segments, walls_.ends, walls_.moving());
-  if (arena_.periodic() && (grid_.nx() < 3 || grid_.ny() < 3))
+  if (arena_.periodic() && (grid_.nx() < 3 || grid_.ny() < 3)) {
+    if (kStep && !def.arena.cell) {
+      // The cell is the memo's rule 2 (r_max + v_max dt): name what made it too wide.
+      double vmax = 0.0;
+      for (std::uint32_t i = 0; i < n; ++i) vmax = std::max(vmax, norm(bodies_.body[i].v));
+      throw std::invalid_argument("step mode: the fastest body's speed " + format_number(vmax) + " at dt = " +
+                                  format_number(dt_) + " makes the cell rule 2 (r_max + v_max dt) = " +
+                                  format_number(cell_) + ", more than a third of this periodic arena (" +
+                                  format_number(arena_.width) + " x " + format_number(arena_.height) +
+                                  "): use a smaller dt or --mode exact");
+    }
     throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell_) +
                                 "); enlarge the arena or use smaller balls");
+  }
 
   if (restitution_.inelastic) restitution_.last_time.assign(n, -kNever);
   bodies_.make_lists(static_cast<std::size_t>(grid_.cell_count()), kExtras);
@@ -366,6 +377,7 @@ bool Engine<F, kBallBall, kStep, kExtras>::process(double limit) {
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
 void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
   const Pending p = bodies_.pending[i];
+  const LastPartner before = bodies_.last[i];
   switch (p.kind) {
     case Partner::body:
       if (bodies_.body[p.partner].count != p.partner_count) {
