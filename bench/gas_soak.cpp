@@ -113,9 +113,11 @@ int main(int argc, char** argv) {
     }
   }
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  char drift_text[32];
+  std::snprintf(drift_text, sizeof drift_text, "%.3g", worst_drift);
   std::printf("ok: %s, %d balls, phi 0.5, %.4g collisions in %.4g s of simulated time, %llu checks; "
               "worst overlap %.3g of a radius, worst energy drift %s, no NaN, no escape (%.0f s)\n",
               scene.c_str(), n, static_cast<double>(w.stats().collisions()), t, static_cast<unsigned long long>(checks),
-              worst_overlap, moving ? "(not checked: the walls do work)" : std::to_string(worst_drift).c_str(), secs);
+              worst_overlap, moving ? "(not checked: the walls do work)" : drift_text, secs);
   return 0;
 }
