@@ -26,6 +26,8 @@ nlohmann::json stats_json(const RunFigures& run, const sim::World& world) {
       {"ball_wall", st.ball_wall},
       {"ball_wall_end", st.ball_wall_end},
       {"exits", st.exits},
+      {"wedged", st.wedged},
+      {"crushed", st.crushed},
       {"turtle_wall", st.turtle_wall},
       {"turtle_wall_end", st.turtle_wall_end},
       {"turtle_turtle", st.turtle_turtle},

@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+
+#include "turtlegas/sim/format.hpp"
 
 namespace turtlegas::sim::detail {
 namespace {
@@ -27,30 +30,73 @@ bool segment_meets_box(Vec2 p, Vec2 q, double x0, double y0, double x1, double y
   return true;
 }
 
+// floor(x / cell) + 1 clamped to [lo, hi], decided in double: a coordinate of 1e30 (or a NaN)
+// must not reach an int conversion, which would be undefined (a wall ending at y = 1e30 once
+// landed in no cell at all and balls passed through it).
+int clamped_index(double x, double cell, int lo, int hi) {
+  const double k = std::floor(x / cell) + 1.0;
+  if (!(k > lo)) return lo;
+  if (!(k < hi)) return hi;
+  return static_cast<int>(k);
+}
+
+// Cells along one side: floor(extent / min_cell), at least 1, decided in double (an arena 1e10
+// wide with cells of 1e-10 overflows an int). kMaxCells bounds the product, so the clamp here
+// only keeps the conversion defined.
+int cells_along(double extent, double min_cell) {
+  const double k = std::floor(extent / min_cell);
+  if (!(k >= 1.0)) return 1;
+  return k > 1e9 ? 1000000000 : static_cast<int>(k);
+}
+
 }  // namespace
 
 CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
                    const std::vector<Segment>& walls, const std::vector<WallEnd>& ends,
                    const std::vector<bool>& skip)
     : width_(width), height_(height), periodic_(periodic) {
-  nx_ = std::max(1, static_cast<int>(std::floor(width / min_cell)));
-  ny_ = std::max(1, static_cast<int>(std::floor(height / min_cell)));
+  const double nxd = std::max(1.0, std::floor(width / min_cell)), nyd = std::max(1.0, std::floor(height / min_cell));
+  if (!((nxd + 2.0) * (nyd + 2.0) <= 2.0e8))
+    throw std::invalid_argument("the grid would need more than 2e8 cells (" + format_number(nxd) + " x " +
+                                format_number(nyd) + " of " + format_number(min_cell) +
+                                "); set a larger arena.cell, or make arena.width and arena.height less unequal");
+  nx_ = cells_along(width, min_cell);
+  ny_ = cells_along(height, min_cell);
   cw_ = width / nx_;
   ch_ = height / ny_;
-  if (static_cast<double>(nx_ + 2) * (ny_ + 2) > 2.0e8)
-    throw std::invalid_argument("the grid would need more than 2e8 cells; set a larger arena.cell");
   for (int k = 0; k <= nx_ + 1; ++k) x_lines_.push_back(x_edge(k));
   for (int k = 0; k <= ny_ + 1; ++k) y_lines_.push_back(y_edge(k));
   for (int sy = 0; sy < 3; ++sy)
     for (int sx = 0; sx < 3; ++sx) shifts_[sy * 3 + sx] = {(sx - 1) * width, (sy - 1) * height};
 
   const auto n = static_cast<std::size_t>(cell_count());
-  (void)n;
+  {
+    // The memory budget, checked before anything is listed: 4 bytes a cell, and per wall about
+    // length / cell + 2 cells crossed, each listed once in its own cell and nine times in the
+    // neighbourhoods around it (a (cell, item) pair of 8 bytes while sorting, 12 once stored).
+    double entries = 0.0, longest = 0.0;
+    for (std::uint32_t w = 0; w < walls.size(); ++w) {
+      if (w < skip.size() && skip[w]) continue;
+      const Vec2 d = walls[w].len * walls[w].u;
+      const double crossed = std::min(std::abs(d.x) / cw_ + 2.0, nx_ + 2.0) + std::min(std::abs(d.y) / ch_ + 2.0, ny_ + 2.0);
+      entries += 10.0 * crossed;
+      longest = std::max(longest, walls[w].len);
+    }
+    entries += 10.0 * static_cast<double>(ends.size());
+    const double bytes = 4.0 * static_cast<double>(n) + 12.0 * entries;
+    if (bytes > kMemoryBudget)
+      throw std::invalid_argument(
+          "the grid would take " + format_number(std::round(bytes / 1e6)) + " MB (" + std::to_string(n) + " cells of " +
+          format_number(cw_) + " x " + format_number(ch_) + ", about " + format_number(std::round(entries)) +
+          " wall entries), over its budget of " + format_number(kMemoryBudget / 1e6) + " MB; set a larger arena.cell" +
+          (12.0 * entries > 4.0 * static_cast<double>(n) ? " or shorten the longest wall (" + format_number(longest) + " long)"
+                                                          : std::string()));
+  }
   std::vector<std::pair<std::uint32_t, std::uint32_t>> wl, el;
   // A little slack so that a wall running exactly along a grid line is listed on both sides.
   const double sx = 1e-9 * cw_, sy = 1e-9 * ch_;
-  auto col = [&](double x) { return std::clamp(static_cast<int>(std::floor(x / cw_)) + 1, 0, nx_ + 1); };
-  auto row = [&](double y) { return std::clamp(static_cast<int>(std::floor(y / ch_)) + 1, 0, ny_ + 1); };
+  auto col = [&](double x) { return clamped_index(x, cw_, 0, nx_ + 1); };
+  auto row = [&](double y) { return clamped_index(y, ch_, 0, ny_ + 1); };
   for (std::uint32_t w = 0; w < walls.size(); ++w) {
     if (w < skip.size() && skip[w]) continue;
     const Vec2 p = walls[w].p1, q = walls[w].p1 + walls[w].len * walls[w].u;
@@ -74,18 +120,27 @@ CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
   auto spread = [&](const std::vector<std::pair<std::uint32_t, std::uint32_t>>& src,
                     std::vector<std::pair<std::uint32_t, Near>>& out) {
     for (const auto& [cell, item] : src) {
-      const int ix = ix_of(static_cast<int>(cell)), iy = iy_of(static_cast<int>(cell));
+      int ix = ix_of(static_cast<int>(cell)), iy = iy_of(static_cast<int>(cell));
+      Vec2 base{};
+      if (periodic_) {
+        // A periodic arena has no ring: what a ring cell lists (a wall or a wall end on the seam
+        // x = W or y = H, or on x = 0, y = 0 seen from below) is the arena cell across the seam's,
+        // seen with that seam's shift. (Dropping it lost the walls and ends on the seam.)
+        if (ix < 1) { ix += nx_; base.x = width_; }
+        else if (ix > nx_) { ix -= nx_; base.x = -width_; }
+        if (iy < 1) { iy += ny_; base.y = height_; }
+        else if (iy > ny_) { iy -= ny_; base.y = -height_; }
+      }
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           int jx = ix + dx, jy = iy + dy;
-          Vec2 seen_shift{};
+          Vec2 seen_shift = base;
           if (periodic_) {
             // The arena cell (jx, jy) sees this item across the seam with the opposite shift.
-            if (jx < 1) { jx += nx_; seen_shift.x = width_; }
-            else if (jx > nx_) { jx -= nx_; seen_shift.x = -width_; }
-            if (jy < 1) { jy += ny_; seen_shift.y = height_; }
-            else if (jy > ny_) { jy -= ny_; seen_shift.y = -height_; }
-            if (ix < 1 || ix > nx_ || iy < 1 || iy > ny_) continue;  // ring cells are unused
+            if (jx < 1) { jx += nx_; seen_shift.x += width_; }
+            else if (jx > nx_) { jx -= nx_; seen_shift.x -= width_; }
+            if (jy < 1) { jy += ny_; seen_shift.y += height_; }
+            else if (jy > ny_) { jy -= ny_; seen_shift.y -= height_; }
           }
           if (jx < 1 || jx > nx_ || jy < 1 || jy > ny_) continue;
           out.emplace_back(index(jx, jy), Near{item, shift_index(seen_shift)});
@@ -131,8 +186,8 @@ void CellGrid::store(std::vector<std::pair<std::uint32_t, T>>& pairs, std::vecto
 }
 
 int CellGrid::arena_cell_of(Vec2 p) const {
-  const int ix = std::clamp(static_cast<int>(std::floor(p.x / cw_)) + 1, 1, nx_);
-  const int iy = std::clamp(static_cast<int>(std::floor(p.y / ch_)) + 1, 1, ny_);
+  const int ix = clamped_index(p.x, cw_, 1, nx_);
+  const int iy = clamped_index(p.y, ch_, 1, ny_);
   return index(ix, iy);
 }
 

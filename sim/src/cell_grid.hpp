@@ -23,6 +23,10 @@ struct WallEnd {
 /// Walls are listed in every cell they pass through, wall ends in the cell that holds them.
 class CellGrid {
  public:
+  /// What one grid may take, in bytes (docs/physics.md, "The grid"): the constructor refuses a
+  /// grid whose cells and wall lists would take more, naming arena.cell and the longest wall.
+  static constexpr double kMemoryBudget = 1e9;
+
   CellGrid() = default;
   /// Walls flagged in `skip` (moving walls, checked apart from the table) are not listed.
   CellGrid(double width, double height, double min_cell, bool periodic,

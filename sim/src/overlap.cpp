@@ -15,6 +15,18 @@ Vec2 min_image(Vec2 d, double w, double h) {
   return d;
 }
 
+constexpr double kNeverDistance = 1e300;
+
+// floor(x / cell), clamped to +-2^62 in double first: a gas of radius 1e-22 has cell indices past
+// int64's range (undefined behaviour once), and neighbours of a clamped index stay in range.
+std::int64_t cell_index(double x, double cell) {
+  const double k = std::floor(x / cell);
+  constexpr double kMax = 0x1p62;
+  if (!(k > -kMax)) return -static_cast<std::int64_t>(kMax);
+  if (!(k < kMax)) return static_cast<std::int64_t>(kMax);
+  return static_cast<std::int64_t>(k);
+}
+
 double distance_to_segment(Vec2 p, const Segment& s) {
   const Vec2 rel = p - s.p1;
   const double foot = std::clamp(dot(rel, s.u), 0.0, s.len);
@@ -52,8 +64,19 @@ Overlap deepest_overlap(const DiscView& discs, const std::vector<Segment>& walls
       const Segment& s = walls[w];
       if (!meet_wall(i, w)) continue;
       Vec2 p = discs.pos(i);
-      if (periodic_width > 0.0) p = s.p1 + min_image(p - s.p1, periodic_width, periodic_height);
-      note(r - distance_to_segment(p, s), r);
+      double dist = kNeverDistance;
+      if (periodic_width > 0.0) {
+        // The nearest image of the disc to the segment, not to its first end: for a wall longer
+        // than half the arena they differ (the first end's nearest image once hid a disc half
+        // inside a wall on the seam).
+        p = s.p1 + min_image(p - s.p1, periodic_width, periodic_height);
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+            dist = std::min(dist, distance_to_segment(p + Vec2{dx * periodic_width, dy * periodic_height}, s));
+      } else {
+        dist = distance_to_segment(p, s);
+      }
+      note(r - dist, r);
     }
   }
   if (!ball_pairs) return worst;
@@ -69,7 +92,7 @@ Overlap deepest_overlap(const DiscView& discs, const std::vector<Segment>& walls
     Vec2 p = discs.pos(i);
     if (periodic_width > 0.0) p = {p.x - periodic_width * std::floor(p.x / periodic_width),
                                    p.y - periodic_height * std::floor(p.y / periodic_height)};
-    return Cell{static_cast<std::int64_t>(std::floor(p.x / cell)), static_cast<std::int64_t>(std::floor(p.y / cell))};
+    return Cell{cell_index(p.x, cell), cell_index(p.y, cell)};
   };
   std::vector<std::uint32_t> order;
   order.reserve(live);
@@ -85,8 +108,8 @@ Overlap deepest_overlap(const DiscView& discs, const std::vector<Segment>& walls
     const double ri = discs.radius(i), rj = discs.radius(j);
     note(ri + rj - norm(d), std::min(ri, rj));
   };
-  const std::int64_t ncx = periodic_width > 0.0 ? static_cast<std::int64_t>(std::floor(periodic_width / cell)) : 0;
-  const std::int64_t ncy = periodic_height > 0.0 ? static_cast<std::int64_t>(std::floor(periodic_height / cell)) : 0;
+  const std::int64_t ncx = periodic_width > 0.0 ? cell_index(periodic_width, cell) : 0;
+  const std::int64_t ncy = periodic_height > 0.0 ? cell_index(periodic_height, cell) : 0;
   const bool brute = periodic_width > 0.0 && (ncx < 3 || ncy < 3);
   if (brute || order.size() < 64) {
     for (std::size_t a = 0; a < order.size(); ++a)

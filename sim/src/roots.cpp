@@ -81,6 +81,10 @@ double first_approach_quadratic(double c0, double c1, double c2) {
     return -c0 / c1;  // c0 > 0 here
   }
   const double disc = c1 * c1 - 4.0 * c2 * c0;
+  // Inside (c0 <= 0), receding (c1 > 0) but pulled back (c2 < 0), and never out (its maximum
+  // -disc / (4 c2) is <= 0): it approaches from the turning point on, deeper at once. The contact
+  // is there, not "never" (a disc a few ulps inside a slope once sank into it under gravity).
+  if (c0 <= 0.0 && c1 > 0.0 && c2 < 0.0 && !(disc > 0.0)) return c1 / (-2.0 * c2);
   if (!(disc > 0.0)) return kNever;  // no real root, or a double root (a graze)
   const double sq = std::sqrt(disc);
   // f'(t) = c1 + 2 c2 t equals -sq at the root (-c1 - sq) / (2 c2): that one is the approach.
@@ -144,7 +148,9 @@ double first_approach_poly(const double* c, int degree, double t_max) {
   for (int k = 0; k <= nc; ++k) {
     const double end = k < nc ? crit[k] : hi;
     const double fend = eval(c, degree, end);
-    // f is monotone on [lo, end]; an approach is a fall from >= 0 to < 0.
+    // f is monotone on [lo, end]; an approach is a fall from >= 0 to < 0, or any fall that
+    // starts inside (flo <= 0: a disc that rose without getting out, and now sinks again).
+    if (flo <= 0.0 && fend < flo) return lo;
     if (flo >= 0.0 && fend < 0.0) {
       if (flo == 0.0) return lo;
       const Bracket br = refine(c, degree, lo, end);

@@ -162,3 +162,25 @@ TEST_CASE("a wall that comes and goes in time", "[moving][visibility]") {
     CHECK(w2.ball(0).vel.x == Approx(-10));
   }
 }
+
+TEST_CASE("a turtle carried by a moving wall is not touched again when another wall reaches a keyframe", "[moving][turtle]") {
+  // Issue 17, section 4: a `door` wall's keyframe at t = 7 used to end the pusher's push (and
+  // re-aim the pusher by round-off), so the pusher struck the turtle a second time at t = 7.
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    INFO("mode " << (mode == Mode::exact ? "exact" : "step"));
+    WorldDef d = box(400, 300);
+    d.walls.push_back(moving("pusher", {20, 200}, {20, 280}, {{15.0, {180, 200}, {180, 280}}}));
+    d.walls.push_back(moving("door", {300, 0}, {300, 100}, {{7.0, {300, 0}, {300, 50}}}));
+    d.turtles.push_back(turtle("t", {60, 240}, 0, 10));
+    World w(d, mode);
+    w.set_event_limit(100000);
+    w.advance_to(14.0);
+    const auto contacts = w.take_turtle_contacts();
+    REQUIRE(contacts.size() == 1);
+    // The pusher (160/15 units/s from x = 20) reaches x = 50 at t = 2.8125.
+    CHECK(contacts[0].t == Approx(2.8125).epsilon(1e-9));
+    // Carried at the pusher's speed ever since: at t = 14 the pusher is at 20 + 14 * 160/15.
+    CHECK(w.turtle(0).pos.x == Approx(20 + 14 * 160.0 / 15 + 10).epsilon(1e-9));
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}

@@ -390,3 +390,34 @@ TEST_CASE("in a periodic arena a touch on the far part of a long wall has the ri
     CHECK(w.measure_overlap().relative <= 1e-9);
   }
 }
+
+TEST_CASE("a turtle that touches a slanted wall, turns along it and drives on is not stopped by a graze", "[turtle]") {
+  // Issue 17: at 30 degrees the turn left the turtle "approaching" the wall at 1e-16 of its
+  // speed, and it stopped at once; at 45 it drove the full 50 units.
+  for (Mode mode : kModes) {
+    for (double deg : {10.0, 30.0, 45.0, 60.0, 75.0}) {
+      INFO(name(mode) << ", wall at " << deg << " degrees");
+      const double a = deg * kDeg;
+      const Vec2 u{std::cos(a), std::sin(a)}, n{-std::sin(a), std::cos(a)};
+      const Vec2 mid{200, 150};
+      WorldDef d = box(400, 300);
+      d.walls.push_back({"slope", mid - 150.0 * u, mid + 150.0 * u});
+      // Heading towards the wall (-n): Logo heading h has the vector (sin h, cos h).
+      const double h = std::atan2(-n.x, -n.y) / kDeg;
+      d.turtles.push_back(turtle("t", mid + 30.0 * n, h));
+      World w(d, mode);
+      w.set_event_limit(100000);
+      w.command_turtle(0, move(100));
+      w.advance_to(2.0);
+      REQUIRE(w.turtle(0).touched);
+      w.command_turtle(0, turn(-90));  // left: now along +u
+      w.advance_to(4.0);
+      w.command_turtle(0, move(50));
+      w.advance_to(8.0);
+      const TurtleState s = w.turtle(0);
+      CHECK_FALSE(s.touched);
+      CHECK(s.done == Approx(50).epsilon(1e-12));
+      CHECK(w.measure_overlap().relative <= 1e-9);
+    }
+  }
+}

@@ -70,10 +70,10 @@ void WorldServer::Impl::lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to) {
     world.add_wall(w);
   } catch (const std::invalid_argument& e) {
     spdlog::warn("turtle '{}' t={:.6g}: wall {} not laid: {}", a.id, now, w.id, e.what());
-    emit({now, "wall-refused", a.id, w.id, {}, 0.0, e.what()});
+    emit({now, "wall-refused", a.id, w.id, {}, 0.0, e.what(), {}});
     return;
   }
-  emit({now, "wall-drawn", a.id, w.id, {}, 0.0, {}});
+  emit({now, "wall-drawn", a.id, w.id, {}, 0.0, {}, {}});
 }
 
 void WorldServer::add_wall(const sim::WallDef& wall) {

@@ -34,6 +34,45 @@ class BodyStore {
   Column<Pending, pending_of> pending;
 
   std::vector<Layers> layers;  ///< per body (with_layers only)
+
+  /// The squeeze rule's mark (squeeze.hpp): the two obstacles a body was last held between, its
+  /// course counter then, when, and whether it flies straight. The vector stays empty until a
+  /// body is first held.
+  struct Held {
+    LastPartner a, b;
+    std::uint32_t count = 0;
+    std::uint32_t count_a = 0, count_b = 0;  ///< the obstacles' counters, when they are turtles
+    bool straight = false;
+    double t = 0.0;  ///< internal time of the squeeze
+  };
+  std::vector<Held> held;
+  void hold(std::uint32_t i, LastPartner a, LastPartner b, double now, bool straight) {
+    if (held.empty()) held.assign(size(), Held{});
+    auto count_of = [&](LastPartner p) { return p.kind() == Partner::body ? body[p.index()].count : 0u; };
+    held[i] = {a, b, body[i].count, count_of(a), count_of(b), straight, now};
+  }
+  /// Whether a contact of body i with `partner` predicted for internal time t is the round-off
+  /// echo of a squeeze the rule has answered: the body has not changed course since, and either
+  /// flies straight (leaving a line or a point at rate >= 0 in a straight line, it cannot approach
+  /// it again: only round-off says it does) or the contact is at that very instant.
+  bool held_against(std::uint32_t i, LastPartner partner, double t) const {
+    if (held.empty()) return false;
+    const Held& h = held[i];
+    if (h.count != body[i].count || !(h.straight || h.t == t)) return false;
+    // A turtle obstacle that has changed course since (a new command) can meet the body anew.
+    if (h.a == partner) return partner.kind() != Partner::body || body[partner.index()].count == h.count_a;
+    if (h.b == partner) return partner.kind() != Partner::body || body[partner.index()].count == h.count_b;
+    return false;
+  }
+  /// A kick between steps, or a wall changing course at a keyframe, changes courses without a
+  /// collision: no mark holds after it.
+  void release_held() {
+    for (Held& h : held) h.a = h.b = LastPartner::none();
+  }
+  /// Internal time moves by -shift (a rebase, or the end of a step).
+  void shift_held(double shift) {
+    for (Held& h : held) h.t -= shift;
+  }
   bool layered = false;        ///< whether any body's layers differ from the defaults
 
   /// The cell lists: the balls, and the turtles, listed in each cell of the table.

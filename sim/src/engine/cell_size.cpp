@@ -61,6 +61,30 @@ double choose_cell_size(const WorldDef& def, Mode mode) {
   }
   double cell = std::max(rule * (1.0 + 1e-9), preferred);
   cell = std::max(cell, std::sqrt(area / 4.0e7));  // keep the table under ~4e7 cells
+  // Keep the walls' lists under ~1e7 entries: a wall is listed in each cell it crosses (about
+  // length / cell + 2 of them) and again in the 3x3 neighbourhood of each, ten entries a cell.
+  // (A 1e15-long arena wall once crossed 3e7 cells and took 10 GB.) Never binding for walls of a
+  // sensible length: 4 x 1600 units of arena walls would need cells of 0.006.
+  // Only the part of a wall inside the arena crosses cells (beyond it a ring cell takes it all).
+  auto inside_length = [&](Vec2 p, Vec2 q) {
+    double t0 = 0.0, t1 = 1.0;
+    const Vec2 d = q - p;
+    const double pk[4] = {-d.x, d.x, -d.y, d.y}, qk[4] = {p.x, width - p.x, p.y, height - p.y};
+    for (int k = 0; k < 4; ++k) {
+      if (pk[k] == 0.0) {
+        if (qk[k] < 0.0) return 0.0;
+      } else {
+        const double r = qk[k] / pk[k];
+        if (pk[k] < 0.0) t0 = std::max(t0, r);
+        else t1 = std::min(t1, r);
+      }
+    }
+    return t1 > t0 ? (t1 - t0) * norm(d) : 0.0;
+  };
+  double wall_length = 0.0;
+  for (const WallDef& w : def.walls) wall_length += inside_length(w.from, w.to);
+  if (def.arena.boundary == Boundary::walls) wall_length += 2.0 * (width + height);
+  cell = std::max(cell, 10.0 * wall_length / 1.0e7);
   // A periodic arena needs three cells across, so that no pair is seen through two images.
   if (def.arena.boundary == Boundary::periodic)
     cell = std::max(rule * (1.0 + 1e-9), std::min(cell, std::min(width, height) / 3.0));

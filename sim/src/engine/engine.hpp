@@ -13,6 +13,7 @@
 //   turtle_motion.*            turtles' commands, contacts and state
 //   walls.*, moving_walls.*    walls and their ends; keyframes and visibility
 //   cell_size.*, checks.hpp    the cell-size policy; energy and overlap
+//   squeeze.hpp                bodies held between two obstacles: wedged or crushed
 //   exact_clock.hpp            cell crossings, exits, the rebase of internal time
 //   step_clock.hpp             the start and the end of one of the memo's steps
 //
@@ -71,6 +72,7 @@
 #include "neighbourhood.hpp"
 #include "parts.hpp"
 #include "records.hpp"
+#include "squeeze.hpp"
 #include "turtle_motion.hpp"
 #include "variant.hpp"
 #include "walls.hpp"
@@ -91,6 +93,7 @@ class Engine final : public EngineBase {
 
   void advance_to(double t) override;
   void set_event_log(std::vector<Event>* log) override { record_.log = log; }
+  void set_event_limit(std::uint64_t limit) override { event_limit_ = limit; }
   double time() const override { return t_base_ + now_; }
   std::size_t ball_count() const override { return bodies_.balls(); }
   BallState ball(std::size_t i) const override {
@@ -209,6 +212,11 @@ class Engine final : public EngineBase {
   }
   void end_command(std::uint32_t i);
   void keyframe();
+  /// The squeeze rule (squeeze.hpp) for body i after its contact with bodies_.last[i]; `before`:
+  /// its partner before that. Returns false when the body was crushed (and removed).
+  bool squeezed(std::uint32_t i, LastPartner before);
+  /// Body i is crushed between A and B: it is removed, with a `crushed` event.
+  void crush(std::uint32_t i, const Side& A, const Side& B);
 
   // The exact clock (exact_clock.hpp).
   void cross(std::uint32_t i);
@@ -238,6 +246,7 @@ class Engine final : public EngineBase {
   double t_base_ = 0.0;  ///< external time of internal time zero
   std::uint64_t events_since_rebase_ = 0;
   std::uint64_t rebase_every_ = 0;
+  std::uint64_t event_limit_ = ~std::uint64_t{0};  ///< World::set_event_limit
   StepState step_;  ///< step mode only
 
   EventRecord record_;
@@ -265,9 +274,20 @@ Engine<F, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<Ba
   const std::size_t n = bodies_.size();
 
   grid_ = CellGrid(arena_.width, arena_.height, cell_, arena_.periodic(), walls_.segments, walls_.ends, walls_.moving());
-  if (arena_.periodic() && (grid_.nx() < 3 || grid_.ny() < 3))
+  if (arena_.periodic() && (grid_.nx() < 3 || grid_.ny() < 3)) {
+    if (kStep && !def.arena.cell) {
+      // The cell is the memo's rule 2 (r_max + v_max dt): name what made it too wide.
+      double vmax = 0.0;
+      for (std::uint32_t i = 0; i < n; ++i) vmax = std::max(vmax, norm(bodies_.body[i].v));
+      throw std::invalid_argument("step mode: the fastest body's speed " + format_number(vmax) + " at dt = " +
+                                  format_number(dt_) + " makes the cell rule 2 (r_max + v_max dt) = " +
+                                  format_number(cell_) + ", more than a third of this periodic arena (" +
+                                  format_number(arena_.width) + " x " + format_number(arena_.height) +
+                                  "): use a smaller dt or --mode exact");
+    }
     throw std::invalid_argument("a periodic arena must be at least 3 cells across (cell " + std::to_string(cell_) +
                                 "); enlarge the arena or use smaller balls");
+  }
 
   if (restitution_.inelastic) restitution_.last_time.assign(n, -kNever);
   bodies_.make_lists(static_cast<std::size_t>(grid_.cell_count()), kExtras);
@@ -343,6 +363,9 @@ bool Engine<F, kBallBall, kStep, kExtras>::process(double limit) {
       }
     }
     if (next_event > limit) break;
+    if (record_.stats.events >= event_limit_) [[unlikely]]
+      throw EventLimitReached("the event limit (" + std::to_string(event_limit_) + ") was reached at t = " +
+                              std::to_string(t_base_ + now_));
     const std::uint32_t i = heap_.top_id();
     now_ = heap_.top_key();
     ++record_.stats.events;
@@ -374,6 +397,7 @@ bool Engine<F, kBallBall, kStep, kExtras>::process(double limit) {
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
 void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
   const Pending p = bodies_.pending[i];
+  const LastPartner before = bodies_.last[i];
   switch (p.kind) {
     case Partner::body:
       if (bodies_.body[p.partner].count != p.partner_count) {
@@ -383,18 +407,63 @@ void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
         schedule(i);
         return;
       }
-      if (is_turtle(i) || is_turtle(p.partner)) served(apply_turtle_body(parts(), i, p.partner));
-      else served(apply_ball_ball(parts(), i, p.partner));
+      if (is_turtle(i) || is_turtle(p.partner)) {
+        // A ball is squeezed against a turtle, a turtle against a turtle; never against a ball.
+        const LastPartner before_partner = bodies_.last[p.partner];
+        const Changed c = apply_turtle_body(parts(), i, p.partner);
+        auto before_of = [&](std::uint32_t k) { return k == i ? before : before_partner; };
+        const bool keep_first = !is_turtle(c.second) || squeezed(c.first, before_of(c.first));
+        const bool keep_second = squeezed(c.second, before_of(c.second));
+        if (keep_first) repredict(c.first);
+        if (keep_second) repredict(c.second);
+      } else {
+        served(apply_ball_ball(parts(), i, p.partner));
+      }
       return;
-    case Partner::wall: served(apply_wall(parts(), i, p.partner)); return;
-    case Partner::end: served(apply_end(parts(), i, p.partner)); return;
-    case Partner::moving_end: served(apply_moving_end(parts(), i, p.partner)); return;
+    case Partner::wall: {
+      const Changed c = apply_wall(parts(), i, p.partner);
+      if (squeezed(i, before)) served(c);
+      return;
+    }
+    case Partner::end: {
+      const Changed c = apply_end(parts(), i, p.partner);
+      if (squeezed(i, before)) served(c);
+      return;
+    }
+    case Partner::moving_end: {
+      const Changed c = apply_moving_end(parts(), i, p.partner);
+      if (squeezed(i, before)) served(c);
+      return;
+    }
     case Partner::none: break;
   }
   // A body with nothing pending has an infinite key and is never popped.
   sync(i);
   predict(i);
   schedule(i);
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+bool Engine<F, kBallBall, kStep, kExtras>::squeezed(std::uint32_t i, LastPartner before) {
+  Side A, B;
+  if (squeeze(parts(), i, before, bodies_.last[i], A, B) != Squeeze::crushed) return true;
+  crush(i, A, B);
+  return false;
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::crush(std::uint32_t i, const Side& A, const Side& B) {
+  const bool turtle = is_turtle(i);
+  const std::uint32_t nb = bodies_.balls();
+  record_.note(t_base_ + now_, EventKind::crushed, turtle ? i - nb : i, A.name, B.name,
+               static_cast<std::uint8_t>((turtle ? kTurtleA : 0) | (A.turtle ? kTurtleB : 0) | (B.turtle ? kTurtleC : 0)));
+  ++record_.stats.crushed;
+  unlink(i);
+  Body& b = bodies_.body[i];
+  b.cell = kNone;
+  ++b.count;  // predictions made against it are now stale
+  heap_.remove(i);
+  if (turtle) turtles_.exit(i - nb, b, bodies_.end[i]);
 }
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
@@ -430,21 +499,24 @@ void Engine<F, kBallBall, kStep, kExtras>::keyframe() {
   now_ = schedule_.next_key;
   ++record_.stats.events;
   schedule_.take_keyframe(walls_, now_, t_base_);
+  bodies_.release_held();  // a wall may have changed course: the squeeze rule's marks no longer hold
   const std::uint32_t nb = bodies_.balls();
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     Body& b = bodies_.body[i];
     if (b.cell == kNone) continue;
     sync(i);
-    if (is_turtle(i) && turtles_.pushed_by[i - nb] != kNone) {
+    if (is_turtle(i) && turtles_.pushed_by[i - nb] != kNone && schedule_.keyed[turtles_.pushed_by[i - nb]]) {
       // The push ends with the segment of motion that made it; the turtle stands where it is.
+      // (Another wall's keyframe changes nothing here: the push goes on.)
       b.v = {};
       turtles_.pushed_by[i - nb] = kNone;
       ++b.count;
     }
     // "Just collided, cannot meet again" does not survive a change of the wall's velocity.
     const LastPartner last = bodies_.last[i];
-    if (!last.is_none() && (last.kind() == Partner::moving_end ||
-                            (last.kind() == Partner::wall && walls_.mover_of[last.index()] != kNone)))
+    if (!last.is_none() && ((last.kind() == Partner::moving_end && schedule_.keyed[last.index() / 2]) ||
+                            (last.kind() == Partner::wall && walls_.mover_of[last.index()] != kNone &&
+                             schedule_.keyed[walls_.mover_of[last.index()]])))
       bodies_.last[i] = LastPartner::none();
     repredict(i);
   }

@@ -29,6 +29,7 @@ WallSchedule::WallSchedule(const Walls& walls) {
     const WallDef& wd = walls.defs[w];
     if (walls.mover_of[w] != kNone) {
       movers.push_back(Mover{w, 0, wd.from, wd.to - wd.from, 0.0, {}, {}});
+      keyed.push_back(0);
       keys_.push_back(mover_keys(wd));
     }
     if (!wd.visibility.empty()) {
@@ -100,10 +101,18 @@ void WallSchedule::take_keyframe(Walls& walls, double now, double t_base) {
       }
       m.t_ref = now;
       ++m.next;
+      keyed[k] = 1;
+    } else {
+      keyed[k] = 0;
     }
   }
   apply_visibility(walls, now, t_base);
-  aim_all(walls, t_base);
+  // Only the movers that took a pose are aimed anew: aiming one that did not would recompute its
+  // velocity from a shifted time base and change it by round-off, and a turtle it carries would
+  // then be struck again (issue 17: a phantom touch whenever another wall reached a keyframe).
+  for (std::size_t k = 0; k < movers.size(); ++k)
+    if (keyed[k]) aim(movers[k], t_base);
+  refresh_next_key(walls, t_base);
 }
 
 }  // namespace turtlegas::sim::detail

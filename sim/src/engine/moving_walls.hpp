@@ -65,6 +65,8 @@ class WallSchedule {
   explicit WallSchedule(const Walls& walls);
 
   std::vector<Mover> movers;
+  /// Per mover: whether the last take_keyframe() gave it a new pose (its course changed there).
+  std::vector<std::uint8_t> keyed;
   double next_key = kNever;  ///< internal time of the next keyframe of any moving or blinking wall
 
   /// Takes the visibility keys due at internal time `now` (and at construction, those at 0).

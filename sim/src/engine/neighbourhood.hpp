@@ -22,6 +22,7 @@
 #include <stdexcept>
 
 #include "../cell_grid.hpp"
+#include "turtlegas/sim/format.hpp"
 #include "interactions.hpp"
 #include "parts.hpp"
 
@@ -91,8 +92,15 @@ template <bool kBallBall, Flight F, bool kExtras>
 [[gnu::always_inline]] inline void look_along_step(const Look<F, kExtras>& l, const CellGrid& grid, StepState& step,
                                                    double dt, std::uint32_t i, const Body& bi, int ix, int iy,
                                                    Pending& p) {
+  // The memo's cell rule, widened to speed: a body whose path and radii reach `reach` in this
+  // step looks `reach / cell + 1` cells each way. Counted in double and capped at the grid's size
+  // (a reach past the arena scans the arena, no more: nothing there is further), so that no speed
+  // overflows an int or scans cells that do not exist.
+  const double cell = std::min(grid.cell_w(), grid.cell_h());
+  const double cap = static_cast<double>(std::max(grid.nx(), grid.ny()) + 2);
   auto rings = [&](double reach) {
-    return static_cast<int>(std::floor(reach / std::min(grid.cell_w(), grid.cell_h()))) + 1;
+    const double k = std::floor(reach / cell) + 1.0;
+    return static_cast<int>(k < cap ? k : cap);  // (a NaN reach takes the cap too)
   };
   const double step_end = dt;
   const double d_i = step.travel[i] + path_length(bi.v, step_end - l.now);
@@ -101,18 +109,28 @@ template <bool kBallBall, Flight F, bool kExtras>
   const int kw = rings(bi.r + d_i);
   const bool periodic = grid.periodic();
   if (periodic && (2 * kb + 1 > grid.nx() || 2 * kb + 1 > grid.ny()))
-    throw std::runtime_error("step mode: a body moves too far in one step for this periodic arena; use a smaller dt or --mode exact");
-  for (int dy = -kb; dy <= kb; ++dy)
-    for (int dx = -kb; dx <= kb; ++dx) {
-      if (!periodic && (ix + dx < 1 || ix + dx > grid.nx() || iy + dy < 1 || iy + dy > grid.ny())) continue;
+    throw std::runtime_error(
+        "step mode: a body at speed " + format_number(norm(bi.v)) + " moves " + format_number(d_i) +
+        " in one step (dt = " + format_number(dt) + "), and with the fastest body's " + format_number(step.dmax) +
+        " its scan must reach " + std::to_string(kb) + " cells of " + format_number(cell) +
+        " each way, more than this periodic arena's " + std::to_string(grid.nx()) + " x " + std::to_string(grid.ny()) +
+        " cells hold (the cell rule: a scan of 2 k + 1 cells across at most, k = (r + r_max + both paths) / cell + 1);"
+        " use a smaller dt or --mode exact");
+  // Open or walled arenas: only the cells that exist (balls are listed in arena cells 1..n, walls
+  // also in the ring of cells around the arena, 0 and n + 1).
+  const int bx0 = periodic ? -kb : std::max(-kb, 1 - ix), bx1 = periodic ? kb : std::min(kb, grid.nx() - ix);
+  const int by0 = periodic ? -kb : std::max(-kb, 1 - iy), by1 = periodic ? kb : std::min(kb, grid.ny() - iy);
+  for (int dy = by0; dy <= by1; ++dy)
+    for (int dx = bx0; dx <= bx1; ++dx) {
       const auto nb = grid.neighbour(ix, iy, dx, dy);
       scan_cell<kBallBall>(l, i, bi, nb.cell, nb.shift, p);
     }
   ++step.scan;
   const std::size_t walls = l.walls.segments.size();
-  for (int dy = -kw; dy <= kw; ++dy)
-    for (int dx = -kw; dx <= kw; ++dx) {
-      if (!periodic && (ix + dx < 0 || ix + dx > grid.nx() + 1 || iy + dy < 0 || iy + dy > grid.ny() + 1)) continue;
+  const int wx0 = periodic ? -kw : std::max(-kw, -ix), wx1 = periodic ? kw : std::min(kw, grid.nx() + 1 - ix);
+  const int wy0 = periodic ? -kw : std::max(-kw, -iy), wy1 = periodic ? kw : std::min(kw, grid.ny() + 1 - iy);
+  for (int dy = wy0; dy <= wy1; ++dy)
+    for (int dx = wx0; dx <= wx1; ++dx) {
       const auto nb = grid.neighbour(ix, iy, dx, dy);
       const std::uint32_t s = grid.shift_index(nb.shift);
       for (auto it = grid.walls_begin(nb.cell); it != grid.walls_end(nb.cell); ++it) {

@@ -75,8 +75,8 @@ struct EventRecord {
     if (depth > max_contact.depth) max_contact.depth = depth;
     if (depth / radius > max_contact.relative) max_contact.relative = depth / radius;
   }
-  void note(double t, EventKind kind, std::uint32_t a, std::uint32_t b) {
-    if (log) log->push_back({t, kind, a, b});
+  void note(double t, EventKind kind, std::uint32_t a, std::uint32_t b, std::uint32_t c = 0, std::uint8_t flags = 0) {
+    if (log) log->push_back({t, kind, a, b, c, flags});
   }
 };
 

@@ -49,14 +49,17 @@ void Engine<F, kBallBall, kStep, kExtras>::finish_step() {
     if (!is_turtle(i)) kick_.apply(i, bodies_.body[i].v, dt_);
   }
   // A kick changes every course, so "just collided, cannot meet again" no longer holds.
-  if (kick_.changes_courses())
+  if (kick_.changes_courses()) {
     for (std::uint32_t i = 0; i < bodies_.last.size(); ++i) bodies_.last[i] = LastPartner::none();
+    bodies_.release_held();
+  }
   ++step_.index;
   ++record_.stats.steps;
   ++record_.stats.events;
   turtles_.shift_times(dt_);
   for (std::size_t k = 0; k < turtles_.size(); ++k) bodies_.end[bodies_.balls() + k] -= dt_;
   schedule_.shift_times(dt_);
+  bodies_.shift_held(dt_);
   if (restitution_.inelastic)
     for (double& t : restitution_.last_time) t -= dt_;
   t_base_ = static_cast<double>(step_.index) * dt_;

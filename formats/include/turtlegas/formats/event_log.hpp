@@ -27,6 +27,7 @@ struct EventLine {
   std::string_view kind;
   std::string_view a;
   std::optional<std::string_view> b;
+  std::optional<std::string_view> c;  ///< wedged, crushed: the second obstacle
   const std::vector<std::string>* sensors = nullptr;
   double bearing = 0.0;  ///< degrees clockwise from the heading to the contact point, [0, 360)
   std::string_view message;
@@ -43,6 +44,10 @@ inline void append_event(std::string& out, const EventLine& e) {
   if (e.b) {
     out += ", \"b\": ";
     append_json_string(out, *e.b);
+  }
+  if (e.c) {
+    out += ", \"c\": ";
+    append_json_string(out, *e.c);
   }
   if (e.sensors) {
     out += ", \"sensors\": [";
@@ -69,6 +74,7 @@ EventLine event_line(const sim::Event& e, const Names& names) {
   line.kind = sim::to_string(e.kind);
   line.a = ids.a;
   line.b = ids.b;
+  line.c = ids.c;
   return line;
 }
 
@@ -79,6 +85,7 @@ inline EventLine event_line(const turtle::LogEvent& e) {
   line.kind = e.kind;
   line.a = e.a;
   if (!e.b.empty()) line.b = e.b;
+  if (!e.c.empty()) line.c = e.c;
   if (e.kind == "touch") {
     line.sensors = &e.sensors;
     line.bearing = e.bearing;

@@ -16,10 +16,18 @@ enum class EventKind : std::uint8_t {
   turtle_wall_end,  ///< a is a turtle, b the index of the wall that owns the end point
   turtle_turtle,    ///< a and b are turtle indices (a is the one whose prediction it was)
   turtle_ball,      ///< a is a turtle, b a ball
+  // The squeeze rule (docs/physics.md, "Wedged and crushed bodies"): a is the body, b and c the
+  // two obstacles it is held between (walls by wall index, turtles by turtle index; `flags` says
+  // which of a, b, c are turtles).
+  wedged,   ///< the body's velocity along the squeeze was taken away; it stays in the scene
+  crushed,  ///< two obstacles closing on the body left it no room: it is removed
 };
 
-/// True for the kinds whose `a` is a turtle.
-constexpr bool involves_turtle(EventKind k) { return k >= EventKind::turtle_wall; }
+/// Event::flags bits: which of a, b and c index turtles (the squeeze events only).
+inline constexpr std::uint8_t kTurtleA = 1, kTurtleB = 2, kTurtleC = 4;
+
+/// True for the kinds whose `a` is always a turtle.
+constexpr bool involves_turtle(EventKind k) { return k >= EventKind::turtle_wall && k <= EventKind::turtle_ball; }
 
 /// The name used in the event log (`ball-ball`, ...).
 constexpr std::string_view to_string(EventKind k) {
@@ -32,6 +40,8 @@ constexpr std::string_view to_string(EventKind k) {
     case EventKind::turtle_wall_end: return "turtle-wall-end";
     case EventKind::turtle_turtle: return "turtle-turtle";
     case EventKind::turtle_ball: return "turtle-ball";
+    case EventKind::wedged: return "wedged";
+    case EventKind::crushed: return "crushed";
   }
   return "?";
 }
@@ -42,6 +52,8 @@ struct Event {
   EventKind kind = EventKind::ball_ball;
   std::uint32_t a = 0;
   std::uint32_t b = 0;
+  std::uint32_t c = 0;      ///< the squeeze events' second obstacle (0 otherwise)
+  std::uint8_t flags = 0;   ///< the squeeze events: kTurtleA | kTurtleB | kTurtleC
 };
 
 }  // namespace turtlegas::sim

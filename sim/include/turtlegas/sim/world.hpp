@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "turtlegas/sim/events.hpp"
@@ -17,6 +18,8 @@ struct Stats {
   std::uint64_t ball_wall = 0;
   std::uint64_t ball_wall_end = 0;
   std::uint64_t exits = 0;
+  std::uint64_t wedged = 0;   ///< the squeeze rule took a body's velocity (docs/physics.md)
+  std::uint64_t crushed = 0;  ///< bodies removed by the squeeze rule
   std::uint64_t turtle_wall = 0;
   std::uint64_t turtle_wall_end = 0;
   std::uint64_t turtle_turtle = 0;
@@ -28,6 +31,11 @@ struct Stats {
   std::uint64_t collisions() const {
     return ball_ball + ball_wall + ball_wall_end + turtle_wall + turtle_wall_end + turtle_turtle + turtle_ball;
   }
+};
+
+/// World::advance_to ran into the bound set with World::set_event_limit.
+struct EventLimitReached : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 /// Position and velocity of one ball at the world's current time.
@@ -102,6 +110,12 @@ class World {
 
   /// When set, every physical event is appended to *log (nullptr stops logging).
   void set_event_log(std::vector<Event>* log);
+
+  /// A bound on the events served (Stats::events, counted from construction): advance_to throws
+  /// EventLimitReached when the next event would exceed it. The world is then in a consistent
+  /// state at the time of the last event served, but the run cannot go on. For tests and fuzzing
+  /// harnesses that must end whatever the scene does.
+  void set_event_limit(std::uint64_t limit);
 
   double time() const;
   Mode mode() const;

@@ -16,6 +16,7 @@ namespace turtlegas::turtle {
 struct EventIds {
   std::string_view a;
   std::optional<std::string_view> b;
+  std::optional<std::string_view> c;  ///< the squeeze events' second obstacle
 };
 
 /// Where the ids come from. `Names` has ball(i), wall(i) and turtle(i), each returning the id of
@@ -36,12 +37,21 @@ std::string_view other_body(sim::EventKind kind, std::uint32_t index, const Name
 template <class Names>
 EventIds name_event(const sim::Event& e, const Names& names) {
   switch (e.kind) {
-    case sim::EventKind::ball_ball: return {names.ball(e.a), names.ball(e.b)};
+    case sim::EventKind::ball_ball: return {names.ball(e.a), names.ball(e.b), std::nullopt};
     case sim::EventKind::ball_wall:
-    case sim::EventKind::ball_wall_end: return {names.ball(e.a), names.wall(e.b)};
+    case sim::EventKind::ball_wall_end: return {names.ball(e.a), names.wall(e.b), std::nullopt};
     // b only says what kind of body left: 1 a turtle, 0 a ball (events.hpp).
-    case sim::EventKind::exit: return {e.b == 1 ? names.turtle(e.a) : names.ball(e.a), std::nullopt};
-    default: return {names.turtle(e.a), other_body(e.kind, e.b, names)};
+    case sim::EventKind::exit: return {e.b == 1 ? names.turtle(e.a) : names.ball(e.a), std::nullopt, std::nullopt};
+    // The body, then the two obstacles it was held between (flags: which are turtles).
+    case sim::EventKind::wedged:
+    case sim::EventKind::crushed: {
+      auto body = [&](std::uint32_t i, std::uint8_t bit) -> std::string_view {
+        return (e.flags & bit) != 0 ? std::string_view(names.turtle(i)) : std::string_view(names.wall(i));
+      };
+      return {(e.flags & sim::kTurtleA) != 0 ? std::string_view(names.turtle(e.a)) : std::string_view(names.ball(e.a)),
+              body(e.b, sim::kTurtleB), body(e.c, sim::kTurtleC)};
+    }
+    default: return {names.turtle(e.a), other_body(e.kind, e.b, names), std::nullopt};
   }
 }
 

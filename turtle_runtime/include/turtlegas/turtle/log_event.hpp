@@ -16,6 +16,7 @@ struct LogEvent {
   std::vector<std::string> sensors;  ///< touch only
   double bearing = 0.0;              ///< touch only, degrees
   std::string message;               ///< `fault` events: what went wrong
+  std::string c;                     ///< `wedged`, `crushed`: the second obstacle
 };
 
 }  // namespace turtlegas::turtle

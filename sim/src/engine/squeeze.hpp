@@ -1,0 +1,210 @@
+// SPDX-License-Identifier: MIT
+// The squeeze rule: the one answer for every body caught between two obstacles of infinite mass
+// (walls, wall ends, moving walls and their ends, and turtles). docs/physics.md, "Wedged and
+// crushed bodies", states it and proves its criteria; in short, at a contact of body i with
+// obstacle B, whose previous contact was with obstacle A on the other side (n_A . n_B < 0):
+//   1. held: if its free room towards A is within kHeldGap of a radius, it touches both. Its
+//      velocity becomes the nearest one that leaves both (the velocity of a perfectly inelastic
+//      contact with both at once); if none exists (A and B parallel and closing), it is crushed.
+//   2. certain crush: if A and B are parallel wall interiors closing at rate c > 0, nothing
+//      changes their motion before the room g closes (the next keyframe is after now + g/c) and
+//      the body stays between them until then (flying straight), no sequence of bounces can save
+//      it: it stops bouncing and rides on B (its velocity along the normal becomes B's), meets A
+//      at now + g/c, and is crushed there by rule 1.
+// A `wedged` event marks a velocity the rule set; `crushed` the removal (the engine's crush()).
+// A body held by rule 1 keeps the pair in BodyStore::held, so that the round-off of a velocity
+// that should leave both exactly tangent cannot make it meet them again: while its course is
+// unchanged, not at all if it flies straight (a straight line leaving a line or a point at rate
+// >= 0 never approaches it again), else not at that very instant.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "parts.hpp"
+
+namespace turtlegas::sim::detail {
+namespace {
+
+/// Free room (distance beyond contact) up to which a body counts as touching an obstacle: the
+/// engine's overlap budget, 1e-9 of a radius, plus the round-off of positions far from the origin.
+inline double held_gap(const Body& b) { return 1e-9 * b.r + 0x1p-46 * (std::abs(b.x.x) + std::abs(b.x.y)); }
+
+/// Normals whose cross product is below this are parallel: over one radius the two obstacles'
+/// separation then changes by less than the overlap budget, 1e-9 of a radius.
+inline constexpr double kParallel = 1e-9;
+
+/// An obstacle as body i sees it now.
+struct Side {
+  bool ok = false;       ///< an obstacle of infinite mass that is still there
+  bool interior = false; ///< a wall's interior, the contact foot strictly inside it
+  Vec2 n;                ///< unit normal from the obstacle to the body
+  Vec2 u;                ///< velocity of the obstacle's surface at the contact
+  double gap = 0.0;      ///< distance from the obstacle minus the contact distance
+  std::uint32_t name = 0;  ///< the wall's index, or the turtle's
+  bool turtle = false;
+  std::uint32_t mover = kNone;  ///< the moving wall it is (or belongs to)
+  Segment seg;           ///< a wall's segment now (interior only)
+};
+
+template <Flight Fl, bool kStep, bool kExtras>
+Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner who) {
+  Side s;
+  if (who.is_none()) return s;
+  const Body& a = p.bodies.body[i];
+  const std::uint32_t k = who.index();
+  switch (who.kind()) {
+    case Partner::none: return s;
+    case Partner::body: {
+      if (!p.is_turtle(k) || p.bodies.body[k].cell == kNone) return s;  // a ball has a finite mass
+      const Body& t = p.bodies.body[k];
+      const Vec2 F = p.arena.min_image(a.x - (t.x + (p.now - t.t) * t.v));
+      const double dist = norm(F);
+      if (!(dist > 0.0)) return s;
+      s.n = F / dist;
+      s.u = t.v;
+      s.gap = dist - a.r - t.r;
+      s.name = k - p.bodies.balls();
+      s.turtle = true;
+      break;
+    }
+    case Partner::wall: {
+      const std::uint32_t mi = p.walls.mover_of[k];
+      const Segment seg = mi == kNone ? p.walls.segments[k] : p.schedule.movers[mi].segment_at(p.walls.segments[k], p.now);
+      const Vec2 rel = p.arena.rel_to_segment(a.x, seg);
+      const double foot = dot(rel, seg.u);
+      const Vec2 off = rel - std::clamp(foot, 0.0, seg.len) * seg.u;
+      const double dist = norm(off);
+      if (!(dist > 0.0)) return s;
+      s.n = off / dist;
+      s.gap = dist - a.r;
+      s.interior = foot > 0.0 && foot < seg.len;
+      s.seg = seg;
+      if (mi != kNone) {
+        const Mover& m = p.schedule.movers[mi];
+        s.u = m.u;
+        if (!m.rigid()) s.u += std::clamp(foot / seg.len, 0.0, 1.0) * m.w;
+        s.mover = mi;
+      }
+      s.name = k;
+      break;
+    }
+    case Partner::end: {
+      const WallEnd& end = p.walls.ends[k];
+      const Vec2 F = p.arena.min_image(a.x - end.p);
+      const double dist = norm(F);
+      if (!(dist > 0.0)) return s;
+      s.n = F / dist;
+      s.gap = dist - a.r;
+      s.name = end.wall;
+      break;
+    }
+    case Partner::moving_end: {
+      const Mover& m = p.schedule.movers[k / 2];
+      const bool second = k % 2 == 1;
+      const Vec2 F = a.x - m.end_at(p.walls.segments[m.wall], second, p.now);
+      const double dist = norm(F);
+      if (!(dist > 0.0)) return s;
+      s.n = F / dist;
+      s.u = m.end_velocity(second);
+      s.gap = dist - a.r;
+      s.name = m.wall;
+      s.mover = k / 2;
+      break;
+    }
+  }
+  s.ok = true;
+  return s;
+}
+
+enum class Squeeze : std::uint8_t { none, wedged, crushed };
+
+/// Whether the body's centre stays over segment s (foot strictly inside) from now to now + tau,
+/// flying straight at v while s translates at u: the foot is linear in time, so both ends suffice.
+inline bool stays_over(Vec2 x, Vec2 v, const Side& s, double tau) {
+  const Vec2 rel_then = (x + tau * v) - (s.seg.p1 + tau * s.u);
+  const double foot = dot(rel_then, s.seg.u);
+  return s.interior && foot > 0.0 && foot < s.seg.len;
+}
+
+/// The squeeze rule for body i, which has just been answered at a contact with `b` (its velocity
+/// already set by the response); `a` is the partner of its contact before that one. Returns what
+/// the rule did; on `wedged` the body's velocity has been changed and the event logged; on
+/// `crushed` nothing has been changed yet (the engine removes the body and logs it).
+template <Flight Fl, bool kStep, bool kExtras>
+Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner a, LastPartner b, Side& A, Side& B) {
+  if (a.is_none() || a == b) return Squeeze::none;
+  A = side_of(p, i, a);
+  if (!A.ok) return Squeeze::none;
+  B = side_of(p, i, b);
+  if (!B.ok || !(dot(A.n, B.n) < 0.0)) return Squeeze::none;
+  Body& body = p.bodies.body[i];
+  const Vec2 v0 = body.v;
+  const double det = cross(A.n, B.n);
+  const bool parallel = std::abs(det) <= kParallel;
+  // How fast the two close on the body along the squeeze (parallel obstacles only).
+  // (Beyond the round-off of those products: a wall sliding along itself does not close.)
+  const double closing = dot(A.u, A.n) + dot(B.u, B.n);
+  const bool closes = closing > 0x1p-40 * (norm(A.u) + norm(B.u));
+  Vec2 v = v0;
+  bool held = true;
+  if (A.gap <= held_gap(body)) {
+    // 1. Held between A and B.
+    const double ra = dot(v0 - A.u, A.n), rb = dot(v0 - B.u, B.n);
+    if (ra >= 0.0 && rb >= 0.0) return Squeeze::none;  // it leaves both already
+    if (parallel) {
+      if (closes) return Squeeze::crushed;
+      v = v0 + (dot(B.u, B.n) - dot(v0, B.n)) * B.n;  // it moves with B along the normal
+    } else {
+      const Vec2 va = v0 - ra * A.n, vb = v0 - rb * B.n;
+      if (ra < 0.0 && dot(va - B.u, B.n) >= 0.0) v = va;
+      else if (rb < 0.0 && dot(vb - A.u, A.n) >= 0.0) v = vb;
+      else {
+        // Both contacts hold: v . n_A = u_A . n_A and v . n_B = u_B . n_B (Cramer's rule).
+        const double ca = dot(A.u, A.n), cb = dot(B.u, B.n);
+        v = {(ca * B.n.y - cb * A.n.y) / det, (cb * A.n.x - ca * B.n.x) / det};
+      }
+    }
+    if (!p.motion.straight(i)) {
+      // Under a field that presses the body into A or B, leaving it at rate 0 would let it sink
+      // at once: the rest threshold (Restitution::bounce) for both contacts, each pressed one left
+      // at least at -a_n tc / 2. Parallel obstacles cannot both be left: the pressed one wins,
+      // and the body, kept in the room by the field, sinks into the other by at most
+      // a_n tc^2 / 8 before it falls back (docs/physics.md).
+      const auto threshold = [&](const Side& s) {
+        const double an = p.motion.flight().normal_accel(i, v, s.n);
+        return an < 0.0 ? -an * p.restitution.tc / 2.0 : 0.0;
+      };
+      const double wa = threshold(A), wb = threshold(B);
+      if (wa > 0.0 || wb > 0.0) {
+        const double ca = dot(A.u, A.n) + wa, cb = dot(B.u, B.n) + wb;
+        if (parallel) {
+          const Side& pressed = wa >= wb ? A : B;
+          v += ((wa >= wb ? ca : cb) - dot(v, pressed.n)) * pressed.n;
+        } else {
+          v = {(ca * B.n.y - cb * A.n.y) / det, (cb * A.n.x - ca * B.n.x) / det};
+        }
+      }
+    }
+  } else {
+    // 2. A certain crush: ride on B until the room closes.
+    if (!parallel || !closes || !A.interior || !B.interior || !p.motion.straight(i)) return Squeeze::none;
+    const double tau = A.gap / closing;
+    if (!(p.now + tau < p.schedule.next_key)) return Squeeze::none;
+    v = v0 + (dot(B.u, B.n) - dot(v0, B.n)) * B.n;
+    if (!stays_over(body.x, v, A, tau) || !stays_over(body.x, v, B, tau)) return Squeeze::none;
+    held = false;  // it must meet A at t*: no mark
+  }
+  body.v = v;
+  const std::uint32_t nb = p.bodies.balls();
+  const bool turtle = p.is_turtle(i);
+  p.record.note(p.t_base + p.now, EventKind::wedged, turtle ? i - nb : i, A.name, B.name,
+                static_cast<std::uint8_t>((turtle ? kTurtleA : 0) | (A.turtle ? kTurtleB : 0) | (B.turtle ? kTurtleC : 0)));
+  ++p.record.stats.wedged;
+  if (held) p.bodies.hold(i, a, b, p.now, p.motion.straight(i));
+  return Squeeze::wedged;
+}
+
+}  // namespace
+}  // namespace turtlegas::sim::detail

@@ -1,0 +1,167 @@
+// SPDX-License-Identifier: MIT
+// The grid and step mode's neighbourhood at the limits of their numbers (issue 17's fuzzing
+// findings): coordinates past int's range, arenas of absurd aspect, speeds that make step mode's
+// scan reach past the arena, walls on a periodic arena's seam, the overlap measure's cell indices.
+// Every run is bounded by an event limit.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "scenes.hpp"
+#include "overlap.hpp"
+#include "turtlegas/sim/format.hpp"
+#include "turtlegas/sim/world.hpp"
+
+using namespace turtlegas::sim;
+using namespace turtlegas::test;
+
+namespace {
+
+std::size_t count(const std::vector<Event>& log, EventKind k) {
+  std::size_t n = 0;
+  for (const Event& e : log) n += e.kind == k;
+  return n;
+}
+
+bool inside(const World& w, std::size_t i, double width, double height) {
+  const Vec2 p = w.ball(i).pos;
+  return p.x >= 0.0 && p.x <= width && p.y >= 0.0 && p.y <= height;
+}
+
+}  // namespace
+
+TEST_CASE("a wall reaching y = 1e30 is listed in the grid, and a ball bounces off it", "[grid]") {
+  // far-wall-passthrough.json: the cell index of 1e30 overflowed an int, the wall landed in no
+  // cell, and the ball passed through it.
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    WorldDef d = box(100, 100, Boundary::none);
+    d.walls.push_back({"w", {50, 10}, {50, 1e30}});
+    d.balls.push_back(ball("b", {20, 50}, {10, 0}, 1));
+    World w(d, mode);
+    std::vector<Event> log;
+    w.set_event_log(&log);
+    w.set_event_limit(10000);
+    w.advance_to(5.0);
+    CHECK(count(log, EventKind::ball_wall) == 1);
+    CHECK(w.ball(0).pos.x < 49.0);
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}
+
+TEST_CASE("an arena of absurd aspect is refused with the key to change, not an overflow or a hang", "[grid]") {
+  // aspect-nx-ub-check-hang.json: 1e10 x 1e-10 overflowed the cell count.
+  WorldDef d = box(1e10, 1e-10, Boundary::none);
+  d.balls.push_back(ball("b", {5, 5e-11}, {1, 0}, 1e-11));
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    try {
+      World w(d, mode);
+      FAIL("the grid of 1e21 cells was accepted");
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      INFO(what);
+      CHECK(what.find("arena.cell") != std::string::npos);
+    }
+  }
+}
+
+TEST_CASE("step mode at speeds whose scan reaches past the arena finds every wall", "[grid][step]") {
+  // step-rings-*.json: the ring count grew with speed dt and overflowed an int (no scan at all:
+  // the ball left the walled box), or scanned (2k+1)^2 cells that do not exist (a hang).
+  struct Case {
+    Vec2 v;
+    double until;
+  };
+  for (const Case c : {Case{{3e9, 1e9}, 1e-7}, Case{{1e7, 3e6}, 2.0 / 30.0}, Case{{1e15, 3e14}, 1e-12}}) {
+    INFO("velocity " << c.v.x << ", " << c.v.y);
+    WorldDef d = box(100, 100);
+    d.balls.push_back(ball("b", {50, 50}, c.v, 1));
+    World w(d, Mode::step);
+    std::vector<Event> log;
+    w.set_event_log(&log);
+    w.set_event_limit(200000);
+    REQUIRE_NOTHROW(w.advance_to(c.until));
+    // Every bounce found: the ball is in the box, and the count of bounces off the x walls is
+    // what its path length says (98 units between two of them), to one.
+    CHECK(inside(w, 0, 100, 100));
+    const double path_x = std::abs(c.v.x) * c.until;
+    const double expected = std::floor((path_x + 49.0) / 98.0);
+    std::size_t x_bounces = 0;
+    for (const Event& e : log)
+      if (e.kind == EventKind::ball_wall && (w.walls()[e.b].from.x == w.walls()[e.b].to.x)) ++x_bounces;
+    CHECK(std::abs(static_cast<double>(x_bounces) - expected) <= 1.0);
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}
+
+TEST_CASE("a periodic arena too small for step mode's scan is refused naming the speed, the dt and the cell rule", "[grid][step]") {
+  WorldDef d = box(100, 100, Boundary::periodic);
+  d.balls.push_back(ball("b", {50, 50}, {1e5, 0}, 1));
+  try {
+    World w(d, Mode::step);
+    w.set_event_limit(1000);
+    w.advance_to(1.0);
+    FAIL("accepted");
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    INFO(what);
+    CHECK(what.find("speed " + format_number(1e5)) != std::string::npos);
+    CHECK(what.find("dt = ") != std::string::npos);
+    CHECK(what.find("cell rule") != std::string::npos);
+  }
+}
+
+TEST_CASE("walls and wall ends on a periodic arena's seam are seen from both sides", "[grid][periodic]") {
+  // A wall from (60, 50) to (100, 50): its end on the seam x = W. A disc coming from x = 10
+  // towards -x meets that end across the seam at x = 1 (the end's image is (0, 50)).
+  {
+    WorldDef d = box(100, 100, Boundary::periodic);
+    d.walls.push_back({"w", {60, 50}, {100, 50}});
+    d.balls.push_back(ball("b", {10, 50}, {-1, 0}, 1));
+    World w(d, Mode::exact);
+    std::vector<Event> log;
+    w.set_event_log(&log);
+    w.set_event_limit(10000);
+    w.advance_to(12.0);
+    REQUIRE(!log.empty());
+    CHECK(log[0].kind == EventKind::ball_wall_end);
+    CHECK(log[0].t == Approx(9.0).epsilon(1e-12));
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+  // A wall lying along x = W: a disc at x = 3 moving -x meets its image x = 0 at x = 1.
+  {
+    WorldDef d = box(100, 100, Boundary::periodic);
+    d.walls.push_back({"w", {100, 20}, {100, 80}});
+    d.balls.push_back(ball("b", {3, 50}, {-1, 0}, 1));
+    d.balls.push_back(ball("c", {95, 30}, {1, 0}, 1));
+    World w(d, Mode::exact);
+    std::vector<Event> log;
+    w.set_event_log(&log);
+    w.set_event_limit(10000);
+    w.advance_to(2.5);
+    REQUIRE(count(log, EventKind::ball_wall) == 1);
+    CHECK(log[0].t == Approx(2.0).epsilon(1e-12));
+    w.advance_to(5.0);
+    CHECK(count(log, EventKind::ball_wall) == 2);  // the other at x = 99, t = 4
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}
+
+TEST_CASE("the overlap measure sees a disc inside a long wall on the seam, through the right image", "[overlap][periodic]") {
+  // For a wall longer than half the arena, the image of a disc nearest to the wall's first end
+  // is not the one nearest to the wall: the measure reported 0 against a real overlap of 0.5.
+  const std::vector<Vec2> pos{{85, 50.5}};
+  detail::DiscView discs{1, [&](std::size_t i) { return pos[i]; }, [](std::size_t) { return 1.0; },
+                         [](std::size_t) { return true; }};
+  const std::vector<Segment> walls{make_segment({10, 50}, {90, 50})};
+  CHECK(detail::deepest_overlap(discs, walls, 100, 100, false).relative == Approx(0.5).epsilon(1e-9));
+}
+
+TEST_CASE("the overlap measure of a gas of tiny discs has its cell indices in range", "[overlap]") {
+  // overlap-int64-ub.min.json: discs of radius 1e-22 at coordinates ~50 have cell indices past
+  // int64's range (undefined behaviour once); 100 of them take the grid path, not the brute one.
+  WorldDef d = box(100, 100);
+  for (int k = 0; k < 100; ++k) d.balls.push_back(ball("g" + std::to_string(k), {5.0 + k * 0.9, 50.0 + (k % 7)}, {0, 0}, 1e-22));
+  World w(d, Mode::exact);
+  CHECK(w.measure_overlap().depth == 0.0);
+}

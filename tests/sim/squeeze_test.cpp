@@ -1,0 +1,328 @@
+// SPDX-License-Identifier: MIT
+// The squeeze rule (docs/physics.md, "Wedged and crushed bodies"): a body caught between two
+// obstacles of infinite mass is wedged (its velocity along the squeeze taken away, a `wedged`
+// event) or, when the two close on it, crushed (removed, a `crushed` event naming both). Every
+// scene here hung before the rule (events without time advancing); each runs under an event
+// limit, so that a regression fails with EventLimitReached instead of hanging.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "scenes.hpp"
+#include "turtlegas/sim/world.hpp"
+
+using namespace turtlegas::sim;
+using namespace turtlegas::test;
+
+namespace {
+
+constexpr std::uint64_t kLimit = 200000;  // far above what any scene here needs
+
+struct Run {
+  std::vector<Event> log;
+  std::size_t count(EventKind k) const {
+    std::size_t n = 0;
+    for (const Event& e : log) n += e.kind == k;
+    return n;
+  }
+  const Event* first(EventKind k) const {
+    for (const Event& e : log)
+      if (e.kind == k) return &e;
+    return nullptr;
+  }
+};
+
+/// Runs w to t under the event limit, logging into run.
+void run_to(World& w, Run& run, double t) {
+  w.set_event_log(&run.log);
+  w.set_event_limit(kLimit);
+  REQUIRE_NOTHROW(w.advance_to(t));
+}
+
+const Mode kModes[] = {Mode::exact, Mode::step};
+
+/// The piston: a 300 x 200 walled arena, a wall from (20, 10)-(20, 190) keyed to x = 290
+/// at t = 10 (27 units/s), and a ball or turtle of radius 8 at rest at (150, 150). The arena's
+/// right wall is x = 300, so the room closes when the piston reaches x = 284: t* = 264/27.
+WorldDef piston_scene() {
+  WorldDef d = box(300, 200);
+  d.walls.push_back(moving("piston", {20, 10}, {20, 190}, {{10.0, {290, 10}, {290, 190}}}));
+  return d;
+}
+constexpr double kCrushTime = 264.0 / 27.0;
+
+}  // namespace
+
+TEST_CASE("a ball crushed by a piston against a wall is removed at the instant the room closes", "[squeeze]") {
+  for (Mode mode : kModes) {
+    INFO("mode " << (mode == Mode::exact ? "exact" : "step"));
+    WorldDef d = piston_scene();
+    d.balls.push_back(ball("b", {150, 150}, {0, 0}, 8));
+    World w(d, mode);
+    Run run;
+    run_to(w, run, 9.7);  // before the crush: the ball is there, no overlap
+    CHECK(w.ball(0).alive);
+    CHECK(run.count(EventKind::crushed) == 0);
+    CHECK(w.measure_overlap().relative <= 1e-9);
+    run_to(w, run, 12.0);
+    REQUIRE(run.count(EventKind::crushed) == 1);
+    const Event& e = *run.first(EventKind::crushed);
+    CHECK(e.a == 0);
+    CHECK(e.flags == 0);  // a ball, between two walls
+    // Both walls are named: the piston (index 0) and the arena's right wall.
+    const auto& walls = w.walls();
+    const std::string b = walls[e.b].id, c = walls[e.c].id;
+    CHECK(((b == "piston") != (c == "piston")));
+    CHECK(e.t == Approx(kCrushTime).epsilon(1e-9));
+    CHECK_FALSE(w.ball(0).alive);
+    CHECK(w.stats().crushed == 1);
+    CHECK(w.measure_overlap().relative <= 1e-9);
+    CHECK(w.max_contact_overlap().relative <= 1e-9);
+  }
+}
+
+TEST_CASE("a ball moving along the piston's line is crushed too, and a ball that gets out is not", "[squeeze]") {
+  for (Mode mode : kModes) {
+    INFO("mode " << (mode == Mode::exact ? "exact" : "step"));
+    {
+      WorldDef d = piston_scene();
+      d.balls.push_back(ball("b", {150, 150}, {3, 1}, 8));  // drifts up by 10 before the crush: still inside
+      World w(d, mode);
+      Run run;
+      run_to(w, run, 12.0);
+      CHECK(run.count(EventKind::crushed) == 1);
+      CHECK(w.measure_overlap().relative <= 1e-9);
+    }
+    {
+      // A piston with a gap above it (it spans y in [10, 120]): a ball rising at 12 units/s leaves
+      // the squeeze over the piston's end before the room closes, and survives.
+      WorldDef d = box(300, 200);
+      d.walls.push_back(moving("piston", {20, 10}, {20, 120}, {{10.0, {290, 10}, {290, 120}}}));
+      d.balls.push_back(ball("b", {150, 60}, {0, 12}, 8));
+      World w(d, mode);
+      Run run;
+      run_to(w, run, 12.0);
+      CHECK(run.count(EventKind::crushed) == 0);
+      CHECK(w.ball(0).alive);
+      CHECK(w.measure_overlap().relative <= 1e-9);
+    }
+  }
+}
+
+TEST_CASE("a turtle crushed by a piston against a wall is removed, in both modes", "[squeeze][turtle]") {
+  for (Mode mode : kModes) {
+    INFO("mode " << (mode == Mode::exact ? "exact" : "step"));
+    WorldDef d = piston_scene();
+    d.turtles.push_back(turtle("t", {150, 150}, 0, 8));
+    World w(d, mode);
+    Run run;
+    run_to(w, run, 9.7);
+    CHECK(run.count(EventKind::crushed) == 0);
+    run_to(w, run, 12.0);
+    REQUIRE(run.count(EventKind::crushed) == 1);
+    const Event& e = *run.first(EventKind::crushed);
+    CHECK(e.a == 0);
+    CHECK(e.flags == kTurtleA);
+    CHECK(e.t == Approx(kCrushTime).epsilon(1e-9));
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}
+
+TEST_CASE("two pistons closing on a ball or a turtle crush it where they meet", "[squeeze]") {
+  for (Mode mode : kModes) {
+    for (bool turtle_body : {false, true}) {
+      INFO("mode " << (mode == Mode::exact ? "exact" : "step") << (turtle_body ? ", turtle" : ", ball"));
+      WorldDef d = box(300, 200);
+      // x = 20 + 20 t and x = 280 - 20 t: they are 2 r = 10 apart at t = 250 / 40.
+      d.walls.push_back(moving("left", {20, 10}, {20, 190}, {{10.0, {220, 10}, {220, 190}}}));
+      d.walls.push_back(moving("right", {280, 10}, {280, 190}, {{10.0, {80, 10}, {80, 190}}}));
+      if (turtle_body) d.turtles.push_back(turtle("t", {100, 100}, 0, 5));
+      else d.balls.push_back(ball("b", {100, 100}, {7, 0}, 5));
+      World w(d, mode);
+      Run run;
+      run_to(w, run, 9.0);
+      REQUIRE(run.count(EventKind::crushed) == 1);
+      const Event& e = *run.first(EventKind::crushed);
+      CHECK(e.t == Approx(250.0 / 40.0).epsilon(1e-9));
+      const std::string b = w.walls()[e.b].id, c = w.walls()[e.c].id;
+      CHECK(((b == "left" && c == "right") || (b == "right" && c == "left")));
+      CHECK(w.measure_overlap().relative <= 1e-9);
+    }
+  }
+}
+
+TEST_CASE("a ball exactly as wide as its corridor cannot move across it: wedged, it slides along", "[squeeze]") {
+  for (Mode mode : kModes) {
+    for (double e : {1.0, 0.9}) {
+      INFO("mode " << (mode == Mode::exact ? "exact" : "step") << ", e = " << e);
+      // The fuzzing reproducer (zeno-wedged-ball.json): arena 1 wide, ball of radius 0.5 moving
+      // across it; and the adversarial corridor: velocity (1e-3, 1) along a corridor 2 r wide.
+      {
+        WorldDef d = box(1, 100);
+        d.effects.restitution = e;
+        d.balls.push_back(ball("b", {0.5, 50}, {1, 0}, 0.5));
+        World w(d, mode);
+        Run run;
+        run_to(w, run, 1e-12);
+        run_to(w, run, 5.0);
+        CHECK(run.count(EventKind::wedged) >= 1);
+        CHECK(w.ball(0).vel.x == 0.0);
+        CHECK(w.ball(0).pos.x == 0.5);
+        CHECK(w.measure_overlap().relative <= 1e-9);
+      }
+      {
+        WorldDef d = box(100, 1000);
+        d.effects.restitution = e;
+        d.walls.push_back({"l", {40, 0}, {40, 1000}});
+        d.walls.push_back({"r", {42, 0}, {42, 1000}});
+        d.balls.push_back(ball("b", {41, 10}, {1e-3, 1}, 1));
+        World w(d, mode);
+        Run run;
+        run_to(w, run, 100.0);
+        CHECK(run.count(EventKind::wedged) >= 1);
+        CHECK(w.ball(0).pos.y == Approx(110).epsilon(1e-9));  // it kept its speed along the corridor
+        CHECK(std::abs(w.ball(0).pos.x - 41) <= 1e-9);
+        CHECK(w.measure_overlap().relative <= 1e-9);
+      }
+    }
+  }
+}
+
+TEST_CASE("a tilted corridor exactly 2r wide wedges a ball too (normals from round-off)", "[squeeze]") {
+  for (Mode mode : kModes) {
+    INFO("mode " << (mode == Mode::exact ? "exact" : "step"));
+    // A corridor at 30 degrees; its walls 2 apart, the ball of radius 1 between them moving across.
+    const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
+    const Vec2 u{c, s}, n{-s, c};
+    const Vec2 o{20, 20};
+    WorldDef d = box(200, 200);
+    // 2 + 2e-12 apart: exactly 2 would overlap the ball by round-off, which validate() refuses.
+    d.walls.push_back({"a", o - (1 + 1e-12) * n, o - (1 + 1e-12) * n + 150.0 * u});
+    d.walls.push_back({"b", o + (1 + 1e-12) * n, o + (1 + 1e-12) * n + 150.0 * u});
+    d.balls.push_back(ball("disc", o + 10.0 * u, 2.0 * n + 1.0 * u, 1));
+    World w(d, mode);
+    Run run;
+    run_to(w, run, 20.0);
+    CHECK(run.count(EventKind::wedged) >= 1);
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}
+
+TEST_CASE("a ball exactly filling the gap between a wall and a standing turtle is wedged", "[squeeze][turtle]") {
+  for (Mode mode : kModes) {
+    INFO("mode " << (mode == Mode::exact ? "exact" : "step"));
+    WorldDef d = box(200, 200);
+    d.turtles.push_back(turtle("t", {30, 100}, 0, 10));  // reaches x = 40
+    d.balls.push_back(ball("b", {41, 100}, {1, 0.5}, 1));  // touches the turtle and the wall x = 42
+    d.walls.push_back({"w", {42, 0}, {42, 200}});
+    World w(d, mode);
+    Run run;
+    run_to(w, run, 10.0);
+    CHECK(run.count(EventKind::wedged) >= 1);
+    CHECK(w.measure_overlap().relative <= 1e-9);
+    CHECK(w.ball(0).alive);
+  }
+}
+
+TEST_CASE("a bouncing turtle in a corridor exactly its width, heading 89 degrees, is wedged and drives on", "[squeeze][turtle]") {
+  for (Mode mode : kModes) {
+    INFO("mode " << (mode == Mode::exact ? "exact" : "step"));
+    WorldDef d = box(400, 100);
+    d.walls.push_back({"lo", {0, 40}, {400, 40}});
+    d.walls.push_back({"hi", {0, 60}, {400, 60}});
+    TurtleDef t = turtle("t", {50, 50}, 89, 10);
+    t.bounce = 1.0;
+    d.turtles.push_back(t);
+    World w(d, mode);
+    Run run;
+    w.set_event_log(&run.log);
+    w.set_event_limit(kLimit);
+    w.command_turtle(0, {TurtleCommand::Kind::move, 100});
+    REQUIRE_NOTHROW(w.advance_to(5.0));
+    CHECK(run.count(EventKind::wedged) >= 1);
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}
+
+namespace {
+
+/// Advances w to `until` in `samples` slices under the event limit; the deepest overlap seen.
+double deepest_over_run(World& w, Run& run, double until, int samples, std::uint64_t limit = kLimit) {
+  w.set_event_log(&run.log);
+  w.set_event_limit(limit);
+  double worst = 0.0;
+  for (int k = 1; k <= samples; ++k) {
+    w.advance_to(until * k / samples);
+    worst = std::max(worst, w.measure_overlap().relative);
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("a disc dropped into a sharp V under gravity comes to rest where it wedges, in both modes", "[squeeze][rest]") {
+  for (Mode mode : kModes) {
+    for (double half_deg : {1.0, 0.1}) {
+      for (double e : {0.9, 0.5}) {
+        for (double x0 : {100.0, 100.3}) {
+          INFO("mode " << (mode == Mode::exact ? "exact" : "step") << ", opening " << 2 * half_deg << " degrees, e = "
+                       << e << ", dropped at x = " << x0);
+          const double h = half_deg * M_PI / 180.0;
+          const Vec2 apex{100, 20};
+          const double len = 1.5 / std::sin(h);  // the walls reach past where the disc wedges
+          WorldDef d = box(200, 20 + len + 50);
+          d.walls.push_back({"l", apex, apex + len * Vec2{-std::sin(h), std::cos(h)}});
+          d.walls.push_back({"r", apex, apex + len * Vec2{std::sin(h), std::cos(h)}});
+          d.effects.gravity = {0, -10};
+          d.effects.restitution = e;
+          const double wedge_y = apex.y + 1.0 / std::sin(h);  // centre of a disc of radius 1 touching both
+          d.balls.push_back(ball("b", {x0, wedge_y + 0.9 * (len * std::cos(h) - 1.0 / std::sin(h))}, {0, 0}, 1));
+          World w(d, mode);
+          Run run;
+          // (Wedged, it hops at the rest threshold's scale, about one hop per t_c = 1e-4 s: some
+          // 1e5 events in 12 s.)
+          const double worst = deepest_over_run(w, run, 12.0, 40, 1000000);
+          CHECK(worst <= 1e-9);
+          CHECK(w.ball(0).pos.y == Approx(wedge_y).margin(1e-3));
+          CHECK(w.ball(0).pos.x == Approx(100).margin(1e-3));
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("a disc in a vertical tube exactly 2r wide falls along it, wedged", "[squeeze][rest]") {
+  for (Mode mode : kModes) {
+    INFO("mode " << (mode == Mode::exact ? "exact" : "step"));
+    WorldDef d = box(100, 400);
+    d.walls.push_back({"l", {49, 10}, {49, 390}});
+    d.walls.push_back({"r", {51, 10}, {51, 390}});
+    d.effects.gravity = {0, -10};
+    d.effects.restitution = 0.9;
+    d.balls.push_back(ball("b", {50, 380}, {0.5, 0}, 1));
+    World w(d, mode);
+    Run run;
+    const double worst = deepest_over_run(w, run, 5.0, 20);
+    CHECK(worst <= 1e-9);
+    CHECK(run.count(EventKind::wedged) >= 1);
+    CHECK(w.ball(0).pos.x == Approx(50).margin(1e-9));
+  }
+}
+
+TEST_CASE("a disc sliding along a 2r corridor built of 80 two-unit segments goes through, in both modes", "[squeeze]") {
+  for (Mode mode : kModes) {
+    INFO("mode " << (mode == Mode::exact ? "exact" : "step"));
+    WorldDef d = box(200, 100);
+    for (int k = 0; k < 80; ++k) {
+      const double x = 10.0 + 2.0 * k;
+      d.walls.push_back({"lo" + std::to_string(k), {x, 49}, {x + 2, 49}});
+      d.walls.push_back({"hi" + std::to_string(k), {x, 51}, {x + 2, 51}});
+    }
+    d.balls.push_back(ball("b", {12, 50}, {10, 0.3}, 1));
+    World w(d, mode);
+    Run run;
+    run_to(w, run, 20.0);
+    CHECK(w.measure_overlap().relative <= 1e-9);
+    CHECK(w.ball(0).alive);
+  }
+}
