@@ -24,7 +24,7 @@
 #include <mpi.h>
 #endif
 
-#include "atomic_file.hpp"
+#include "output_file.hpp"
 #include "child_processes.hpp"
 #include "cli_common.hpp"
 #include "option_checks.hpp"
@@ -384,7 +384,7 @@ std::string summary_table(const Spec& spec, const Results& results) {
 /// The results file: a header line, then every run's line in run order. The same for any --jobs,
 /// any number of MPI ranks, and a resumed sweep.
 void write_results(const std::string& out, const Spec& spec, const Results& results) {
-  AtomicFile f(out, "--out");
+  OutputFile f(out, "--out");
   nlohmann::ordered_json header;
   header["format"] = "turtlegas-sweep-results/1";
   header["spec"] = spec.text;

@@ -83,7 +83,7 @@ extern "C" void turtlegas_register(turtlegas::turtle::Registry& registry) {
         t.wait(p.get("after", 0.5));
         const std::string how = p.get<std::string>("how", "null");
         if (how == "null") {
-          volatile int* volatile g_nowhere = nullptr;
+          volatile int* volatile nowhere = nullptr;
           *nowhere = 1;
         }
         if (how == "abort") std::abort();

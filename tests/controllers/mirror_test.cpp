@@ -300,6 +300,7 @@ TEST_CASE("the mirror controller's params are checked, naming the turtle and the
     }
   }
   // A mirror of a mirror across the same line is the controller itself.
-  program.params = {{"of", "mirror"}, {"params", {{"of", "script"}, {"params", {{"commands", {{"forward", 1}}}}}}}};
+  const nlohmann::json commands = nlohmann::json::array({nlohmann::json::array({"forward", 1})});
+  program.params = {{"of", "mirror"}, {"params", {{"of", "script"}, {"params", {{"commands", commands}}}}}};
   CHECK_NOTHROW(turtle::WorldServer(def, {program}, registry, {}));
 }

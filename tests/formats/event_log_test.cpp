@@ -49,7 +49,7 @@ TEST_CASE("the event log names each kind's bodies, and both inputs write the sam
   for (const sim::Event& e : events) {
     const turtle::EventIds ids = turtle::name_event(e, Names{});
     logged.push_back({e.t, std::string(sim::to_string(e.kind)), std::string(ids.a),
-                      ids.b ? std::string(*ids.b) : std::string(), {}, 0.0, {}});
+                      ids.b ? std::string(*ids.b) : std::string(), {}, 0.0, {}, {}});
   }
   std::ostringstream server;
   formats::EventLogWriter(server).write(logged);
@@ -58,9 +58,9 @@ TEST_CASE("the event log names each kind's bodies, and both inputs write the sam
 
 TEST_CASE("touch and fault lines carry their extra fields", "[formats]") {
   const std::vector<turtle::LogEvent> logged = {
-      {1.0, "touch", "t0", "w1", {"front", "left"}, 337.5, {}},
-      {1.0, "touch", "t0", "b0", {}, 0.0, {}},
-      {2.0, "fault", "t1", {}, {}, 0.0, "its program threw: \"x\"\n"},
+      {1.0, "touch", "t0", "w1", {"front", "left"}, 337.5, {}, {}},
+      {1.0, "touch", "t0", "b0", {}, 0.0, {}, {}},
+      {2.0, "fault", "t1", {}, {}, 0.0, "its program threw: \"x\"\n", {}},
   };
   std::ostringstream out;
   formats::EventLogWriter(out).write(logged);

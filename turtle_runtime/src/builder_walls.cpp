@@ -82,7 +82,7 @@ void WorldServer::add_wall(const sim::WallDef& wall) {
   if (s.id_taken(wall.id))
     throw std::invalid_argument("id '" + wall.id + "' is taken; give the wall an id that no wall, ball or turtle has");
   s.world.add_wall(wall);  // throws std::invalid_argument, changing nothing
-  s.emit({s.world.time(), "wall-added", wall.id, {}, {}, 0.0, {}});
+  s.emit({s.world.time(), "wall-added", wall.id, {}, {}, 0.0, {}, {}});
 }
 
 }  // namespace turtlegas::turtle

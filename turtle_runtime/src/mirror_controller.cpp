@@ -45,6 +45,7 @@ Controller compose(const Registry& registry, const json& params, const std::stri
       throw bad("params.twin: the id of the turtle this one mirrors (its random stream is shared), one of this world's turtles");
   }
   Controller inner;
+  json given = inner_params;  // the wrapped controller's params, with its declared defaults
   if (of == "mirror") {
     if (depth >= max_depth) throw bad("params.of: mirrors nested more than " + std::to_string(max_depth) + " deep");
     inner = compose(registry, inner_params, context + " (params.params)", turtle_ids, depth + 1);
@@ -52,8 +53,15 @@ Controller compose(const Registry& registry, const json& params, const std::stri
     const Controller* c = registry.find(of);
     if (!c) throw bad("params.of: " + registry.not_registered(of));
     inner = *c;
+    // As for a turtle's own params: checked against the wrapped controller's declarations, and
+    // its declared defaults filled in (Params::get<T>(key) without a fallback reads them).
+    if (const ControllerInfo* info = registry.info(of)) {
+      if (auto problem = check_params(of, *info, inner_params))
+        throw bad("params.params" + problem->pointer + ": " + problem->reason);
+      given = with_defaults(*info, inner_params);
+    }
   }
-  return [inner = std::move(inner), p = Params(inner_params), axis, through](Turtle& t, const Params&) {
+  return [inner = std::move(inner), p = Params(given), axis, through](Turtle& t, const Params&) {
     Turtle m = t.mirrored(axis, through);
     inner(m, p);
   };
