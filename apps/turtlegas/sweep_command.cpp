@@ -1,4 +1,7 @@
 // SPDX-License-Identifier: MIT
+// `turtlegas sweep`: the spec, its runs, the journal that makes a sweep resumable, local children
+// and MPI ranks, one results file. Just over 600 lines: the local and the MPI schedulers share the
+// journal and results code in this file, and splitting them apart would expose it for two callers.
 #include "sweep_command.hpp"
 
 #include <fcntl.h>

@@ -1,4 +1,9 @@
 // SPDX-License-Identifier: MIT
+// The simulation side of `turtlegas serve`: the one WorldServer, its inbox applied at control
+// boundaries, pacing, frames, remote turtles, files. Over 600 lines because handle_message
+// dispatches every protocol message (about 275 lines, one case per message type, each validating
+// and answering as docs/protocol.md says); it is the first thing to move into per-message handlers
+// when the protocol grows (the viewer's view_* messages would be the moment).
 #include "turtlegas/server/world_host.hpp"
 
 #include <unistd.h>

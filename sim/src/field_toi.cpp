@@ -1,4 +1,9 @@
 // SPDX-License-Identifier: MIT
+// Times of impact of field flights (field_toi.hpp). Over 600 lines on purpose: the pair, face, end
+// and cell-exit searches share file-local machinery (gap projections, critical phases, the
+// isolation of monotone pieces, the bracketed search and its continuation) that no other file
+// should see; split, it would become a public header of internals. Read it in its order: helpers
+// and the projection of a gap (top), the pair searches, walls and ends, cell exits, quiet times.
 #include "turtlegas/sim/field_toi.hpp"
 
 #include <algorithm>
