@@ -54,30 +54,27 @@ Estimate estimate(const std::vector<double>& x) {
   return e;
 }
 
-/// a - b, with Welch's interval.
-Comparison compare(const TournamentRow& a, const TournamentRow& b) {
-  Comparison c;
-  c.a = a.controller;
-  c.b = b.controller;
-  c.difference.mean = a.time_it.mean - b.time_it.mean;
-  c.difference.n = std::min(a.time_it.n, b.time_it.n);
-  if (a.time_it.n < 2 || b.time_it.n < 2) {
-    c.difference.half_width = std::numeric_limits<double>::infinity();
-    return c;
+/// a - b over their own rounds, with Welch's interval (unequal variances, Welch-Satterthwaite degrees
+/// of freedom): the fallback for two controllers that met in fewer than two rounds.
+Estimate welch_difference(const Estimate& a, const Estimate& b) {
+  Estimate d;
+  d.mean = a.mean - b.mean;
+  d.n = std::min(a.n, b.n);
+  if (a.n < 2 || b.n < 2) {
+    d.half_width = std::numeric_limits<double>::infinity();
+    return d;
   }
-  const double va = a.time_it.sd * a.time_it.sd / static_cast<double>(a.time_it.n);
-  const double vb = b.time_it.sd * b.time_it.sd / static_cast<double>(b.time_it.n);
-  const double se = std::sqrt(va + vb);
-  c.difference.sd = se;
-  if (se == 0.0) {
-    c.difference.half_width = 0.0;
-  } else {
-    const double df = (va + vb) * (va + vb) /
-                      (va * va / static_cast<double>(a.time_it.n - 1) + vb * vb / static_cast<double>(b.time_it.n - 1));
-    c.difference.half_width = t_quantile_975(std::max(1.0, df)) * se;
+  const double va = a.sd * a.sd / static_cast<double>(a.n);
+  const double vb = b.sd * b.sd / static_cast<double>(b.n);
+  d.sd = std::sqrt(va + vb);
+  if (d.sd == 0.0) {
+    d.half_width = 0.0;
+    return d;
   }
-  c.significant = std::abs(c.difference.mean) > c.difference.half_width;
-  return c;
+  const double df = (va + vb) * (va + vb) /
+                    (va * va / static_cast<double>(a.n - 1) + vb * vb / static_cast<double>(b.n - 1));
+  d.half_width = t_quantile_975(std::max(1.0, df)) * d.sd;
+  return d;
 }
 
 std::string number(double v, int digits = 3) {
@@ -87,6 +84,34 @@ std::string number(double v, int digits = 3) {
 }
 
 }  // namespace
+
+Estimate paired_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) throw std::invalid_argument("paired_difference: the two series differ in length");
+  std::vector<double> d;
+  for (std::size_t r = 0; r < a.size(); ++r)
+    if (!std::isnan(a[r]) && !std::isnan(b[r])) d.push_back(a[r] - b[r]);
+  return estimate(d);
+}
+
+Comparison compare(const std::string& a, const std::vector<double>& a_rounds, const std::string& b,
+                   const std::vector<double>& b_rounds) {
+  Comparison c;
+  c.a = a;
+  c.b = b;
+  c.difference = paired_difference(a_rounds, b_rounds);
+  if (c.difference.n < 2) {
+    auto own = [](const std::vector<double>& x) {
+      std::vector<double> v;
+      for (double t : x)
+        if (!std::isnan(t)) v.push_back(t);
+      return estimate(v);
+    };
+    c.difference = welch_difference(own(a_rounds), own(b_rounds));
+    c.paired = false;
+  }
+  c.significant = std::abs(c.difference.mean) > c.difference.half_width;
+  return c;
+}
 
 TournamentResult run_tag_tournament(const Scene& scene, const std::string& world_file,
                                     const TournamentOptions& options, const turtle::Registry& registry) {
@@ -119,6 +144,9 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
     if (!p.is_object()) throw std::invalid_argument("--params " + name + ": params must be a JSON object");
   }
   std::vector<std::vector<double>> round_time_it(c), round_tags(c);
+  // The same values by round number, NaN where the controller did not play: rounds pair them.
+  const double absent = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::vector<double>> by_round(c, std::vector<double>(options.rounds, absent));
 
   for (std::size_t r = 0; r < options.rounds; ++r) {
     sim::WorldDef def = scene.def;
@@ -168,6 +196,7 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
       if (drove[k] == 0) continue;
       ++rows[k].rounds;
       round_time_it[k].push_back(t_sum[k] / static_cast<double>(drove[k]));
+      by_round[k][r] = round_time_it[k].back();
       round_tags[k].push_back(tags_sum[k] / static_cast<double>(drove[k]));
     }
     result.rounds.push_back(std::move(round));
@@ -187,8 +216,14 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
     return a.tags_per_round > b.tags_per_round;
   });
   for (std::size_t k = 0; k < rows.size(); ++k) rows[k].rank = k + 1;
+  auto rounds_of = [&](const TournamentRow& row) -> const std::vector<double>& {
+    return by_round[static_cast<std::size_t>(std::find(names.begin(), names.end(), row.controller) - names.begin())];
+  };
+  auto compare_rows = [&](const TournamentRow& a, const TournamentRow& b) {
+    return compare(a.controller, rounds_of(a), b.controller, rounds_of(b));
+  };
   for (std::size_t i = 0; i < rows.size(); ++i)
-    for (std::size_t j = i + 1; j < rows.size(); ++j) result.pairwise.push_back(compare(rows[i], rows[j]));
+    for (std::size_t j = i + 1; j < rows.size(); ++j) result.pairwise.push_back(compare_rows(rows[i], rows[j]));
   if (options.rounds % c != 0) {
     std::string starts;
     for (const TournamentRow& row : rows)
@@ -198,7 +233,7 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
                            "); play a multiple of " + std::to_string(c) + " rounds");
   }
   for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
-    const Comparison cmp = compare(rows[i], rows[i + 1]);
+    const Comparison cmp = compare_rows(rows[i], rows[i + 1]);
     if (cmp.significant) continue;
     std::string note = "ranks " + std::to_string(i + 1) + " and " + std::to_string(i + 2) + " (" + rows[i].controller +
                        ", " + rows[i + 1].controller + ") cannot be told apart at 95 %: their mean time as \"it\" ";
@@ -206,7 +241,9 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
     if (!std::isfinite(hw)) {
       note += "needs at least 2 rounds each";
     } else {
-      note += "differs by " + number(d) + " +/- " + number(hw) + " s (Welch t-interval)";
+      note += "differs by " + number(d) + " +/- " + number(hw) + " s (" +
+              (cmp.paired ? "paired t-interval over the rounds both played" : "Welch t-interval: they never met twice") +
+              ")";
       if (d > 0.0) {
         // The interval narrows as 1/sqrt(rounds): this many would make a difference this size stand out.
         const double need = std::ceil(static_cast<double>(options.rounds) * (hw / d) * (hw / d) /
@@ -244,7 +281,8 @@ nlohmann::json to_json(const TournamentResult& result) {
                         {"b", p.b},
                         {"time_it_difference", p.difference.mean},
                         {"ci95", finite_or_null(p.difference.half_width)},
-                        {"significant", p.significant}});
+                        {"significant", p.significant},
+                        {"method", p.paired ? "paired" : "welch"}});
   nlohmann::json rounds = nlohmann::json::array();
   for (const TournamentRound& r : result.rounds) {
     nlohmann::json turtles = nlohmann::json::array();
@@ -263,7 +301,8 @@ nlohmann::json to_json(const TournamentResult& result) {
           {"until", result.options.until},
           {"controllers", result.options.controllers},
           {"method", "per controller, one value per round it played (its turtles' mean); 95 % Student t-interval "
-                     "over rounds; pairs: Welch t-interval of the difference of mean time as it"},
+                     "over rounds; pairs: paired t-interval of the per-round difference of time as it over the rounds "
+                     "both played (Welch's interval over their own rounds for a pair that met in fewer than 2)"},
           {"ranking", ranking},
           {"pairwise", pairwise},
           {"notes", result.notes},
@@ -288,7 +327,7 @@ std::string ranking_table(const TournamentResult& result) {
     out += line;
   }
   if (result.ranking.size() > 1) {
-    out += "\nmean time as \"it\", row minus column, s (95 % Welch t-interval; * : significant)\n";
+    out += "\nmean time as \"it\", row minus column, s (95 % paired t-interval over rounds; * : significant)\n";
     std::snprintf(line, sizeof line, "%-*s", w, "");
     out += line;
     for (std::size_t j = 1; j < result.ranking.size(); ++j) {

@@ -48,13 +48,26 @@ struct TournamentRow {
   std::size_t rank = 0;          ///< 1 is best: least mean time as "it", then most tags per round
 };
 
-/// Two controllers compared: the difference of their mean time as "it" (a - b) with a 95 % Welch
-/// t-interval (unequal variances, Welch-Satterthwaite degrees of freedom).
+/// Two controllers compared: the mean per-round difference of their time as "it" (a - b) over the
+/// rounds both played, with a 95 % paired t-interval. Pairing matters: in one tag round the times
+/// as "it" share the round's length, so they are negatively correlated and an interval that treats
+/// them as independent (Welch's) is too narrow and calls differences significant too often. A pair
+/// that met in fewer than 2 rounds falls back to Welch's interval over their own rounds.
 struct Comparison {
   std::string a, b;
   Estimate difference;
   bool significant = false;  ///< the interval excludes 0
+  bool paired = true;        ///< false: Welch's fallback
 };
+
+/// Mean and 95 % t-interval of a[r] - b[r] over the rounds r where neither is NaN (a NaN marks a
+/// round the controller did not play); n is that count. Throws std::invalid_argument when the
+/// lengths differ.
+Estimate paired_difference(const std::vector<double>& a, const std::vector<double>& b);
+
+/// The comparison of two controllers from their per-round values (NaN where one did not play).
+Comparison compare(const std::string& a, const std::vector<double>& a_rounds, const std::string& b,
+                   const std::vector<double>& b_rounds);
 struct TournamentRound {
   std::size_t round = 0;
   std::uint64_t seed = 0;
@@ -92,7 +105,8 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
 
 /// {"world", "rounds", "until", "controllers", "method", "ranking": [{"rank", "controller", "rounds",
 /// "turtle_rounds", "mean_time_it", "time_it_ci95", "tags", "tags_per_round", "tags_per_round_ci95",
-/// "starts_it", "faults"}], "pairwise": [{"a", "b", "time_it_difference", "ci95", "significant"}],
+/// "starts_it", "faults"}], "pairwise": [{"a", "b", "time_it_difference", "ci95", "significant",
+/// "method": "paired" | "welch"}],
 /// "notes": [...], "round_results": [...]}
 nlohmann::json to_json(const TournamentResult& result);
 
