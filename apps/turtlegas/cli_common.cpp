@@ -70,6 +70,20 @@ CLI::Validator integer_in(std::int64_t min, std::int64_t max, const std::string&
       words);
 }
 
+CLI::Option* add_stack_kib_option(CLI::App& cmd, std::size_t& kib) {
+  return cmd.add_option("--stack-kib", kib, "Each turtle program's stack, KiB (a guard page is added)")
+      ->capture_default_str()
+      ->check(integer_in(16, 1024 * 1024, "KiB"));
+}
+
+CLI::Option* add_program_budget_option(CLI::App& cmd, double& seconds, const std::string& what_stops) {
+  return cmd
+      .add_option("--program-budget", seconds,
+                  "Wall-clock seconds a turtle program may run without issuing a command before " + what_stops)
+      ->capture_default_str()
+      ->check(real_in(0, 1e6, "seconds", true));
+}
+
 std::string count_summary(const sim::WorldDef& def, std::size_t balls) {
   auto plural = [](std::size_t n, const char* noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); };
   std::string s = plural(balls, "ball") + ", " + plural(def.walls.size(), "wall");

@@ -61,6 +61,12 @@ CLI::Validator real_in(double min, double max, const std::string& unit, bool min
 /// A whole number from `min` to `max`, written without a fraction or exponent.
 CLI::Validator integer_in(std::int64_t min, std::int64_t max, const std::string& unit = {});
 
+/// The options of every command that runs turtle programs (run, test, tag, sweep), one
+/// definition with one range: `--stack-kib` (16 KiB to 1 GiB; below 16 KiB the API's own frames
+/// do not fit) and `--program-budget` (seconds of wall clock, > 0 and at most 10^6).
+CLI::Option* add_stack_kib_option(CLI::App& cmd, std::size_t& kib);
+CLI::Option* add_program_budget_option(CLI::App& cmd, double& seconds, const std::string& what_stops);
+
 /// "3 balls, 1 wall (+4 arena walls), 2 turtles".
 std::string count_summary(const sim::WorldDef& def, std::size_t balls);
 /// "none", "walls" or "periodic".

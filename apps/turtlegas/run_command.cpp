@@ -258,13 +258,8 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
   run->add_option("--plugin", plugins, plugin_help);
   run->add_option("--inputs", opt.inputs,
                   "Replay this input log (written by `turtlegas serve --inputs-out`) into the world's remote turtles");
-  run->add_option("--stack-kib", opt.stack_kib, "Each turtle program's stack, KiB (a guard page is added)")
-      ->capture_default_str()
-      ->check(integer_in(16, 1024 * 1024, "KiB"));
-  run->add_option("--program-budget", opt.program_budget,
-                  "Wall-clock seconds a turtle program may run without issuing a command before the run stops")
-      ->capture_default_str()
-      ->check(real_in(0, 1e6, "seconds", true));
+  add_stack_kib_option(*run, opt.stack_kib);
+  add_program_budget_option(*run, opt.program_budget, "the run stops");
   line.max_wall_option =
       run->add_option("--max-wall-seconds", line.max_wall_seconds,
                       "Stop the run cleanly after this much wall-clock time, outputs written up to there (exit 3)")

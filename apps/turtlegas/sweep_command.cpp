@@ -30,7 +30,6 @@
 #include "output_file.hpp"
 #include "child_processes.hpp"
 #include "cli_common.hpp"
-#include "option_checks.hpp"
 #include "turtlegas/formats/stats_file.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/scenario.hpp"
@@ -545,23 +544,19 @@ CLI::App* add_sweep_command(CLI::App& app, SweepOptions& options) {
   cmd->add_option("spec", options.spec, "Sweep spec (format turtlegas-sweep/1, docs/sweeps.md)")->required();
   cmd->add_option("--out,-o", options.out, "Results file (JSON lines); default <spec's name>.results.jsonl here");
   cmd->add_option("--jobs,-j", options.jobs, "Runs at once on this machine, each in its own process")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(1, 1024, "processes"));
   cmd->add_option("--timeout", options.timeout, "Wall-clock seconds a run may take before it is killed (0: no limit)")
-      ->capture_default_str();
-  cmd->add_option("--stack-kib", options.stack_kib, "Each turtle program's stack, KiB")->capture_default_str();
-  cmd->add_option("--program-budget", options.program_budget,
-                  "Wall-clock seconds a turtle program may run without issuing a command")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(0, 1e9, "seconds"));
+  add_stack_kib_option(*cmd, options.stack_kib);
+  add_program_budget_option(*cmd, options.program_budget, "its run fails");
   cmd->add_flag("--quiet,-q", options.quiet, "No progress lines");
   cmd->add_option("--run", options.child_run, "(internal) run this one run here, report on descriptor 3")->group("");
   return cmd;
 }
 
 int sweep_command(const SweepOptions& options, const turtle::Registry& registry, const std::vector<std::string>& plugins) {
-  check_count("--jobs", options.jobs, 1, 1024);
-  check_seconds("--timeout", options.timeout, true);
-  check_stack_kib(options.stack_kib);
-  check_program_budget(options.program_budget);
   const Spec spec = parse_spec(options.spec);
   const std::string out = options.out.empty() ? default_out(options.spec) : options.out;
 

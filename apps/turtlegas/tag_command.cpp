@@ -2,6 +2,7 @@
 #include "tag_command.hpp"
 
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <vector>
@@ -11,7 +12,6 @@
 
 #include "output_file.hpp"
 #include "cli_common.hpp"
-#include "option_checks.hpp"
 
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/tag_tournament.hpp"
@@ -24,8 +24,12 @@ CLI::App* add_tag_command(CLI::App& app, TagCommandOptions& options) {
       ->required();
   tag->add_option("--controllers", options.controllers, "Comma-separated controller names, e.g. tag_chaser,tag_evader")
       ->required();
-  tag->add_option("--rounds", options.rounds, "Rounds to play, each with its own seed")->capture_default_str();
-  tag->add_option("--until", options.until, "Simulated seconds per round")->capture_default_str();
+  tag->add_option("--rounds", options.rounds, "Rounds to play, each with its own seed")
+      ->capture_default_str()
+      ->check(integer_in(1, 100000000, "rounds"));
+  tag->add_option("--until", options.until, "Simulated seconds per round")
+      ->capture_default_str()
+      ->check(real_in(0, std::numeric_limits<double>::max(), "seconds", true));
   tag->add_option("--json", options.json_out, "Write the ranking and every round's score here (JSON)");
   tag->add_option("--mode", options.mode, "exact (event-driven) or step (the memo's fixed steps)")
       ->check(CLI::IsMember(sim::mode_names))
@@ -33,11 +37,8 @@ CLI::App* add_tag_command(CLI::App& app, TagCommandOptions& options) {
   tag->add_option("--params", options.params,
                   "A param for every turtle a controller drives, controller.key=value (value: JSON, else a string); "
                   "repeatable");
-  tag->add_option("--stack-kib", options.stack_kib, "Each turtle program's stack, KiB (a guard page is added)")
-      ->capture_default_str();
-  tag->add_option("--program-budget", options.program_budget,
-                  "Wall-clock seconds a turtle program may run without issuing a command before the round stops")
-      ->capture_default_str();
+  add_stack_kib_option(*tag, options.stack_kib);
+  add_program_budget_option(*tag, options.program_budget, "the round stops");
   return tag;
 }
 
@@ -55,10 +56,6 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
   t.rounds = options.rounds;
   t.until = options.until;
   t.server.mode = sim::mode_from_string(options.mode).value_or(sim::Mode::exact);  // CLI11 checked it
-  check_count("--rounds", options.rounds, 1, 100000000);
-  check_seconds("--until", options.until, false);
-  check_stack_kib(options.stack_kib);
-  check_program_budget(options.program_budget);
   t.server.stack_bytes = options.stack_kib * 1024;
   t.server.program_budget = options.program_budget;
   for (const std::string& p : options.params) {

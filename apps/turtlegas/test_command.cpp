@@ -18,7 +18,6 @@
 #include "output_file.hpp"
 #include "child_processes.hpp"
 #include "cli_common.hpp"
-#include "option_checks.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/expect.hpp"
 #include "turtlegas/world/scenario.hpp"
@@ -268,15 +267,15 @@ CLI::App* add_test_command(CLI::App& app, TestOptions& options) {
   cmd->add_option("worlds", options.worlds, "World files with an \"expect\" list")->required();
   cmd->add_option("--mode", options.mode, "exact or step: overrides each world's own {\"mode\": ...}")
       ->check(CLI::IsMember(sim::mode_names));
-  cmd->add_option("--program-budget", options.program_budget,
-                  "Wall-clock seconds a turtle program may run without issuing a command before its world fails")
-      ->capture_default_str();
-  cmd->add_option("--stack-kib", options.stack_kib, "Each turtle program's stack, KiB (a guard page is added)")
-      ->capture_default_str();
-  cmd->add_option("--jobs,-j", options.jobs, "Worlds run at once, each in its own process")->capture_default_str();
+  add_program_budget_option(*cmd, options.program_budget, "its world fails");
+  add_stack_kib_option(*cmd, options.stack_kib);
+  cmd->add_option("--jobs,-j", options.jobs, "Worlds run at once, each in its own process")
+      ->capture_default_str()
+      ->check(integer_in(1, 1024, "processes"));
   cmd->add_option("--timeout", options.timeout,
                   "Wall-clock seconds a world may take before it is killed and fails (0: no limit)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(0, 1e9, "seconds"));
   cmd->add_option("--junit", options.junit, "Write a JUnit XML report here (for CI)");
   cmd->add_flag("--tap", options.tap, "Print TAP 13 on stdout instead of PASS/FAIL lines");
   cmd->add_flag("--quiet,-q", options.quiet, "Leave out the worlds' log lines; print only the results");
@@ -286,10 +285,6 @@ CLI::App* add_test_command(CLI::App& app, TestOptions& options) {
 }
 
 int test_command(const TestOptions& options, const turtle::Registry& registry, const std::vector<std::string>& plugins) {
-  check_stack_kib(options.stack_kib);
-  check_program_budget(options.program_budget);
-  check_count("--jobs", options.jobs, 1, 1024);
-  check_seconds("--timeout", options.timeout, true);
   if (options.child) return child_main(options, registry);
 
   // Opened first, so that a bad path costs nothing; renamed into place when written whole.

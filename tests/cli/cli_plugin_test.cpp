@@ -201,11 +201,12 @@ TEST_CASE("test: numeric options out of range are bad input") {
   TempDir dir;
   const fs::path chatty = dir.write("chatty.json", one_turtle_test("chatty"));
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
-      {{"--jobs", "0"}, "--jobs must be from 1 to 1024 (got 0)"},
-      {{"--timeout", "-1"}, "--timeout must be a finite time >= 0"},
-      {{"--timeout", "nan"}, "--timeout must be a finite time >= 0"},
-      {{"--stack-kib", "4"}, "--stack-kib must be from 16 to 1048576 (got 4)"},
-      {{"--program-budget", "0"}, "--program-budget must be a finite time > 0"},
+      {{"--jobs", "0"}, "--jobs: must be a whole number of processes from 1 to 1024 (got 0)"},
+      {{"--jobs", "-1"}, "--jobs: must be a whole number of processes from 1 to 1024 (got -1)"},
+      {{"--timeout", "-1"}, "--timeout: must be a number of seconds from 0 to"},
+      {{"--timeout", "nan"}, "--timeout: must be a number of seconds from 0 to"},
+      {{"--stack-kib", "4"}, "--stack-kib: must be a whole number of KiB from 16 to 1048576 (got 4)"},
+      {{"--program-budget", "0"}, "--program-budget: must be a number of seconds from 0 (exclusive) to"},
   };
   for (const auto& [opts, message] : cases) {
     std::vector<std::string> args = {"test", chatty.string(), "--plugin", TEST_PLUGIN};

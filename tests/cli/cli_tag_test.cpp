@@ -82,10 +82,13 @@ TEST_CASE("turtlegas tag: intervals, the pairwise table, notes, --params and ran
   const std::vector<std::pair<std::vector<std::string>, std::string>> bad = {
       {{"--params", "lunge=25"}, "--params lunge=25: write controller.key=value"},
       {{"--params", "wander.step=3"}, "'wander' is not one of --controllers"},
-      {{"--stack-kib", "8"}, "--stack-kib must be from 16"},
-      {{"--program-budget", "-1"}, "--program-budget must be a finite time > 0"},
-      {{"--rounds", "0"}, "--rounds must be from 1"},
-      {{"--until", "0"}, "--until must be a finite time > 0"},
+      {{"--stack-kib", "8"}, "--stack-kib: must be a whole number of KiB from 16 to 1048576 (got 8)"},
+      {{"--program-budget", "-1"}, "--program-budget: must be a number of seconds from 0 (exclusive) to"},
+      {{"--rounds", "0"}, "--rounds: must be a whole number of rounds from 1 to 100000000 (got 0)"},
+      // The text as typed: a check after CLI11's conversion said "(got 18446744073709551615)".
+      {{"--rounds", "-1"}, "--rounds: must be a whole number of rounds from 1 to 100000000 (got -1)"},
+      {{"--until", "0"}, "--until: must be a number of seconds > 0 (got 0)"},
+      {{"--until", "inf"}, "--until: must be a number of seconds > 0 (got inf)"},
   };
   for (const auto& [extra, message] : bad) {
     std::vector<std::string> args = {"tag", "worlds/tag.json", "--controllers", "tag_chaser,tag_evader"};
