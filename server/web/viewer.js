@@ -676,6 +676,8 @@
     requestAnimationFrame(frame);
   }
 
+  if (params.get('json') === '1') document.getElementById('binary').checked = false;
+
   // ---- controls ------------------------------------------------------------------------------
   function wire() {
     document.getElementById('pause').onclick = () => send({type: 'pause'});

@@ -6,6 +6,7 @@ Chromium reads NUL-terminated JSON commands on its fd 3 and writes replies and e
 Every wait is bounded."""
 
 import base64
+import fcntl
 import json
 import os
 import select
@@ -46,8 +47,10 @@ class Browser:
                 "--user-data-dir=" + self.profile, "--window-size=%d,%d" % (width, height), "about:blank"]
 
         def child():
-            os.dup2(cmd_r, 3)
-            os.dup2(ev_w, 4)
+            # Through fds >= 10 first: the pipe's own numbers may be 3 or 4.
+            a, b = fcntl.fcntl(cmd_r, fcntl.F_DUPFD, 10), fcntl.fcntl(ev_w, fcntl.F_DUPFD, 10)
+            os.dup2(a, 3)
+            os.dup2(b, 4)
 
         self.stderr = tempfile.TemporaryFile()
         self.proc = subprocess.Popen(args, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=self.stderr,
