@@ -212,6 +212,36 @@ def test():
         st = page.state()
         check(st["t"] == t0 and api_state(server)["t"] == s0, "paused: the clock stays at %s (page %s, server %s)" % (t0, st["t"], api_state(server)["t"]))
         check("PAUSED" in st["status"] and "t=%.2f" % t0 in st["status"], "the status line says paused at t: %r" % st["status"])
+
+        # Clicking a turtle opens a view that follows it; dragging a rectangle, a fixed view of it.
+        rect = b.eval("(() => { const r = document.querySelector('canvas[data-view=\"room\"]').getBoundingClientRect();"
+                      " return [r.left, r.top, r.width, r.height]; })()")
+        w, h = page.canvas("room")
+        x1, y1 = turtle_pose(st, "t1")[:2]
+
+        def page_xy(p):
+            px, py = to_pixel(views["room"], None, p, w, h)
+            return rect[0] + px * rect[2] / w, rect[1] + py * rect[3] / h
+
+        def mouse(kind, xy):
+            b.call("Input.dispatchMouseEvent", {"type": kind, "x": xy[0], "y": xy[1], "button": "left",
+                                                "buttons": 1 if kind != "mouseReleased" else 0, "clickCount": 1})
+
+        at = page_xy((x1, y1))
+        mouse("mousePressed", at)
+        mouse("mouseReleased", at)
+        b.wait_for("turtlegasViewer.state.views.some((v) => v.follow === 't1' && !v.rotate) && "
+                   "document.querySelector('canvas[data-view=\"t1-follow\"]') !== null", 10, "a click on t1 opens a view following it")
+        a, z = page_xy((220, 40)), page_xy((300, 100))
+        mouse("mousePressed", a)
+        for k in range(1, 6):
+            mouse("mouseMoved", (a[0] + k * (z[0] - a[0]) / 5, a[1] + k * (z[1] - a[1]) / 5))
+        mouse("mouseReleased", z)
+        box = b.wait_for("turtlegasViewer.state.views.find((v) => v.id === 'box')", 10, "a drag opens a fixed view")
+        check(abs(box["center"][0] - 260) < 3 and abs(box["center"][1] - 70) < 3 and abs(box["size"][0] - 80) < 3
+              and abs(box["size"][1] - 60) < 3, "the dragged view covers the rectangle: %r" % box)
+        time.sleep(0.5)
+        b.screenshot(os.path.join(shot_dir, "turtlegas_viewer_opened.png"))
         print("ok   browser: fixed, follow and turned views match the geometry (%d wall probes in the turned view); "
               "pause holds t=%.2f; screenshots in %s" % (seen_start + seen, t0, shot_dir))
 
