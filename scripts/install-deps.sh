@@ -11,6 +11,7 @@ packages=(
   dpkg-dev binutils   # the Debian package: cpack (dpkg-shlibdeps), tests/package/deb_test.py (readelf)
   clang libclang-rt-14-dev clang-tidy   # the clang and fuzz presets, scripts/tidy.sh
   libopenmpi-dev openmpi-bin   # turtlegas sweep under mpirun (optional at build time; its test runs mpirun)
+  chromium   # the viewer's browser tests (tests/server/test_browser.py) and bench/viewer_bench.py, headless
 )
 
 missing=()

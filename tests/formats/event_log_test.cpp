@@ -49,23 +49,25 @@ TEST_CASE("the event log names each kind's bodies, and both inputs write the sam
   for (const sim::Event& e : events) {
     const turtle::EventIds ids = turtle::name_event(e, Names{});
     logged.push_back({e.t, std::string(sim::to_string(e.kind)), std::string(ids.a),
-                      ids.b ? std::string(*ids.b) : std::string(), {}, 0.0, {}, {}});
+                      ids.b ? std::string(*ids.b) : std::string(), {}, 0.0, {}, {}, {}});
   }
   std::ostringstream server;
   formats::EventLogWriter(server).write(logged);
   CHECK(server.str() == engine.str());
 }
 
-TEST_CASE("touch and fault lines carry their extra fields", "[formats]") {
+TEST_CASE("touch, fault and view lines carry their extra fields", "[formats]") {
   const std::vector<turtle::LogEvent> logged = {
-      {1.0, "touch", "t0", "w1", {"front", "left"}, 337.5, {}, {}},
-      {1.0, "touch", "t0", "b0", {}, 0.0, {}, {}},
-      {2.0, "fault", "t1", {}, {}, 0.0, "its program threw: \"x\"\n", {}},
+      {1.0, "touch", "t0", "w1", {"front", "left"}, 337.5, {}, {}, {}},
+      {1.0, "touch", "t0", "b0", {}, 0.0, {}, {}, {}},
+      {2.0, "fault", "t1", {}, {}, 0.0, "its program threw: \"x\"\n", {}, {}},
+      {3.0, "view", "v1", {}, {}, 0.0, {}, {}, "\"op\": \"close\", \"by\": \"t1\""},
   };
   std::ostringstream out;
   formats::EventLogWriter(out).write(logged);
   CHECK(out.str() ==
         "{\"t\": 1, \"kind\": \"touch\", \"a\": \"t0\", \"b\": \"w1\", \"sensors\": [\"front\", \"left\"], \"bearing\": 337.5}\n"
         "{\"t\": 1, \"kind\": \"touch\", \"a\": \"t0\", \"b\": \"b0\", \"sensors\": [], \"bearing\": 0}\n"
-        "{\"t\": 2, \"kind\": \"fault\", \"a\": \"t1\", \"message\": \"its program threw: \\\"x\\\"\\n\"}\n");
+        "{\"t\": 2, \"kind\": \"fault\", \"a\": \"t1\", \"message\": \"its program threw: \\\"x\\\"\\n\"}\n"
+        "{\"t\": 3, \"kind\": \"view\", \"a\": \"v1\", \"op\": \"close\", \"by\": \"t1\"}\n");
 }

@@ -37,6 +37,9 @@
 
 namespace turtlegas::server {
 
+/// view_open, view_change or view_close (view_messages.cpp).
+bool is_view_message(const std::string& type);
+
 struct HostOptions {
   std::string world_file;   ///< as given, for messages
   std::string world_text;   ///< GET /api/world
@@ -129,6 +132,9 @@ class WorldHost {
   bool wait_inbox_until(double steady_deadline);  ///< true when something arrived
   void handle(Inbound& in);
   void handle_message(ClientState& c, const nlohmann::json& m);
+  /// view_open, view_change, view_close (view_messages.cpp).
+  void handle_view_message(ClientState& c, const nlohmann::json& m, const std::string& type);
+  std::string open_views_list() const;
   void at_boundary(turtle::WorldServer& server, std::uint64_t step);
   std::optional<turtle::RemoteCommand> next_command(std::uint64_t step, std::size_t turtle);
   void on_report(const turtle::RemoteReport& r);
@@ -163,6 +169,7 @@ class WorldHost {
   std::optional<std::ofstream> events_file_, inputs_file_;
   std::optional<formats::EventLogWriter> events_writer_;
   std::vector<Slot> slots_;
+  std::vector<TurtleLook> looks_;  ///< snapshots' turtle layers and sensor arcs
   std::map<std::uint64_t, ClientState> clients_;
   std::map<std::string, FrameStream> streams_;
   std::deque<WallChange> wall_changes_;
