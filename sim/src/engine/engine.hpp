@@ -125,6 +125,15 @@ class Engine final : public EngineBase {
   }
   void command_turtle(std::size_t k, const TurtleCommand& command) override;
   std::size_t add_wall(const WallDef& wall) override;
+  // Changes to a running world (operations.hpp).
+  std::size_t spawn_ball(const BallDef& ball) override;
+  std::size_t spawn_turtle(const TurtleDef& turtle) override;
+  void remove_body(bool turtle, std::size_t index) override;
+  void teleport_ball(std::size_t i, Vec2 pos, Vec2 vel) override;
+  void teleport_turtle(std::size_t i, Vec2 pos, double heading) override;
+  bool turtle_alive(std::size_t k) const override {
+    return k < turtles_.size() && bodies_.body[bodies_.balls() + k].cell != kNone;
+  }
   std::vector<TurtleContact> take_turtle_contacts() override { return turtles_.take_contacts(); }
   double energy() const override {
     if constexpr (kStep) return detail::energy(look(), kick_);
@@ -212,6 +221,15 @@ class Engine final : public EngineBase {
   }
   void end_command(std::uint32_t i);
   void keyframe();
+  // operations.hpp
+  /// Throws PlacementError unless a disc of radius r at pos (layers `layers`) lies clear of the
+  /// walls and of every body but `self` (kNone: none), inside the arena.
+  void check_clear(Vec2 pos, double r, const Layers& layers, std::uint32_t self) const;
+  /// Makes id `at` for a new body (BodyStore::insert) and everything kept per body with it.
+  void make_room(std::uint32_t at, bool ball, const Layers& layers);
+  /// Body i, brought to now and placed at pos (unlinked already, or new), enters its cell and
+  /// predicts afresh.
+  void place(std::uint32_t i, Vec2 pos);
   /// The squeeze rule (squeeze.hpp) for body i after its contact with bodies_.last[i]; `before`:
   /// its partner before that. Returns false when the body was crushed (and removed).
   bool squeezed(std::uint32_t i, LastPartner before);
@@ -580,6 +598,7 @@ void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
 }  // namespace turtlegas::sim::detail
 
 #include "exact_clock.hpp"
+#include "operations.hpp"
 #include "step_clock.hpp"
 
 namespace turtlegas::sim::detail {
