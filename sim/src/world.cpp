@@ -45,6 +45,9 @@ void World::teleport_ball(std::size_t i, Vec2 pos, Vec2 vel) { impl_->engine->te
 void World::teleport_turtle(std::size_t i, Vec2 pos, double heading) {
   impl_->engine->teleport_turtle(i, pos, heading);
 }
+void World::balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const {
+  impl_->engine->balls_in_rect(lo, hi, out);
+}
 bool World::turtle_alive(std::size_t i) const { return impl_->engine->turtle_alive(i); }
 std::size_t World::turtle_count() const { return impl_->engine->turtle_count(); }
 TurtleState World::turtle(std::size_t i) const { return impl_->engine->turtle(i); }

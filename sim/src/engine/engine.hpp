@@ -131,6 +131,7 @@ class Engine final : public EngineBase {
   void remove_body(bool turtle, std::size_t index) override;
   void teleport_ball(std::size_t i, Vec2 pos, Vec2 vel) override;
   void teleport_turtle(std::size_t i, Vec2 pos, double heading) override;
+  void balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const override;  // region.hpp
   bool turtle_alive(std::size_t k) const override {
     return k < turtles_.size() && bodies_.body[bodies_.balls() + k].cell != kNone;
   }
@@ -599,6 +600,7 @@ void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
 
 #include "exact_clock.hpp"
 #include "operations.hpp"
+#include "region.hpp"
 #include "step_clock.hpp"
 
 namespace turtlegas::sim::detail {

@@ -177,6 +177,14 @@ class World {
   /// Whether turtle i is in the world (false once it exited, was crushed or removed).
   bool turtle_alive(std::size_t i) const;
 
+  /// Appends to *out, in increasing order, the live balls whose centre lies in the closed
+  /// rectangle [lo.x, hi.x] x [lo.y, hi.y] now (in a periodic arena: one of the centre's images
+  /// does, so a rectangle may cross the seams or reach past the arena). From the grid: it looks
+  /// at the cells the rectangle touches (and a ring round them, where round-off or a step's
+  /// travel may have moved a ball out of its listed cell), O(cells touched + balls found).
+  /// Nothing when lo > hi in either axis.
+  void balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const;
+
   std::size_t turtle_count() const;
   TurtleState turtle(std::size_t i) const;
   double turtle_radius(std::size_t i) const;
