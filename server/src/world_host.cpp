@@ -106,6 +106,7 @@ void WorldHost::build_world(world::Scene scene) {
   server_->set_event_log(&events_);
   slots_.assign(server_->turtle_count(), Slot{});
   wall_changes_.clear();
+  body_changes_.clear();
   takeovers_.clear();
   ended_.reset();
   pause_at_.reset();
@@ -282,6 +283,7 @@ void WorldHost::end_world(const std::string& reason) {
   for (const Takeover& t : takeovers_) refuse(t.client, t.id, "claim");
   wall_changes_.clear();
   takeovers_.clear();
+  refuse_body_changes(reason);
   broadcast_status();
 }
 
@@ -496,7 +498,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     welcome["authorized"] = c.authorized;
     welcome["world"] = world_json();
     welcome["status"] = status_json();
-    welcome["capabilities"] = {"frames", "binary-frames", "control", "remote", "add_wall", "save", "load"};
+    welcome["capabilities"] = {"frames", "binary-frames", "control", "remote", "add_wall", "spawn", "remove", "teleport", "save", "load"};
     welcome["limits"] = {{"max_message", l.max_message}, {"max_rate", l.max_rate}, {"max_claims", l.max_claims}, {"max_clients", l.max_clients}};
     reply(c, welcome);
     return;
@@ -593,8 +595,10 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), id, world_json()["arena"]));
     return;
   }
-  if (type == "spawn" || type == "remove" || type == "teleport")
-    throw RequestError("unsupported", "\"" + type + "\" is not available: the engine cannot yet add, remove or move bodies in a running world");
+  if (type == "spawn" || type == "remove" || type == "teleport") {
+    queue_body_change(c, m, type);
+    return;  // answered at the next boundary
+  }
 
   if (type == "pause" || type == "resume" || type == "step" || type == "speed" || type == "run_until") {
     require_live();
@@ -769,6 +773,7 @@ void WorldHost::at_boundary(turtle::WorldServer& server, std::uint64_t step) {
       }
     }
   }
+  apply_body_changes(server, step);
 }
 
 std::optional<turtle::RemoteCommand> WorldHost::next_command(std::uint64_t step, std::size_t turtle) {
