@@ -1,5 +1,8 @@
 // SPDX-License-Identifier: MIT
 //
+// (Just over 600 lines: the class's declaration is the one place that lists every room it holds
+// and every operation a World forwards to it; the operations' bodies live in the files it names.)
+//
 // The GAS engine. One class template, instantiated once per row of the table of variants
 // (factory.cpp): the flight (straight, or parabolas under gravity), ball-ball collisions on or
 // off, exact or step mode, extras or not. It is chosen when the World is built, so nothing is
@@ -16,6 +19,8 @@
 //   squeeze.hpp                bodies held between two obstacles: wedged or crushed
 //   exact_clock.hpp            cell crossings, exits, the rebase of internal time
 //   step_clock.hpp             the start and the end of one of the memo's steps
+//   operations.hpp             spawn, remove, teleport: changes to a running world
+//   region.hpp                 the balls in a rectangle, from the cell lists
 //
 // Order of work, exact mode (event-driven):
 //   1. Every ball holds one pending prediction: its earliest collision among the objects in its
