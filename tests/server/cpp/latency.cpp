@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The floor of a lockstep round trip, from C++ (tests/server/cpp/client.hpp): a remote turtle's
+// The floor of a lockstep round trip, from C++ (client.hpp): a remote turtle's
 // commands whose results are immediate (pen: the same control boundary) or one control step away
 // (left 1, forward 1), sent one after the other over TCP lines or WebSocket to a running
 // `turtlegas serve` (world with a remote turtle "t1", at --speed max). Beside the Python figures of
-// bench/server_bench.py it says how much of a round trip is the client's. Prints one JSON line per
+// bench/server_bench.py (docs/performance.md) it says how much of a round trip is the client's. Prints one JSON line per
 // command kind. Not a test.
 //
 //   server_latency LINE_PORT HTTP_PORT COUNT
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "cpp/client.hpp"
+#include "client.hpp"
 
 using namespace turtlegas::test;
 
