@@ -98,6 +98,19 @@ class WsCounter(threading.Thread):
                 self.binary = opcode == 2
 
 
+def cpp_frames_bench(n_balls, viewers, seconds, d, reader):
+    """The same measure with the C++ reader (bench/server_viewers.cpp) over WebSocket, binary."""
+    import subprocess
+    w = gas_world(n_balls, os.path.join(d, "gas%d.json" % n_balls))
+    with harness.Server(w, "--speed", "1") as s:
+        out = subprocess.run([reader, str(s.http_port), str(viewers), "30", str(seconds), "binary"],
+                             capture_output=True, text=True, timeout=120 + seconds)
+        s.stop()
+    r = json.loads(out.stdout)
+    r.update({"balls": n_balls, "transport": "binary/ws (C++ reader)"})
+    return r
+
+
 def frames_bench(n_balls, viewers, transport, seconds, d):
     w = gas_world(n_balls, os.path.join(d, "gas%d.json" % n_balls))
     with harness.Server(w, "--speed", "1") as s:
@@ -187,16 +200,24 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--turtlegas", default=os.path.join(ROOT, "build", "release", "turtlegas"))
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--cpp-viewers", help="bench/server_viewers (built with the benchmarks): C++ readers for the binary frames")
+    ap.add_argument("--only", choices=("frames", "latency", "speed"), help="run one part")
     a = ap.parse_args()
     harness.BIN = a.turtlegas
     secs = 2.0 if a.quick else 4.0
     with tempfile.TemporaryDirectory() as d:
-        for n in (1000, 10000):
-            for transport in ("json/lines", "binary/ws"):
-                for viewers in (1, 10, 50):
-                    print(json.dumps(frames_bench(n, viewers, transport, secs, d)), flush=True)
-        print(json.dumps(latency_bench(500 if a.quick else 2000, d)), flush=True)
-        print(json.dumps(sim_speed_bench(3 if a.quick else 5, 20 if a.quick else 40, d)), flush=True)
+        if a.only in (None, "frames"):
+            for n in (1000, 10000):
+                for transport in ("json/lines", "binary/ws"):
+                    for viewers in (1, 10, 50):
+                        print(json.dumps(frames_bench(n, viewers, transport, secs, d)), flush=True)
+                if a.cpp_viewers:
+                    for viewers in (1, 10, 50):
+                        print(json.dumps(cpp_frames_bench(n, viewers, secs, d, a.cpp_viewers)), flush=True)
+        if a.only in (None, "latency"):
+            print(json.dumps(latency_bench(500 if a.quick else 2000, d)), flush=True)
+        if a.only in (None, "speed"):
+            print(json.dumps(sim_speed_bench(3 if a.quick else 5, 20 if a.quick else 40, d)), flush=True)
 
 
 if __name__ == "__main__":

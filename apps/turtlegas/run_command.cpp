@@ -33,6 +33,7 @@
 #include "turtlegas/formats/stats_file.hpp"
 #include "turtlegas/formats/svg_snapshot.hpp"
 #include "turtlegas/sim/mode_names.hpp"
+#include "turtlegas/world/entries.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/turtle/game.hpp"
 #include "turtlegas/turtle/world_server.hpp"
@@ -336,7 +337,16 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     std::ifstream in(opt.inputs);
     if (!in) throw BadInput("--inputs: cannot read '" + opt.inputs + "'");
     try {
-      replay = std::make_shared<formats::ReplayInput>(in, def, opt.inputs);
+      formats::SpawnApplier spawn = [&registry, file = opt.inputs](turtle::WorldServer& server,
+                                                                   const nlohmann::json& entry) {
+        try {
+          world::spawn_entry(server, entry, file, registry);
+        } catch (const std::exception& e) {
+          throw std::runtime_error(file + ": a spawn recorded in the log was refused (" + e.what() +
+                                   "); is this the log of this world?");
+        }
+      };
+      replay = std::make_shared<formats::ReplayInput>(in, def, opt.inputs, std::move(spawn));
     } catch (const std::invalid_argument& e) {
       throw BadInput(std::string("--inputs: ") + e.what());
     }
@@ -406,7 +416,15 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     };
   }
   const sim::World& world = server ? server->world() : *bare;
-  const formats::RunNames names{ball_ids, def, world};
+  // Ids by index. With the world server, its scene: bodies spawned by an input log are in it
+  // (after the scene's own); their ball ids are packed when they are first needed.
+  formats::IdTable spawned_ids;
+  auto current_names = [&]() -> formats::RunNames {
+    if (!server || (server->scene().balls.size() == ball_ids.size() && server->scene().turtles.size() == def.turtles.size()))
+      return {ball_ids, def, world};
+    if (spawned_ids.size() != server->scene().balls.size()) spawned_ids = formats::ball_ids(server->scene());
+    return {spawned_ids, server->scene(), world};
+  };
   // A scene whose scales predict a run that will not finish says so, with numbers, before it
   // starts (check says the same); the chunks start small enough to come back all the same.
   scales.set_cell(world.cell_size());
@@ -424,7 +442,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     c.dt = def.dt;
     c.t = t;
     c.events = world.stats().events;
-    c.state_hash = state_hash(world, names);
+    c.state_hash = state_hash(world, current_names());
     c.why = why;
     OutputFile out(opt.checkpoint, "--checkpoint");
     write_checkpoint(out.stream(), c);
@@ -442,7 +460,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
                         [&] { flush(false); }, [](double, const std::string&) {});
     if (end.first == Stop::until) {
       const bool same = world.time() == resume->t && world.stats().events == resume->events &&
-                        state_hash(world, names) == resume->state_hash;
+                        state_hash(world, current_names()) == resume->state_hash;
       if (!same)
         throw std::runtime_error("--resume " + opt.resume + ": replaying the run to t = " + fmt(resume->t) +
                                  " s did not arrive at the checkpoint's state (a controller that is not "
@@ -487,7 +505,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
 
   if (events_file) events_file->commit();
   if (state_file) {
-    formats::write_state(state_file->stream(), world, names);
+    formats::write_state(state_file->stream(), world, current_names());
     state_file->commit();
   }
   if (stats_file) {

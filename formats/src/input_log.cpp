@@ -77,7 +77,48 @@ std::string input_wall_line(std::uint64_t step, const sim::WallDef& wall) {
   return out;
 }
 
-ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string file) : file_(std::move(file)) {
+std::string input_spawn_line(std::uint64_t step, std::string_view kind, const nlohmann::json& entry) {
+  std::string out;
+  append_step(out, step);
+  out += ", \"spawn\": {";
+  append_json_string(out, kind);
+  out += ": ";
+  out += entry.dump();  // numbers as the shortest text that reads back to the same double
+  out += "}}\n";
+  return out;
+}
+
+std::string input_remove_line(std::uint64_t step, std::string_view id) {
+  std::string out;
+  append_step(out, step);
+  out += ", \"remove\": ";
+  append_json_string(out, id);
+  out += "}\n";
+  return out;
+}
+
+std::string input_teleport_line(std::uint64_t step, std::string_view id, sim::Vec2 pos, std::optional<sim::Vec2> vel,
+                                std::optional<double> heading) {
+  std::string out;
+  append_step(out, step);
+  out += ", \"teleport\": {\"id\": ";
+  append_json_string(out, id);
+  out += ", \"pos\": ";
+  append_point(out, pos);
+  if (vel) {
+    out += ", \"vel\": ";
+    append_point(out, *vel);
+  }
+  if (heading) {
+    out += ", \"heading\": ";
+    append_number(out, *heading);
+  }
+  out += "}}\n";
+  return out;
+}
+
+ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string file, SpawnApplier spawn)
+    : spawn_(std::move(spawn)), file_(std::move(file)) {
   for (const sim::TurtleDef& t : def.turtles) turtle_ids_.push_back(t.id);
   commands_.resize(turtle_ids_.size());
   auto index_of = [&](const std::string& id, std::size_t line, const char* key) {
@@ -124,17 +165,55 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
           c.pen = j.value("mode", std::string("line")) == "wall" ? turtle::PenMode::wall : turtle::PenMode::line;
         commands_[i].push_back({step, c});
       } else if (j.contains("takeover")) {
-        changes_.push_back({step, index_of(j.at("takeover").get<std::string>(), line, "takeover"), {}});
+        Change c;
+        c.kind = Change::Kind::takeover;
+        c.step = step;
+        c.turtle = index_of(j.at("takeover").get<std::string>(), line, "takeover");
+        changes_.push_back(std::move(c));
+      } else if (j.contains("spawn")) {
+        const nlohmann::json& sp = j.at("spawn");
+        if (!sp.is_object() || sp.size() != 1 || !(sp.contains("ball") || sp.contains("turtle")))
+          fail("/spawn: must be {\"ball\": {...}} or {\"turtle\": {...}}, a world-file entry");
+        if (!spawn_) fail("/spawn: this log spawns bodies, which this replay cannot apply");
+        if (sp.contains("turtle")) {
+          // Its commands follow under its id; its index is the next turtle's.
+          turtle_ids_.push_back(sp.at("turtle").at("id").get<std::string>());
+          commands_.resize(turtle_ids_.size());
+        }
+        Change c;
+        c.kind = Change::Kind::spawn;
+        c.step = step;
+        c.spawn = sp;
+        changes_.push_back(std::move(c));
+      } else if (j.contains("remove")) {
+        Change c;
+        c.kind = Change::Kind::remove;
+        c.step = step;
+        c.id = j.at("remove").get<std::string>();
+        changes_.push_back(std::move(c));
+      } else if (j.contains("teleport")) {
+        const nlohmann::json& tp = j.at("teleport");
+        Change c;
+        c.kind = Change::Kind::teleport;
+        c.step = step;
+        c.id = tp.at("id").get<std::string>();
+        c.pos = {tp.at("pos").at(0).get<double>(), tp.at("pos").at(1).get<double>()};
+        if (tp.contains("vel")) c.vel = sim::Vec2{tp.at("vel").at(0).get<double>(), tp.at("vel").at(1).get<double>()};
+        if (tp.contains("heading")) c.heading = tp.at("heading").get<double>();
+        if (c.vel.has_value() == c.heading.has_value())
+          fail("/teleport: a ball's teleport has \"vel\", a turtle's \"heading\" (one of them)");
+        changes_.push_back(std::move(c));
       } else if (j.contains("add_wall")) {
         const nlohmann::json& w = j.at("add_wall");
         Change c;
+        c.kind = Change::Kind::add_wall;
         c.step = step;
         c.wall.id = w.at("id").get<std::string>();
         c.wall.from = {w.at("from").at(0).get<double>(), w.at("from").at(1).get<double>()};
         c.wall.to = {w.at("to").at(0).get<double>(), w.at("to").at(1).get<double>()};
         changes_.push_back(std::move(c));
       } else {
-        fail("a line needs \"turtle\" (a command), \"takeover\" or \"add_wall\"");
+        fail("a line needs \"turtle\" (a command), \"takeover\", \"add_wall\", \"spawn\", \"remove\" or \"teleport\"");
       }
     } catch (const nlohmann::json::exception& e) {
       fail(std::string("a field is missing or has the wrong type: ") + e.what());
@@ -150,8 +229,16 @@ void ReplayInput::at_boundary(turtle::WorldServer& server, std::uint64_t step) {
     if (c.step < step)
       throw std::runtime_error(file_ + ": the change recorded at step " + std::to_string(c.step) +
                                " was not reached at that step; is this the log of this world?");
-    if (c.takeover) server.make_remote(*c.takeover);
-    else server.add_wall(c.wall);
+    switch (c.kind) {
+      case Change::Kind::takeover: server.make_remote(c.turtle); break;
+      case Change::Kind::add_wall: server.add_wall(c.wall); break;
+      case Change::Kind::spawn: spawn_(server, c.spawn); break;
+      case Change::Kind::remove: server.remove_body(c.id); break;
+      case Change::Kind::teleport:
+        if (c.vel) server.teleport_ball(c.id, c.pos, *c.vel);
+        else server.teleport_turtle(c.id, c.pos, *c.heading);
+        break;
+    }
   }
 }
 

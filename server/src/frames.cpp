@@ -81,17 +81,13 @@ void append_walls(std::string& out, const turtle::WorldServer& server, std::size
   out += ']';
 }
 
-/// The balls a frame of `kind` carries: all, or those in its region (from World's public
-/// accessors, O(N) per frame; a query on the engine's grid would make it O(region)).
+/// The balls a frame of `kind` carries: all, or those in its region (the grid's region query,
+/// O(cells touched + balls found); in a periodic arena a region may cross the seams).
 std::vector<std::uint32_t> balls_in(const sim::World& world, const FrameKind& kind) {
   std::vector<std::uint32_t> out;
-  const std::size_t n = world.ball_count();
   if (!kind.region) return out;
   const auto [x0, y0, x1, y1] = *kind.region;
-  for (std::size_t i = 0; i < n; ++i) {
-    const sim::BallState b = world.ball(i);
-    if (b.alive && b.pos.x >= x0 && b.pos.x <= x1 && b.pos.y >= y0 && b.pos.y <= y1) out.push_back(static_cast<std::uint32_t>(i));
-  }
+  world.balls_in_rect({x0, y0}, {x1, y1}, out);
   return out;
 }
 
@@ -144,6 +140,7 @@ void append_turtle_head(std::string& out, const turtle::WorldServer::TurtleInfo&
   out += info.remote ? ", \"remote\": true" : ", \"remote\": false";
   out += claimed ? ", \"claimed\": true" : ", \"claimed\": false";
   out += info.finished ? ", \"finished\": true" : ", \"finished\": false";
+  out += info.gone ? ", \"gone\": true" : ", \"gone\": false";
 }
 
 void append_points(std::string& out, const std::vector<sim::Vec2>& points) {
@@ -263,6 +260,7 @@ std::shared_ptr<const std::string> FrameStream::build(const turtle::WorldServer&
   const sim::World& world = server.world();
   // The parts JSON and binary frames share: new trail points and walls, and the events.
   std::string trails = "[";
+  if (trail_sent_.size() < server.turtle_count()) trail_sent_.resize(server.turtle_count(), 0);  // spawned since
   std::vector<std::size_t> from(server.turtle_count());
   std::vector<std::vector<sim::Vec2>> points(server.turtle_count());
   for (std::size_t i = 0; i < server.turtle_count(); ++i) {

@@ -17,6 +17,10 @@ WebSocketSession::WebSocketSession(boost::asio::ip::tcp::socket&& socket, WorldH
 }
 
 void WebSocketSession::run(beast::http::request<beast::http::string_body> req) {
+  // Results and frames go out as soon as they are written (as on TCP lines): no Nagle delay for a
+  // lockstep client's next round trip.
+  boost::system::error_code nodelay_ec;  // (a socket that will not take it just keeps Nagle)
+  ws_.next_layer().socket().set_option(boost::asio::ip::tcp::no_delay(true), nodelay_ec);
   ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
   ws_.read_message_max(host_.options().limits.max_websocket_read);
   ws_.auto_fragment(false);  // a frame goes out as one WebSocket frame

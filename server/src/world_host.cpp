@@ -109,6 +109,7 @@ void WorldHost::build_world(world::Scene scene) {
   const sim::WorldDef layered = turtle::with_builder_layers(scene_.def, scene_.programs);
   for (std::size_t i = 0; i < layered.turtles.size(); ++i) looks_.push_back({layered.turtles[i].layers, scene_.programs[i].sensors});
   wall_changes_.clear();
+  body_changes_.clear();
   takeovers_.clear();
   ended_.reset();
   pause_at_.reset();
@@ -285,6 +286,7 @@ void WorldHost::end_world(const std::string& reason) {
   for (const Takeover& t : takeovers_) refuse(t.client, t.id, "claim");
   wall_changes_.clear();
   takeovers_.clear();
+  refuse_body_changes(reason);
   broadcast_status();
 }
 
@@ -500,7 +502,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     welcome["authorized"] = c.authorized;
     welcome["world"] = world_json();
     welcome["status"] = status_json();
-    welcome["capabilities"] = {"frames", "binary-frames", "control", "remote", "add_wall", "save", "load", "views"};
+    welcome["capabilities"] = {"frames", "binary-frames", "control", "remote", "add_wall", "spawn", "remove", "teleport", "save", "load", "views"};
     welcome["limits"] = {{"max_message", l.max_message}, {"max_rate", l.max_rate}, {"max_claims", l.max_claims}, {"max_clients", l.max_clients}};
     reply(c, welcome);
     return;
@@ -598,8 +600,10 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     return;
   }
   if (is_view_message(type)) return handle_view_message(c, m, type);
-  if (type == "spawn" || type == "remove" || type == "teleport")
-    throw RequestError("unsupported", "\"" + type + "\" is not available: the engine cannot yet add, remove or move bodies in a running world");
+  if (type == "spawn" || type == "remove" || type == "teleport") {
+    queue_body_change(c, m, type);
+    return;  // answered at the next boundary
+  }
 
   if (type == "pause" || type == "resume" || type == "step" || type == "speed" || type == "run_until") {
     require_live();
@@ -774,6 +778,7 @@ void WorldHost::at_boundary(turtle::WorldServer& server, std::uint64_t step) {
       }
     }
   }
+  apply_body_changes(server, step);
 }
 
 std::optional<turtle::RemoteCommand> WorldHost::next_command(std::uint64_t step, std::size_t turtle) {

@@ -39,6 +39,12 @@ class EventQueue {
   void remove(std::uint32_t id);
   /// True when no finite key is stored.
   bool empty() const { return finite_ == 0; }
+  /// Whether id is in the queue (with a finite or an infinite key), and its key then: what a
+  /// caller that rebuilds the queue over moved nodes (a run-time spawn) sets again. The order
+  /// of service depends on the keys and ids alone (ties go to the smaller id), not on the
+  /// buckets, so such a rebuild serves the same ids in the same order.
+  bool contains(std::uint32_t id) const { return node(id).where != kNowhere; }
+  double key(std::uint32_t id) const { return node(id).key; }
   /// The earliest (key, id); only when !empty().
   double top_key() { settle(); return node(heap_[0]).key; }
   std::uint32_t top_id() { settle(); return heap_[0]; }

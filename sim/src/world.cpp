@@ -37,6 +37,18 @@ double World::radius(std::size_t i) const { return impl_->engine->radius(i); }
 double World::mass(std::size_t i) const { return impl_->engine->mass(i); }
 const std::vector<WallDef>& World::walls() const { return impl_->engine->walls(); }
 std::size_t World::add_wall(const WallDef& wall) { return impl_->engine->add_wall(wall); }
+std::size_t World::spawn_ball(const BallDef& ball) { return impl_->engine->spawn_ball(ball); }
+std::size_t World::spawn_turtle(const TurtleDef& turtle) { return impl_->engine->spawn_turtle(turtle); }
+void World::remove_ball(std::size_t i) { impl_->engine->remove_body(false, i); }
+void World::remove_turtle(std::size_t i) { impl_->engine->remove_body(true, i); }
+void World::teleport_ball(std::size_t i, Vec2 pos, Vec2 vel) { impl_->engine->teleport_ball(i, pos, vel); }
+void World::teleport_turtle(std::size_t i, Vec2 pos, double heading) {
+  impl_->engine->teleport_turtle(i, pos, heading);
+}
+void World::balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const {
+  impl_->engine->balls_in_rect(lo, hi, out);
+}
+bool World::turtle_alive(std::size_t i) const { return impl_->engine->turtle_alive(i); }
 std::size_t World::turtle_count() const { return impl_->engine->turtle_count(); }
 TurtleState World::turtle(std::size_t i) const { return impl_->engine->turtle(i); }
 double World::turtle_radius(std::size_t i) const { return impl_->engine->turtle_radius(i); }

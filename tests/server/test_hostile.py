@@ -38,6 +38,8 @@ UNAUTHORIZED = COMMON + [
     ('{"type": "forward", "turtle": "t1", "amount": 1}', "unauthorized"),
     ('{"type": "save", "file": "../x.json"}', "unauthorized"), ('{"type": "add_wall", "wall": {}}', "unauthorized"),
     ('{"type": "load", "file": "room.json"}', "unauthorized"),
+    ('{"type": "spawn", "ball": {"id": "x", "pos": [50, 50], "radius": 2}}', "unauthorized"),
+    ('{"type": "remove", "body": "b1"}', "unauthorized"),
     ('{"type": "hello", "protocol": "turtlegas/1", "token": "wrong"}', "bad_token"),
     ('{"type": "subscribe", "rate": 0}', "bad_value"), ('{"type": "subscribe", "rate": "fast"}', "wrong_type"),
 ]
@@ -66,11 +68,26 @@ AUTHORIZED = COMMON + [
     ('{"type": "load", "file": "..\\\\x"}', "bad_path"), ('{"type": "save"}', "missing_field"),
     ('{"type": "save", "file": "link.json"}', "bad_path"), ('{"type": "load", "file": "link.json"}', "bad_path"),
     ('{"type": "load", "file": "missing.json"}', "not_found"), ('{"type": "load", "file": "garbage.json"}', "bad_world"),
-    ('{"type": "spawn", "ball": {"id": "x", "pos": [250, 60], "radius": 5}}', "unsupported"),
-    ('{"type": "teleport", "turtle": "t1", "pos": [0, 0]}', "unsupported"), ('{"type": "remove", "id": "b1"}', "unsupported"),
+    # Bodies: spawns onto the turtle t1 (at rest at (250, 60), radius 10) or the ball b1 (400, 300),
+    # bad entries, bad or unknown bodies: each refused at once, nothing queued.
+    ('{"type": "spawn", "ball": {"id": "x", "pos": [250, 60], "radius": 5}}', "refused"),
+    ('{"type": "spawn", "turtle": {"id": "x", "pos": [400, 300]}}', "refused"),
+    ('{"type": "spawn", "ball": {"id": "x", "pos": [250, 200], "radius": -5}}', "bad_value"),
+    ('{"type": "spawn", "ball": {"id": "x", "pos": [250, 200]}}', "bad_value"),
+    ('{"type": "spawn", "ball": {"id": "x", "pos": [250, 200], "radius": 2, "category": "sneaky"}}', "bad_value"),
+    ('{"type": "spawn", "turtle": {"id": "x", "pos": [250, 200], "controller": "rm -rf"}}', "bad_value"),
+    ('{"type": "spawn", "ball": [1, 2]}', "bad_value"), ('{"type": "spawn"}', "missing_field"),
+    ('{"type": "spawn", "ball": {"id": "x", "pos": [250, 200], "radius": 2}, "turtle": {}}', "bad_value"),
+    ('{"type": "teleport", "body": "b1", "pos": [250, 60]}', "refused"),
+    ('{"type": "teleport", "body": "b1", "pos": "here"}', "wrong_type"),
+    ('{"type": "teleport", "body": "b1", "pos": [250, 200], "heading": 5}', "bad_value"),
+    ('{"type": "remove", "body": "nobody"}', "unknown_body"), ('{"type": "remove", "id": "b1"}', "missing_field"),
+    ('{"type": "remove", "body": 7}', "wrong_type"), ('{"type": "teleport", "body": "../../etc", "pos": [1, 1]}', "unknown_body"),
 ]
 SECOND = [('{"type": "claim", "turtle": "t1"}', "claimed"), ('{"type": "forward", "turtle": "t1", "amount": 1}', "not_claimed"),
-          ('{"type": "release", "turtle": "t1"}', "not_claimed")] + COMMON
+          ('{"type": "release", "turtle": "t1"}', "not_claimed"),
+          # Another connection's turtle is theirs to remove or move.
+          ('{"type": "remove", "body": "t1"}', "claimed"), ('{"type": "teleport", "body": "t1", "pos": [250, 200]}', "claimed")] + COMMON
 HUGE = '{"type": "ping", "pad": "' + "x" * (10 * 1024 * 1024) + '"}'
 
 

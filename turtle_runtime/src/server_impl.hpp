@@ -39,9 +39,15 @@ class WorldServer::Impl : public GameHost {
   std::vector<RemoteReport> reports;  // the remote programs' reports, until flush_reports()
   std::vector<View> views;             // the open views (view.cpp), in opening order
   std::uint64_t views_revision = 0;
+  Registry registry;  // a copy of the constructor's: the programs of turtles spawned later
 
   Impl(sim::WorldDef d, ServerOptions o) : def(std::move(d)), world(def, o.mode), options(std::move(o)) {}
 
+  /// The agent of turtle k (def.turtles[k]) running `program`; throws std::invalid_argument for
+  /// a controller that is not registered or bad sensor arcs.
+  std::unique_ptr<Agent> make_agent(std::size_t k, TurtleProgram program, const std::vector<std::string>& turtle_ids);
+  /// Throws std::logic_error unless called from InputSource::at_boundary (what: the caller's name).
+  void require_boundary(const char* what) const;
   double boundary_time(std::uint64_t k) const { return sim::control_boundary(k, def.dt); }
   void control_step();
   void run_program(Agent& a);

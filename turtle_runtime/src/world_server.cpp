@@ -69,50 +69,56 @@ void WorldServer::Impl::finish_command(Agent& a) {
   a.answer = s.touched && !a.inbox.empty() ? Result(done, a.inbox.front()) : Result(done, std::nullopt);
 }
 
+std::unique_ptr<Agent> WorldServer::Impl::make_agent(std::size_t k, TurtleProgram program,
+                                                    const std::vector<std::string>& turtle_ids) {
+  const Registry& reg = registry;
+  auto a = std::make_unique<Agent>();
+  a->server = this;
+  a->index = k;
+  a->id = def.turtles[k].id;
+  a->program = std::move(program);
+  a->remote = a->program.controller == remote_controller_name;  // the runtime's own program (remote.cpp)
+  const Controller* controller = a->remote ? nullptr : reg.find(a->program.controller);
+  if (!controller && !a->remote)  // Registry::require's message; its context built only when it is needed
+    throw std::invalid_argument("turtle '" + a->id + "': " + reg.not_registered(a->program.controller));
+  Controller composed;  // a mirror: the controller it mirrors, through Turtle::mirrored
+  if (a->program.controller == "mirror") {
+    composed = detail::compose_mirror(reg, a->program.params, a->id, turtle_ids);
+    controller = &composed;
+  }
+  if (a->program.sensors.empty() || a->program.sensors.size() > 64)
+    throw std::invalid_argument("turtle '" + a->id + "' needs 1 to 64 sensors (has " +
+                                std::to_string(a->program.sensors.size()) + ")");
+  for (const SensorArc& arc : a->program.sensors) a->sensor_names.push_back(arc.name);
+  a->controller = a->remote ? detail::remote_program_for(*a) : *controller;
+  // The declared defaults are the controller's (Params::get<T>(key)); the loader has checked
+  // the rest against the declarations. A remote turtle's params are its client's business.
+  a->params = a->remote ? Params(a->program.params)
+                        : Params(with_defaults(*reg.info(a->program.controller), a->program.params));
+  a->pen_down = a->program.pen_down || a->program.pen_walls;
+  if (a->program.pen_walls) {
+    if (!a->program.builder)
+      throw std::invalid_argument("turtle '" + a->id + "': its pen starts in wall mode but it is not a builder");
+    a->pen_mode = PenMode::wall;
+  }
+  if (a->pen_down) a->trail.push_back(def.turtles[k].pos);
+  // Its own stream, or (a mirror with a twin) the twin's, so that a randomised program has an
+  // exact mirror image.
+  a->rng.seed_with(def.seed ^ fnv1a(detail::stream_owner(a->program.controller, a->program.params, a->id)));
+  return a;
+}
+
 WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> programs, const Registry& registry,
                          ServerOptions options)
     : impl_(std::make_unique<Impl>(with_builder_layers(def, programs), options)) {
   if (programs.size() != def.turtles.size())
     throw std::invalid_argument("WorldServer: " + std::to_string(programs.size()) + " programs for " +
                                 std::to_string(def.turtles.size()) + " turtles");
-  for (std::size_t k = 0; k < programs.size(); ++k) {
-    auto a = std::make_unique<Agent>();
-    a->server = impl_.get();
-    a->index = k;
-    a->id = def.turtles[k].id;
-    a->program = std::move(programs[k]);
-    a->remote = a->program.controller == remote_controller_name;  // the runtime's own program (remote.cpp)
-    const Controller* controller = a->remote ? nullptr : registry.find(a->program.controller);
-    if (!controller && !a->remote)  // Registry::require's message; its context built only when it is needed
-      throw std::invalid_argument("turtle '" + a->id + "': " + registry.not_registered(a->program.controller));
-    Controller composed;  // a mirror: the controller it mirrors, through Turtle::mirrored
-    if (a->program.controller == "mirror") {
-      std::vector<std::string> ids;
-      for (const auto& t : def.turtles) ids.push_back(t.id);
-      composed = detail::compose_mirror(registry, a->program.params, a->id, ids);
-      controller = &composed;
-    }
-    if (a->program.sensors.empty() || a->program.sensors.size() > 64)
-      throw std::invalid_argument("turtle '" + a->id + "' needs 1 to 64 sensors (has " +
-                                  std::to_string(a->program.sensors.size()) + ")");
-    for (const SensorArc& arc : a->program.sensors) a->sensor_names.push_back(arc.name);
-    a->controller = a->remote ? detail::remote_program_for(*a) : *controller;
-    // The declared defaults are the controller's (Params::get<T>(key)); the loader has checked
-    // the rest against the declarations. A remote turtle's params are its client's business.
-    a->params = a->remote ? Params(a->program.params)
-                          : Params(with_defaults(*registry.info(a->program.controller), a->program.params));
-    a->pen_down = a->program.pen_down || a->program.pen_walls;
-    if (a->program.pen_walls) {
-      if (!a->program.builder)
-        throw std::invalid_argument("turtle '" + a->id + "': its pen starts in wall mode but it is not a builder");
-      a->pen_mode = PenMode::wall;
-    }
-    if (a->pen_down) a->trail.push_back(def.turtles[k].pos);
-    // Its own stream, or (a mirror with a twin) the twin's, so that a randomised program has an
-    // exact mirror image.
-    a->rng.seed_with(def.seed ^ fnv1a(detail::stream_owner(a->program.controller, a->program.params, a->id)));
-    impl_->agents.push_back(std::move(a));
-  }
+  impl_->registry = registry;
+  std::vector<std::string> ids;
+  for (const auto& t : def.turtles) ids.push_back(t.id);
+  for (std::size_t k = 0; k < programs.size(); ++k)
+    impl_->agents.push_back(impl_->make_agent(k, std::move(programs[k]), ids));
   impl_->world.set_event_log(&impl_->sim_log);
   impl_->self = this;
 }
@@ -310,6 +316,7 @@ WorldServer::TurtleInfo WorldServer::turtle_status(std::size_t i) const {
   info.pen_mode = a.pen_mode;
   info.it = a.it;
   info.remote = a.remote;
+  info.gone = !impl_->world.turtle_alive(i);
   return info;
 }
 

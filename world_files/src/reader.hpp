@@ -46,6 +46,9 @@ class Reader : public JsonReader {
       : JsonReader(std::move(file), Wording::kind), registry_(registry) {}
 
   Scene read(const json& doc, std::string_view default_name);
+  // Also one entry at a time (entries.cpp).
+  void read_balls(const json& v, std::vector<sim::BallDef>& balls);
+  void read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles, std::vector<turtle::TurtleProgram>& programs);
 
  private:
   std::string id(const json& obj, const std::string& path, std::string_view what) {
@@ -70,8 +73,6 @@ class Reader : public JsonReader {
   std::uint32_t category_bits(const json& v, const std::string& path) const;
   void read_walls(const json& v, std::vector<sim::WallDef>& walls);
   void read_draw(const json& v, std::vector<sim::WallDef>& walls);
-  void read_balls(const json& v, std::vector<sim::BallDef>& balls);
-  void read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles, std::vector<turtle::TurtleProgram>& programs);
   std::vector<turtle::SensorArc> read_sensors(const json& v, const std::string& path) const;
   void check_script(const json& params, const std::string& path) const;
   std::vector<turtle::View> read_views(const json& v, const sim::WorldDef& def);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstring>
 #include <new>
+#include <type_traits>
 
 namespace turtlegas::sim::detail {
 
@@ -55,6 +56,46 @@ BodyStore::BodyStore(const WorldDef& def, std::vector<BallDef>* release, bool wi
     body[id].r = d.radius;
     end[id] = kNever;
   }
+}
+
+void BodyStore::insert(std::uint32_t at, bool ball) {
+  const std::size_t n = size();
+  auto up = [at](std::uint32_t id) { return id != kNone && id >= at ? id + 1 : id; };
+  auto up_partner = [&](LastPartner p) {
+    return !p.is_none() && p.kind() == Partner::body ? LastPartner::of(Partner::body, up(p.index())) : p;
+  };
+  std::unique_ptr<Record[], FreeRecords> grown(
+      static_cast<Record*>(::operator new((n + 1) * sizeof(Record), std::align_val_t{alignof(Record)})));
+  Record* const to = grown.get();
+  // Record is trivially copyable: its bytes move, then the ids inside follow.
+  static_assert(std::is_trivially_copyable_v<Record>);
+  if (at > 0) std::memcpy(static_cast<void*>(to), records_.get(), at * sizeof(Record));
+  if (n > at) std::memcpy(static_cast<void*>(to + at + 1), records_.get() + at, (n - at) * sizeof(Record));
+  new (to + at) Record{};
+  for (std::size_t i = 0; i <= n; ++i) {
+    if (i == at) continue;
+    Body& b = to[i].body;
+    b.next = up(b.next);
+    b.prev = up(b.prev);
+    Pending& p = to[i].pending;
+    if (p.kind == Partner::body) p.partner = up(p.partner);
+    p.last = up_partner(p.last);
+    to[i].node = EventQueue::Node{};  // out of any queue: the caller sets the keys again
+  }
+  for (std::uint32_t& h : head) h = up(h);
+  for (std::uint32_t& h : turtle_head) h = up(h);
+  for (Held& h : held) {
+    h.a = up_partner(h.a);
+    h.b = up_partner(h.b);
+  }
+  if (!held.empty()) held.insert(held.begin() + at, Held{});
+  records_ = std::move(grown);
+  if (ball) ++nb_;
+  body = {records_.get(), n + 1};
+  mass = {records_.get(), nb_};
+  end = {records_.get(), n + 1};
+  last = {records_.get(), n + 1};
+  pending = {records_.get(), n + 1};
 }
 
 }  // namespace turtlegas::sim::detail

@@ -23,6 +23,14 @@ class BodyStore {
   BodyStore(const WorldDef& def, std::vector<BallDef>* release, bool with_layers);
 
   std::uint32_t balls() const { return nb_; }
+  /// Makes room for one body with id `at`: a ball at balls() (after the balls, before the
+  /// turtles) or a turtle at size(). The records move to a new allocation one longer (the
+  /// columns follow), the bodies from `at` on shift up by one id, and every id the records, the
+  /// squeeze marks and the cell lists keep follows them, so that the relative order of all ids
+  /// (which breaks ties in the queue) stays as it was. The new record is default (cell kNone,
+  /// unlinked); its layers are the caller's to insert. Every queue node is left out of any queue: the caller resets the queue
+  /// and sets the keys again (EventQueue::contains and key, read before). A run-time spawn (operations.hpp).
+  void insert(std::uint32_t at, bool ball);
   std::size_t size() const { return body.size(); }
   /// The queue's nodes, one in each record (EventQueue::reset).
   EventQueue::Node* nodes() const { return size() > 0 ? &records_[0].node : nullptr; }

@@ -1,5 +1,8 @@
 // SPDX-License-Identifier: MIT
 //
+// (Just over 600 lines: the class's declaration is the one place that lists every room it holds
+// and every operation a World forwards to it; the operations' bodies live in the files it names.)
+//
 // The GAS engine. One class template, instantiated once per row of the table of variants
 // (factory.cpp): the flight (straight, or parabolas under gravity), ball-ball collisions on or
 // off, exact or step mode, extras or not. It is chosen when the World is built, so nothing is
@@ -16,6 +19,8 @@
 //   squeeze.hpp                bodies held between two obstacles: wedged or crushed
 //   exact_clock.hpp            cell crossings, exits, the rebase of internal time
 //   step_clock.hpp             the start and the end of one of the memo's steps
+//   operations.hpp             spawn, remove, teleport: changes to a running world
+//   region.hpp                 the balls in a rectangle, from the cell lists
 //
 // Order of work, exact mode (event-driven):
 //   1. Every ball holds one pending prediction: its earliest collision among the objects in its
@@ -125,6 +130,16 @@ class Engine final : public EngineBase {
   }
   void command_turtle(std::size_t k, const TurtleCommand& command) override;
   std::size_t add_wall(const WallDef& wall) override;
+  // Changes to a running world (operations.hpp).
+  std::size_t spawn_ball(const BallDef& ball) override;
+  std::size_t spawn_turtle(const TurtleDef& turtle) override;
+  void remove_body(bool turtle, std::size_t index) override;
+  void teleport_ball(std::size_t i, Vec2 pos, Vec2 vel) override;
+  void teleport_turtle(std::size_t i, Vec2 pos, double heading) override;
+  void balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const override;  // region.hpp
+  bool turtle_alive(std::size_t k) const override {
+    return k < turtles_.size() && bodies_.body[bodies_.balls() + k].cell != kNone;
+  }
   std::vector<TurtleContact> take_turtle_contacts() override { return turtles_.take_contacts(); }
   double energy() const override {
     if constexpr (kStep) return detail::energy(look(), kick_);
@@ -212,6 +227,15 @@ class Engine final : public EngineBase {
   }
   void end_command(std::uint32_t i);
   void keyframe();
+  // operations.hpp
+  /// Throws PlacementError unless a disc of radius r at pos (layers `layers`) lies clear of the
+  /// walls and of every body but `self` (kNone: none), inside the arena.
+  void check_clear(Vec2 pos, double r, const Layers& layers, std::uint32_t self) const;
+  /// Makes id `at` for a new body (BodyStore::insert) and everything kept per body with it.
+  void make_room(std::uint32_t at, bool ball, const Layers& layers);
+  /// Body i, brought to now and placed at pos (unlinked already, or new), enters its cell and
+  /// predicts afresh.
+  void place(std::uint32_t i, Vec2 pos);
   /// The squeeze rule (squeeze.hpp) for body i after its contact with bodies_.last[i]; `before`:
   /// its partner before that. Returns false when the body was crushed (and removed).
   bool squeezed(std::uint32_t i, LastPartner before);
@@ -580,6 +604,8 @@ void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
 }  // namespace turtlegas::sim::detail
 
 #include "exact_clock.hpp"
+#include "operations.hpp"
+#include "region.hpp"
 #include "step_clock.hpp"
 
 namespace turtlegas::sim::detail {

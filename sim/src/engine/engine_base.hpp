@@ -33,6 +33,13 @@ class EngineBase {
   virtual void command_turtle(std::size_t i, const TurtleCommand& command) = 0;
   virtual std::vector<TurtleContact> take_turtle_contacts() = 0;
   virtual std::size_t add_wall(const WallDef& wall) = 0;
+  virtual std::size_t spawn_ball(const BallDef& ball) = 0;
+  virtual std::size_t spawn_turtle(const TurtleDef& turtle) = 0;
+  virtual void remove_body(bool turtle, std::size_t index) = 0;
+  virtual void teleport_ball(std::size_t i, Vec2 pos, Vec2 vel) = 0;
+  virtual void teleport_turtle(std::size_t i, Vec2 pos, double heading) = 0;
+  virtual bool turtle_alive(std::size_t i) const = 0;
+  virtual void balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const = 0;
   virtual double cell_size() const = 0;
   virtual int cells_x() const = 0;
   virtual int cells_y() const = 0;

@@ -44,6 +44,8 @@ class Kick {
     }
   }
 
+  /// Whether the kick keeps something per ball (charged balls in a field): a run-time spawn refuses then.
+  bool per_ball() const { return !of_.empty(); }
   /// Whether a kick changes any course: then "just collided, cannot meet again" no longer holds.
   bool changes_courses() const { return a_.x != 0.0 || a_.y != 0.0 || species_.size() > 1; }
   /// Ball `ball`'s velocity after the kick of a step of length dt.

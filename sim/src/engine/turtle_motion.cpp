@@ -142,6 +142,36 @@ void Turtles::touch(std::size_t k, Body& b, double& end, double now, double t_ba
   contacts_.push_back({t_base + now, static_cast<std::uint32_t>(k), kind, other, normal});
 }
 
+void Turtles::add(const TurtleDef& d) {
+  TurtleRun r;
+  r.heading0 = d.heading;
+  r.speed = d.speed;
+  r.turn_rate = d.turn_rate;
+  r.bounce = d.bounce;
+  run_.push_back(r);
+  busy_.push_back(0);
+  pushed_by.push_back(kNone);
+}
+
+void Turtles::place(std::size_t k, double heading, Body& b, double& end, double now) {
+  TurtleRun& r = run_[k];
+  if (busy_[k] != 0) {
+    const double el = now - r.t_start;
+    r.amount = r.kind == TurtleCommand::Kind::move ? r.speed * el
+               : r.kind == TurtleCommand::Kind::turn ? r.turn_rate * el
+                                                     : el;
+  }
+  busy_[k] = 0;
+  r.coasting = false;
+  r.touched = false;
+  r.omega = 0.0;
+  r.t_start = now;
+  r.heading0 = heading;
+  end = kNever;
+  b.v = {};
+  pushed_by[k] = kNone;
+}
+
 void Turtles::exit(std::size_t k, Body& b, double& end) {
   busy_[k] = 0;
   end = kNever;

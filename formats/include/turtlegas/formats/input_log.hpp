@@ -6,6 +6,11 @@
 //   {"step": 3, "turtle": "t1", "command": "pen_down", "mode": "wall"}
 //   {"step": 40, "takeover": "t2"}
 //   {"step": 52, "add_wall": {"id": "w", "from": [100, 300], "to": [200, 300]}}
+//   {"step": 60, "spawn": {"ball": {"id": "b9", "pos": [50, 50], "vel": [10, 0], "radius": 4}}}
+//   {"step": 61, "spawn": {"turtle": {"id": "t9", "pos": [80, 80], "heading": 90}}}
+//   {"step": 70, "remove": "b9"}
+//   {"step": 80, "teleport": {"id": "t9", "pos": [120, 80], "heading": 180}}
+// A spawn's entry is the world file's (world/entries.hpp), as the host accepted it.
 // `turtlegas serve --inputs-out` writes it; ReplayInput feeds it back to a WorldServer headless
 // (`turtlegas run --inputs`), which then gives the same event log bit for bit.
 #pragma once
@@ -13,11 +18,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <istream>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "turtlegas/sim/world_def.hpp"
 #include "turtlegas/turtle/remote.hpp"
@@ -32,6 +40,16 @@ std::string input_header_line(std::string_view world_name, double dt);
 std::string input_command_line(std::uint64_t step, std::string_view turtle, const turtle::RemoteCommand& c);
 std::string input_takeover_line(std::uint64_t step, std::string_view turtle);
 std::string input_wall_line(std::uint64_t step, const sim::WallDef& wall);
+/// kind: "ball" or "turtle"; entry: the world-file entry that was spawned.
+std::string input_spawn_line(std::uint64_t step, std::string_view kind, const nlohmann::json& entry);
+std::string input_remove_line(std::uint64_t step, std::string_view id);
+/// A ball's teleport (vel) or a turtle's (heading, degrees).
+std::string input_teleport_line(std::uint64_t step, std::string_view id, sim::Vec2 pos, std::optional<sim::Vec2> vel,
+                                std::optional<double> heading);
+
+/// Spawns the body of a spawn line ({"ball": {...}} or {"turtle": {...}}) into the server: the
+/// host's reading of world-file entries (formats does not read world files), given to ReplayInput.
+using SpawnApplier = std::function<void(turtle::WorldServer& server, const nlohmann::json& spawn)>;
 
 /// An input log fed back at the steps it was recorded at. Throws std::invalid_argument naming
 /// `file`, the line and the fix for a log that is not one, or names a turtle the world lacks.
@@ -39,16 +57,24 @@ std::string input_wall_line(std::uint64_t step, const sim::WallDef& wall);
 /// the inputs where they were recorded (the log belongs to another world or version).
 class ReplayInput : public turtle::InputSource {
  public:
-  ReplayInput(std::istream& in, const sim::WorldDef& def, std::string file);
+  /// `spawn` applies the log's spawn lines (a log with one and no applier is refused).
+  ReplayInput(std::istream& in, const sim::WorldDef& def, std::string file, SpawnApplier spawn = {});
   void at_boundary(turtle::WorldServer& server, std::uint64_t step) override;
   std::optional<turtle::RemoteCommand> next(std::uint64_t step, std::size_t turtle) override;
 
  private:
   struct Change {
+    enum class Kind { takeover, add_wall, spawn, remove, teleport } kind = Kind::add_wall;
     std::uint64_t step = 0;
-    std::optional<std::size_t> takeover;
-    sim::WallDef wall;
+    std::size_t turtle = 0;  ///< takeover
+    sim::WallDef wall;       ///< add_wall
+    nlohmann::json spawn;    ///< spawn: {"ball": {...}} or {"turtle": {...}}
+    std::string id;          ///< remove, teleport
+    sim::Vec2 pos;           ///< teleport
+    std::optional<sim::Vec2> vel;
+    std::optional<double> heading;
   };
+  SpawnApplier spawn_;
   struct Command {
     std::uint64_t step = 0;
     turtle::RemoteCommand command;

@@ -114,6 +114,17 @@ class WorldHost {
     nlohmann::json id;
     sim::WallDef wall;
   };
+  struct BodyChange {  ///< spawn, remove or teleport (body_changes.cpp)
+    std::uint64_t client = 0;
+    nlohmann::json id;
+    std::string type;
+    std::string body;     ///< the body's id
+    bool ball = false;    ///< remove, teleport: the body is a ball
+    nlohmann::json spawn;  ///< spawn: {"ball": {...}} or {"turtle": {...}}
+    sim::Vec2 pos;
+    std::optional<sim::Vec2> vel;
+    std::optional<double> heading;
+  };
   struct Takeover {
     std::uint64_t client;
     nlohmann::json id;
@@ -136,6 +147,10 @@ class WorldHost {
   void handle_view_message(ClientState& c, const nlohmann::json& m, const std::string& type);
   std::string open_views_list() const;
   void at_boundary(turtle::WorldServer& server, std::uint64_t step);
+  // spawn, remove, teleport (body_changes.cpp): checked on arrival, applied at the boundary.
+  void queue_body_change(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void apply_body_changes(turtle::WorldServer& server, std::uint64_t step);
+  void refuse_body_changes(const std::string& reason);
   std::optional<turtle::RemoteCommand> next_command(std::uint64_t step, std::size_t turtle);
   void on_report(const turtle::RemoteReport& r);
   void step_world(double target);
@@ -173,6 +188,7 @@ class WorldHost {
   std::map<std::uint64_t, ClientState> clients_;
   std::map<std::string, FrameStream> streams_;
   std::deque<WallChange> wall_changes_;
+  std::deque<BodyChange> body_changes_;
   std::deque<Takeover> takeovers_;
   std::deque<FileRequest> file_requests_;
   // Pacing.

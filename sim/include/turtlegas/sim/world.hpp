@@ -78,6 +78,18 @@ struct TurtleContact {
   Vec2 normal;            ///< unit vector from the obstacle towards the turtle's centre
 };
 
+/// A run-time spawn or teleport the engine refuses (World::spawn_ball and the others): what()
+/// says why; for an overlap, also which body or wall is in the way and by how much, so that a
+/// caller that knows the ids can name it. Nothing has changed.
+struct PlacementError : std::invalid_argument {
+  enum class Obstacle { none, ball, turtle, wall };
+  explicit PlacementError(const std::string& what, Obstacle o = Obstacle::none, std::size_t i = 0, double d = 0.0)
+      : std::invalid_argument(what), obstacle(o), index(i), depth(d) {}
+  Obstacle obstacle = Obstacle::none;
+  std::size_t index = 0;  ///< the obstacle's ball, turtle or wall index
+  double depth = 0.0;     ///< how far the discs (or the disc and the wall) would overlap, world units
+};
+
 /// Overlap found by World::measure_overlap, in world units and as a fraction of the smaller radius.
 struct Overlap {
   double depth = 0.0;
@@ -135,6 +147,43 @@ class World {
   /// prediction at once. Returns its index. Throws std::invalid_argument, changing nothing, if it
   /// has zero length, reaches outside a periodic arena, or overlaps a ball or a turtle.
   std::size_t add_wall(const WallDef& wall);
+
+  // Changes to a running world (for a host, at a control boundary: call them between calls to
+  // advance_to). Each is checked like a world-file entry and throws PlacementError (or
+  // std::invalid_argument, std::out_of_range), changing nothing, when refused: a disc that would
+  // overlap a body or a wall it collides with (per layers), a centre outside the arena (the
+  // whole disc inside, with boundary walls), a bad number. Only the body concerned is predicted
+  // again: every other body's events stay exactly as they were (the queue serves ties by id, and
+  // ids keep their order). Not in scenes with moving walls. See docs/physics.md, "Changes to a
+  // running world".
+  /// Adds a ball at the current time; returns its index, ball_count() before the call (indices
+  /// are never reused: a removed ball keeps its index, not alive). Refused in scenes with charged
+  /// balls under a field (their flights keep per-ball species).
+  std::size_t spawn_ball(const BallDef& ball);
+  /// Adds a turtle standing still, no command; returns its index, turtle_count() before the
+  /// call. Refused in a world built without turtles, layers or moving walls (its engine has no
+  /// turtle lists: give the scene a turtle, or layers).
+  std::size_t spawn_turtle(const TurtleDef& turtle);
+  /// Removes ball i or turtle i now (as an exit does, without an event: the host logs it). Its
+  /// index stays taken; a removed body is not alive (BallState::alive) and never met again.
+  /// Throws std::out_of_range for no such body, std::invalid_argument if it is gone already.
+  void remove_ball(std::size_t i);
+  void remove_turtle(std::size_t i);
+  /// Moves ball i to pos with velocity vel, now.
+  void teleport_ball(std::size_t i, Vec2 pos, Vec2 vel);
+  /// Moves turtle i to pos with heading (radians), standing still: the command it was running
+  /// ends there (not touched; done what it had done).
+  void teleport_turtle(std::size_t i, Vec2 pos, double heading);
+  /// Whether turtle i is in the world (false once it exited, was crushed or removed).
+  bool turtle_alive(std::size_t i) const;
+
+  /// Appends to *out, in increasing order, the live balls whose centre lies in the closed
+  /// rectangle [lo.x, hi.x] x [lo.y, hi.y] now (in a periodic arena: one of the centre's images
+  /// does, so a rectangle may cross the seams or reach past the arena). From the grid: it looks
+  /// at the cells the rectangle touches (and a ring round them, where round-off or a step's
+  /// travel may have moved a ball out of its listed cell), O(cells touched + balls found).
+  /// Nothing when lo > hi in either axis.
+  void balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const;
 
   std::size_t turtle_count() const;
   TurtleState turtle(std::size_t i) const;

@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -131,6 +132,9 @@ class WorldServer {
   /// runs the programs of a boundary at t, and the physics stops at t).
   std::uint64_t step() const;
   const sim::World& world() const;
+  /// The scene as it is now: the world file's (builder turtles in their categories), with the
+  /// balls and turtles spawned since appended (ids by index, for writers).
+  const sim::WorldDef& scene() const;
 
   /// When set, events are appended to *log (nullptr stops).
   void set_event_log(std::vector<LogEvent>* log);
@@ -152,6 +156,7 @@ class WorldServer {
     PenMode pen_mode = PenMode::line;
     bool it = false;      ///< "it" in the world's game
     bool remote = false;  ///< runs the remote program (remote.hpp)
+    bool gone = false;    ///< no longer in the world: removed, crushed, or out of an open arena
   };
   std::size_t turtle_count() const;
   /// Turtle i with its whole trail (and the live tip, its position, when the pen is down).
@@ -197,6 +202,32 @@ class WorldServer {
   /// The index of the turtle with that id, or nullopt.
   std::optional<std::size_t> turtle_index(const std::string& id) const;
 
+  // Bodies added, removed and moved at the current boundary (world_changes.cpp; docs/physics.md,
+  // "Bodies added, removed and moved at run time"). Each throws std::invalid_argument, changing
+  // nothing, for a taken or unknown id or a placement the engine refuses (the message names the
+  // body in the way by its id, and by how much), and std::logic_error when not called from
+  // InputSource::at_boundary. Each logs an event: `spawn`, `remove` or `teleport` (a: the id, b:
+  // "ball" or "turtle").
+  /// Adds a ball now; returns its index (indices are never reused).
+  std::size_t spawn_ball(const sim::BallDef& ball);
+  /// Adds a turtle standing still, with its program (a registered controller or "remote"), which
+  /// starts at this boundary in its turn (after the turtles before it). Not a builder.
+  std::size_t spawn_turtle(const sim::TurtleDef& turtle, TurtleProgram program);
+  /// Removes the ball or turtle `id` now; a turtle's program is unwound (its coroutine ends) and
+  /// its touches not yet delivered are dropped.
+  void remove_body(const std::string& id);
+  /// Moves ball `id` to pos with velocity vel.
+  void teleport_ball(const std::string& id, sim::Vec2 pos, sim::Vec2 vel);
+  /// Moves turtle `id` to pos facing heading_deg (degrees, Logo convention), standing still: the
+  /// command it was running ends there (its result: not touched, done what it had done).
+  void teleport_turtle(const std::string& id, sim::Vec2 pos, double heading_deg);
+  /// Why a disc of `radius` at `pos` (default layers) could not be placed now, or nullopt: the
+  /// overlaps spawn_ball and the teleports refuse (naming the body or wall in the way and by how
+  /// much), measured against the present state with nothing changed, ignoring the body `self`.
+  /// For a host that answers at once what the next boundary would refuse; the boundary checks again.
+  std::optional<std::string> placement_problem(sim::Vec2 pos, double radius, const std::string& self = {}) const;
+  /// Whether the body `id` is a ball (false: a turtle; nullopt: no such body, or removed).
+  std::optional<bool> body_is_ball(const std::string& id) const;
   /// Bytes of program stack actually reserved per turtle (stack plus guard page).
   std::size_t stack_reservation() const;
 
