@@ -93,6 +93,7 @@ class Engine final : public EngineBase {
 
   void advance_to(double t) override;
   void set_event_log(std::vector<Event>* log) override { record_.log = log; }
+  void set_impulse_log(std::vector<Impulse>* log) override { record_.impulses = log; }
   void set_event_limit(std::uint64_t limit) override { event_limit_ = limit; }
   double time() const override { return t_base_ + now_; }
   std::size_t ball_count() const override { return bodies_.balls(); }
