@@ -43,6 +43,12 @@ ChargedFlight::ChargedFlight(const WorldDef& def) {
       ++used;
     }
   bracketed_pairs_ = used > 1 || (charged && !def.turtles.empty());
+  // One species of drift-free circles, fixed walls: every time of impact is a closed form exact
+  // over any horizon (pairs: the rotation; faces and ends: the circle's), as with straight flights.
+  bool moving_walls = false;
+  for (const WallDef& w : def.walls) moving_walls = moving_walls || !w.keys.empty();
+  closed_forms_ = !bracketed_pairs_ && !moving_walls;
+  for (std::uint32_t k : of_) closed_forms_ = closed_forms_ && species_[k].w != 0.0 && species_[k].a == Vec2{};
 }
 
 CellExit ChargedFlight::cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const CellBox& b) const {

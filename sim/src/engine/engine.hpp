@@ -333,7 +333,7 @@ void Engine<F, kBallBall, kStep, kExtras>::predict(std::uint32_t i, int ix, int 
     // Curved flights look no further than the cell exit (or the flight's re-plan time), when the
     // body predicts afresh anyway: the bracketed searches need a finite horizon, and every search
     // is cheaper for it. Nothing found leaves no candidate.
-    p.t_coll = p.t_cross;
+    if (!motion_.flight().closed_forms()) p.t_coll = p.t_cross;
     look_around<kBallBall>(look(), grid_, i, bi, ix, iy, p);
     if (p.kind == Partner::none) p.t_coll = kNever;
   } else if constexpr (!kStep) {

@@ -249,6 +249,11 @@ class ChargedFlight {
     return dot(s.a + s.w * turn_cw(v), n);
   }
   double potential(std::uint32_t ball, Vec2 x) const { return -dot(species(ball).a, x); }
+  /// Every time of impact the scene can ask for is a closed form that needs no horizon (one species
+  /// of drift-free circles among fixed walls): then predictions look as far as they like, and a
+  /// cell crossing keeps the old prediction and looks only at the strip of cells it brings into
+  /// the neighbourhood, as with straight flights (engine.hpp, exact_clock.hpp).
+  bool closed_forms() const { return closed_forms_; }
 
  private:
   std::vector<Species> species_;
@@ -256,6 +261,7 @@ class ChargedFlight {
   /// Some pair needs the bracketed search (two species, or a charged ball and turtles): then a
   /// drift-free circle that never leaves its cell re-plans every few periods (cell_exit).
   bool bracketed_pairs_ = false;
+  bool closed_forms_ = false;
 };
 
 static_assert(Flight<FreeFlight> && Flight<GravityFlight> && Flight<ChargedFlight>);
