@@ -655,6 +655,13 @@ TEST_CASE("held-out-oracle scenes: the engine agrees with the brute-force refere
     d.balls.push_back(charged("q", {70.0, 27.0}, {0.0, 1.5}, 1.0, 1.0, 1.0));
     compare_with_reference(d, 40.0, 3);
   }
+  SECTION("one drift-free species in B: crossings keep old predictions and scan the new strip") {
+    // (ChargedFlight::closed_forms(): predictions beyond the cell exit, found before crossings.)
+    WorldDef d = charged_gas(24, 0.2, 1.0, 2.0, 1414, {1.0});
+    d.effects.magnetic = 0.6;
+    d.arena.cell = 2.0;
+    compare_with_reference(d, 6.0, 30);
+  }
   SECTION("all three fields in a small memo gas") {
     WorldDef d = charged_gas(16, 0.15, 1.0, 1.5, 272, {1.0, -2.0, 0.0});
     d.effects.gravity = {0.0, -0.2};

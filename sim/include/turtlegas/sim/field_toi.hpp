@@ -9,7 +9,7 @@
 // touching (or overlapping by round-off) and approaching collides at 0; touching and receding
 // looks for the next contact; a graze (tangency, a double root) is not a contact; a bracketed root
 // is returned at the end of its bracket where the bodies are still apart, so a contact never
-// overlaps. Derivations and the proofs that no root is skipped: docs/physics-fields.md.
+// overlaps. Derivations and the proofs that no root is skipped: docs/physics.md, "Fields: the mathematics".
 namespace turtlegas::sim {
 
 /// Two discs whose relative motion is a pure rotation: equal w and equal a (equal q/m in B, any E
