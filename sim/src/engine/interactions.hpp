@@ -39,8 +39,9 @@ template <Flight F, bool kExtras>
   const Body& bj = l.bodies.body[j];
   const double dtj = l.now - bj.t;
   const F& f = l.motion.flight();
-  const Vec2 r = f.pos(j, bj.x, bj.v, dtj) + shift - bi.x;
-  const Vec2 vj = f.vel(j, bj.v, dtj);
+  const FieldState sj = flight_state(f, j, bj.x, bj.v, dtj);
+  const Vec2 r = sj.x + shift - bi.x;
+  const Vec2 vj = sj.v;
   const double t = l.now + f.toi_balls(i, j, r, bi.v, vj, bi.r + bj.r, p.t_coll - l.now);
   if (t < p.t_coll) {
     // Checked only for a winner: most candidates miss, and last[j] is a cache miss.

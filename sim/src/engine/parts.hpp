@@ -114,8 +114,9 @@ void sync_body(BodyStore& bodies, const Motion<F, kExtras>& motion, StepState& s
   Body& b = bodies.body[i];
   const double dt = now - b.t;
   if constexpr (kStep) step.travel[i] += path_length(b.v, dt);
-  b.x = motion.pos(b, i, dt);
-  b.v = motion.vel(b, i, dt);
+  const FieldState s = motion.state(b, i, dt);
+  b.x = s.x;
+  b.v = s.v;
   b.t = now;
 }
 
