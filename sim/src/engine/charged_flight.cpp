@@ -70,6 +70,10 @@ CellExit ChargedFlight::cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const Cell
   CellExit e;
   if (quiet > 0.0) {
     e = {quiet, kReplan};
+  } else if (s.a == Vec2{}) {
+    const BoxExit bx = field_box_exit_drift_free(x, f, {b.x_lo, b.y_lo}, {b.x_hi, b.y_hi});
+    e = bx.t == kNever ? CellExit{horizon, kReplan}
+                       : CellExit{bx.t, static_cast<std::uint8_t>(bx.axis == 0 ? (bx.upper ? 1 : 0) : (bx.upper ? 3 : 2))};
   } else {
     e = earlier_exit(field_axis_exit(x.x, f, 0, b.x_lo, b.x_hi, horizon), field_axis_exit(x.y, f, 1, b.y_lo, b.y_hi, horizon));
     if (e.t == kNever) e = {horizon, kReplan};

@@ -68,6 +68,15 @@ double toi_field_disc_point(Vec2 rel, const FieldFlight& f, double radius, doubl
 /// form per side, else the monotone pieces between the closed-form critical points, bisected.
 AxisExit field_axis_exit(double x, const FieldFlight& f, int axis, double lo, double hi, double horizon);
 
+/// Where a drift-free circle (f.w != 0, f.a == 0) at x leaves the box [lo, hi]: field_axis_exit of
+/// both axes and the earlier of the two (x first at a tie), with one arctangent instead of four.
+struct BoxExit {
+  double t = kNever;
+  int axis = 0;        ///< 0: x, 1: y
+  bool upper = false;  ///< through hi (else lo)
+};
+BoxExit field_box_exit_drift_free(Vec2 x, const FieldFlight& f, Vec2 lo, Vec2 hi);
+
 /// Where a body can be: for w != 0 its centre is, at every t >= 0, exactly `rho` (the gyration
 /// radius) from centre + drift t (the guiding centre), so its disc lies inside the disc of
 /// `radius` = rho + `body` about it. `margin` bounds the rounding of centre and radii (the
