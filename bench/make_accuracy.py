@@ -83,6 +83,21 @@ def gas_table(rows):
                                  "collisions", "collisions − exact", "notes"], out)
 
 
+def charged_table(rows):
+    exact = next((r for r in rows if r["mode"] == "exact"), None)
+    out = []
+    for r in rows:
+        out.append(cost_cells(r, exact) + [
+            g3(r["max_position_error"]) if r["mode"] == "step" else "reference",
+            g3(r["rms_position_error"]) if r["mode"] == "step" else "–",
+            g3(r["median_position_error"]) if r["mode"] == "step" else "–", g3(r["rms_speed_error"]),
+            f"{r['collisions']:,}", make_tables.flag(r) or "",
+        ])
+    return make_tables.md_table(["mode", "dt (s)", "CPU s / sim s", "cost ÷ exact", "max position error",
+                                 "RMS position error", "median position error", "speed error, each ball (RMS)",
+                                 "collisions", "notes"], out)
+
+
 # Errors below a double's round-off at the quantity's own size are counted as this much in the
 # ratios against Box2D (an exact 0 is round-off that happened to cancel).
 ROUND_OFF = 1e-16
@@ -298,6 +313,12 @@ def main():
         parts += [f"### The memo's gas under gravity (`{g['world_file']}`: N = {g['N']}, "
                   f"T = {g['sim_seconds']:.3g} s)",
                   "", gas_table(gas), ""]
+    charged = scene_rows(rows, "charged")
+    if charged:
+        c = charged[0]
+        parts += [f"### Charged balls in B: step mode's rotation kick against exact circles (`{c['world_file']}`: "
+                  f"N = {c['N']}, T = {c['sim_seconds']:.3g} s; positions against exact mode's)", "",
+                  charged_table(charged), ""]
     if report.args.svg:
         svg_plot([r for r in rows if r["scene"] in ("ballistic", "gas")], report.args.svg)
         parts += [f"![error against CPU seconds per simulated second]({report.rel(report.args.svg)})", ""]

@@ -26,9 +26,11 @@
 #include "output_file.hpp"
 #include "scene_scales.hpp"
 #include "signals.hpp"
+#include "turtlegas/formats/ball_trails.hpp"
 #include "turtlegas/formats/event_log.hpp"
 #include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/names.hpp"
+#include "turtlegas/formats/observables.hpp"
 #include "turtlegas/formats/state_file.hpp"
 #include "turtlegas/formats/stats_file.hpp"
 #include "turtlegas/formats/svg_snapshot.hpp"
@@ -256,6 +258,10 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
   run->add_flag("--stats", opt.stats, "Print a summary of the run");
   run->add_option("--stats-json", opt.stats_json, "Write the run's statistics here (JSON; - for standard output)");
   run->add_option("--svg", opt.svg, "Write an SVG picture of the final state here (- for standard output)");
+  run->add_option("--svg-trails", opt.svg_trails,
+                  "Draw each ball's path over the last SECONDS of the run in the --svg picture, along its flight "
+                  "(curves under fields; the first 1000 balls; exact mode)")
+      ->check(real_in(0, big, "seconds", true));
   run->add_option("--plugin", plugins, plugin_help);
   run->add_option("--inputs", opt.inputs,
                   "Replay this input log (written by `turtlegas serve --inputs-out`) into the world's remote turtles");
@@ -275,6 +281,26 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
       run->add_option("--checkpoint-every", line.checkpoint_every, "Simulated seconds between checkpoints")
           ->check(real_in(0, big, "seconds", true));
   run->add_option("--resume", opt.resume, "Continue the run a checkpoint was written for (replays it to there)");
+  run->add_option("--observe", opt.observe,
+                  "Write the gas observables here (JSON; - for standard output): temperature, pressure, collision "
+                  "rate, mean free path, speed histogram, density profile, per time window with error bars");
+  run->add_option("--observe-from", opt.observe_from, "Simulated time the observation starts at (equilibration before)")
+      ->check(real_in(0, big, "seconds"));
+  run->add_option("--observe-window", opt.observe_window,
+                  "Seconds per observation window (block); default a tenth of --until minus --observe-from")
+      ->check(real_in(0, big, "seconds", true));
+  run->add_option("--observe-samples", opt.observe_samples, "State samples per window")
+      ->capture_default_str()
+      ->check(integer_in(1, 1000000, "samples"));
+  run->add_option("--observe-axis", opt.observe_axis, "Axis of the density profile")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"x", "y"}));
+  run->add_option("--observe-bins", opt.observe_bins, "Bins of the density profile")
+      ->capture_default_str()
+      ->check(integer_in(1, 100000, "bins"));
+  run->add_option("--observe-speed-bins", opt.observe_speed_bins, "Bins of the speed histogram (0 to 4 rms speeds)")
+      ->capture_default_str()
+      ->check(integer_in(1, 100000, "bins"));
   return run;
 }
 
@@ -291,7 +317,8 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   std::vector<NamedPath> inputs{{opt.world, "the world file"}};
   for (const std::string& p : opt.plugins) inputs.push_back({p, "--plugin"});
   std::vector<NamedPath> outputs{{opt.events, "--events"}, {opt.state_out, "--state-out"},
-                                 {opt.stats_json, "--stats-json"}, {opt.svg, "--svg"}, {opt.checkpoint, "--checkpoint"}};
+                                 {opt.stats_json, "--stats-json"}, {opt.svg, "--svg"}, {opt.observe, "--observe"},
+                                 {opt.checkpoint, "--checkpoint"}};
   if (opt.stats) outputs.push_back({"-", "--stats"});
   if (!opt.resume.empty()) {
     std::vector<NamedPath> others(outputs.begin(), outputs.end() - (opt.stats ? 2 : 1));
@@ -299,7 +326,18 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   }
   check_outputs(outputs, inputs);
   if (opt.checkpoint == "-") throw BadInput("--checkpoint needs a file name, not standard output");
-  std::optional<OutputFile> events_file, state_file, stats_file, svg_file;
+  std::optional<OutputFile> events_file, state_file, stats_file, svg_file, observe_file;
+  formats::ObserveOptions observing;
+  if (!opt.observe.empty()) {
+    observing.from = opt.observe_from;
+    observing.window = opt.observe_window;
+    observing.samples = opt.observe_samples;
+    observing.axis = opt.observe_axis.empty() ? 'y' : opt.observe_axis[0];
+    observing.profile_bins = opt.observe_bins;
+    observing.speed_bins = opt.observe_speed_bins;
+    if (const std::string bad = formats::check_observe(observing, 0.0, opt.until); !bad.empty()) throw BadInput(bad);
+    observe_file.emplace(opt.observe, "--observe");
+  }
   if (!opt.events.empty()) events_file.emplace(opt.events, "--events");
   if (!opt.state_out.empty()) state_file.emplace(opt.state_out, "--state-out");
   if (!opt.stats_json.empty()) stats_file.emplace(opt.stats_json, "--stats-json");
@@ -359,6 +397,22 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   std::optional<formats::EventLogWriter> writer;
   if (events_file) writer.emplace(events_file->stream());
   double first_chunk = 0.0;
+  std::optional<formats::Observer> observer;
+  std::optional<formats::BallTrails> trails;
+  std::vector<sim::Impulse> trail_impulses;  // when there is no observer to pass them on
+  if (opt.svg_trails > 0.0) {
+    if (opt.svg.empty()) throw BadInput("--svg-trails draws in the --svg picture: give --svg F as well");
+    if (mode != sim::Mode::exact)
+      throw BadInput("--svg-trails draws exact mode's flights; leave it out in step mode (or run --mode exact)");
+    if (!def.turtles.empty() || replay)
+      throw BadInput("--svg-trails draws the balls of a run by the bare engine; " + opt.world +
+                     (replay ? " is run with --inputs" : " has turtles (their pen trails are drawn anyway)") +
+                     ": leave out --svg-trails");
+    trails.emplace(def, std::max(0.0, opt.until - opt.svg_trails));
+  }
+  if (observe_file && (!def.turtles.empty() || replay))
+    throw BadInput("--observe measures a gas run by the bare engine; " + opt.world +
+                   (replay ? " is run with --inputs" : " has turtles") + ": leave out --observe, or the turtles");
   if (def.turtles.empty() && !replay) {
     // The World takes the balls over, so that the scene's copy of them (and their ids' strings)
     // and the engine are never in memory together: a million balls then cost about 170 bytes each
@@ -372,10 +426,23 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     sim::World& world = *bare;
     totals.energy_start = world.energy();
     world.set_event_log(&bare_events);
+    if (observe_file) observer.emplace(world, def, observing, opt.until);
+    if (trails && observer) observer->forward = [&trails](const std::vector<sim::Impulse>& b) { trails->take(b); };
+    else if (trails) world.set_impulse_log(&trail_impulses);
     // A quarter step first: short enough for a million balls.
     first_chunk = std::min((opt.until - world.time()) / 64.0, def.dt / 4.0);
-    advance = [&world](double t) {
-      world.advance_to(t);
+    advance = [&world, &observer, &trails, &trail_impulses](double t) {
+      auto to = [&](double u) {
+        if (observer) observer->advance_to(u);  // stops at its sample times on the way
+        else world.advance_to(u);
+        if (trails) trails->take(trail_impulses), trail_impulses.clear();
+      };
+      if (trails && !trails->started() && trails->from() <= t) {
+        to(trails->from());  // the trails start: a stop there
+        trails->start(world);
+        trail_impulses.clear();
+      }
+      to(t);
       return world.stats().events;
     };
     flush = [&, names = formats::RunNames{ball_ids, def, world}](bool write) {
@@ -478,6 +545,12 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     for (std::size_t i = 0; i < server->turtle_count(); ++i) totals.turtles_finished += server->turtle(i).finished ? 1 : 0;
   } else {
     bare->set_event_log(nullptr);
+    if (observer) observer->detach();
+    if (trails) {
+      trails->take(trail_impulses);
+      trails->finish(*bare);
+      bare->set_impulse_log(nullptr);
+    }
   }
   const std::string stopped = stop_name(end.first, end.second);
 
@@ -512,8 +585,14 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     formats::write_stats(stats_file->stream(), run, world);
     stats_file->commit();
   }
+  if (observe_file) {
+    observe_file->stream() << observer->result().dump(1) << '\n';
+    observe_file->commit();
+  }
   if (svg_file) {
-    formats::write_svg(svg_file->stream(), server ? formats::snapshot_of(*server, def) : formats::snapshot_of(world, def));
+    formats::Snapshot picture = server ? formats::snapshot_of(*server, def) : formats::snapshot_of(world, def);
+    if (trails) picture.ball_trails = trails->polylines();
+    formats::write_svg(svg_file->stream(), picture);
     svg_file->commit();
   }
   // A resumed run stopped while it was still replaying has got no further than its checkpoint:

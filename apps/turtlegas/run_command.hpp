@@ -35,6 +35,12 @@ struct RunOptions {
   std::optional<double> checkpoint_every;
   std::string resume;
   std::vector<std::string> plugins;  ///< for the output-is-an-input check
+  /// Gas observables (formats/observables.hpp) written to `observe`, with their options.
+  std::string observe;
+  double observe_from = 0.0, observe_window = 0.0;
+  int observe_samples = 20, observe_bins = 20, observe_speed_bins = 40;
+  std::string observe_axis = "y";
+  double svg_trails = 0.0;  ///< seconds of each ball's path the SVG draws (0: none)
 };
 
 /// The `run` subcommand's command line, parsed into a RunOptions by options() once CLI11 has run.

@@ -122,6 +122,13 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
         << "\" y2=\"" << fmt(pose.to.y) << (there ? "\" stroke=\"#222\"" : "\" stroke=\"#bbb\" stroke-dasharray=\"4 3\"")
         << " stroke-width=\"2\" stroke-linecap=\"round\" vector-effect=\"non-scaling-stroke\"/>\n";
   }
+  for (const auto& trail : snap.ball_trails) {
+    if (trail.size() < 2) continue;
+    out << "<polyline class=\"ball-trail\" fill=\"none\" stroke=\"#8a8fa8\" stroke-opacity=\"0.7\" "
+           "stroke-width=\"0.8\" stroke-linejoin=\"round\" vector-effect=\"non-scaling-stroke\" points=\"";
+    for (std::size_t k = 0; k < trail.size(); ++k) out << (k == 0 ? "" : " ") << fmt(trail[k].x) << ',' << fmt(trail[k].y);
+    out << "\"/>\n";
+  }
   for (std::size_t i = 0; i < snap.balls.size(); ++i) {
     const auto& b = snap.balls[i];
     out << "<circle cx=\"" << fmt(b.pos.x) << "\" cy=\"" << fmt(b.pos.y) << "\" r=\"" << fmt(b.radius)

@@ -24,6 +24,7 @@ World& World::operator=(World&&) noexcept = default;
 
 void World::advance_to(double t) { impl_->engine->advance_to(t); }
 void World::set_event_log(std::vector<Event>* log) { impl_->engine->set_event_log(log); }
+void World::set_impulse_log(std::vector<Impulse>* log) { impl_->engine->set_impulse_log(log); }
 void World::set_event_limit(std::uint64_t limit) { impl_->engine->set_event_limit(limit); }
 double World::time() const { return impl_->engine->time(); }
 Mode World::mode() const { return impl_->engine->mode(); }

@@ -437,3 +437,42 @@ TEST_CASE("cli: every shipped turtle world runs for a minute") {
     CHECK(json::parse(read(stats)).at("max_overlap_relative").get<double>() <= 1e-9);
   }
 }
+
+TEST_CASE("cli: --observe writes the gas observables and --svg-trails the balls' flights, the run unchanged") {
+  TempDir dir;
+  auto P = [&](const char* name) { return (dir.path / name).string(); };
+  const std::string gas = std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/memo_gas_fields.json";
+  const Result plain = run(dir, {"run", gas, "--until", "3", "--events", P("plain.jsonl")});
+  REQUIRE(plain.code == 0);
+  const Result r = run(dir, {"run", gas, "--until", "3", "--events", P("observed.jsonl"), "--observe", P("obs.json"),
+                             "--observe-from", "1", "--observe-window", "0.5", "--observe-samples", "5", "--svg",
+                             P("pic.svg"), "--svg-trails", "1"});
+  REQUIRE(r.code == 0);
+  // Stopping at the sample times changes nothing: the same event log, byte for byte.
+  CHECK(read(dir.path / "observed.jsonl") == read(dir.path / "plain.jsonl"));
+  const json o = json::parse(read(dir.path / "obs.json"));
+  CHECK(o.at("format") == "turtlegas-observables/1");
+  CHECK(o.at("windows") == 4);
+  CHECK(o.at("per_window").size() == 4);
+  CHECK(o.at("summary").at("kT").at("mean").get<double>() > 0.0);
+  CHECK(o.at("summary").at("collision_rate").at("mean").get<double>() > 0.0);
+  CHECK(o.at("speed_histogram").at("density").size() == 40);
+  CHECK(o.at("density_profile").at("density").size() == 20);
+  CHECK(o.at("walls").size() > 4);
+  CHECK(!o.at("summary").contains("Z_virial"));  // a walled arena: no virial pressure
+  CHECK(contains(read(dir.path / "pic.svg"), "class=\"ball-trail\""));
+  SECTION("bad uses are refused with exit 2") {
+    Result b = run(dir, {"run", gas, "--until", "3", "--svg-trails", "1"});
+    CHECK(b.code == 2);
+    CHECK(contains(b.err, "--svg-trails draws in the --svg picture"));
+    b = run(dir, {"run", gas, "--until", "3", "--observe", P("o.json"), "--observe-window", "5"});
+    CHECK(b.code == 2);
+    CHECK(contains(b.err, "--observe-window"));
+    b = run(dir, {"run", std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/wander.json", "--until", "1", "--observe", P("o.json")});
+    CHECK(b.code == 2);
+    CHECK(contains(b.err, "has turtles"));
+    b = run(dir, {"run", gas, "--until", "1", "--mode", "step", "--svg", P("s.svg"), "--svg-trails", "1"});
+    CHECK(b.code == 2);
+    CHECK(contains(b.err, "step mode"));
+  }
+}

@@ -13,6 +13,7 @@
 #include <vector>
 #include <algorithm>
 #include <numbers>
+#include <random>
 
 #include "field_oracle.hpp"
 #include "turtlegas/sim/field_toi.hpp"
@@ -907,4 +908,35 @@ TEST_CASE("the bracketed search continues past its split budget instead of decid
   const L dist = ld_norm(P2{x2.x - x1.x, x2.y - x1.y});
   CHECK(static_cast<double>(dist - sigma) == Approx(0.0).margin(1e-9));
   CHECK(dist >= sigma - 1e-12L);
+}
+
+TEST_CASE("a drift-free circle's box exit is field_axis_exit's on both axes, to the bit", "[fields][toi]") {
+  // Random circles (centres inside and outside, radii below and above the box's size, both signs of
+  // w, magnitudes 1e-3 to 1e3) and boxes; also exits starting at a face. Seed 1414.
+  std::mt19937_64 rng(1414);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int exits = 0;
+  for (int k = 0; k < 200000; ++k) {
+    const double w = std::pow(10.0, 3.0 * u(rng)) * (u(rng) < 0 ? -1.0 : 1.0);
+    const Vec2 lo{u(rng), u(rng)}, hi{lo.x + 0.01 + 2.0 * std::abs(u(rng)), lo.y + 0.01 + 2.0 * std::abs(u(rng))};
+    Vec2 x{lo.x + (hi.x - lo.x) * (0.5 + 0.5 * u(rng)), lo.y + (hi.y - lo.y) * (0.5 + 0.5 * u(rng))};
+    if (k % 10 == 0) x.x = lo.x;  // on a face
+    if (k % 10 == 1) x.y = hi.y;
+    const double speed = std::pow(10.0, 2.0 * u(rng)), a = 3.14159265358979 * u(rng);
+    const FieldFlight f{{speed * std::cos(a), speed * std::sin(a)}, {}, w};
+    const double horizon = 64.0 * gyration_period(w);
+    const AxisExit ex = field_axis_exit(x.x, f, 0, lo.x, hi.x, horizon);
+    const AxisExit ey = field_axis_exit(x.y, f, 1, lo.y, hi.y, horizon);
+    const bool x_first = ex.t <= ey.t;
+    const double t = x_first ? ex.t : ey.t;
+    const BoxExit b = field_box_exit_drift_free(x, f, lo, hi);
+    INFO("case " << k);
+    REQUIRE(b.t == t);
+    if (t != kNever) {
+      REQUIRE(b.axis == (x_first ? 0 : 1));
+      REQUIRE(b.upper == (x_first ? ex.upper : ey.upper));
+      ++exits;
+    }
+  }
+  CHECK(exits > 100000);
 }

@@ -107,6 +107,32 @@ TEST_CASE("E x B drift: the guiding centre moves at E x B / B^2 to 1e-9", "[fiel
   CHECK(world.energy() == Approx(0.5 * dot(v0, v0) - dot(Vec2{0.0, -2.0}, x0)).epsilon(1e-12));
 }
 
+TEST_CASE("E x B drift after 10^4 periods: the drift velocity to 1e-9, the position on the oracle's", "[fields][engine]") {
+  // E = (0, -0.02), Bz = 1, q/m = 1: drift (-0.02, 0); 10^4 periods carry the guiding centre 1257
+  // units to the left, across ~1300 cells.
+  WorldDef d = box(2000, 200);
+  d.effects.electric = {0.0, -0.02};
+  d.effects.magnetic = 1.0;
+  const Vec2 x0{1800.0, 100.0}, v0{0.5, 1.0};
+  d.balls.push_back(charged("p", x0, v0, 0.5, 1.0, 1.0));
+  World world(d, Mode::exact);
+  const FieldFlight f{v0, {0.0, -0.02}, 1.0};
+  const Vec2 drift = drift_velocity(f);
+  const double rho = gyration_radius(f);
+  const Vec2 gc0 = guiding_centre(x0, f);
+  const double T = (1e4 + 0.37) * gyration_period(1.0);
+  world.advance_to(T);
+  const BallState s = world.ball(0);
+  const Vec2 gc = guiding_centre(s.pos, {s.vel, f.a, f.w});
+  CHECK((gc.x - gc0.x) / T == Approx(drift.x).epsilon(1e-9));
+  CHECK(std::abs(gc.y - gc0.y) <= 1e-9 * std::abs(drift.x) * T);
+  const auto exact = field_oracle::mp_state(x0, f, field_oracle::Mp(T));
+  const double ex = static_cast<double>(exact.x.x), ey = static_cast<double>(exact.x.y);
+  INFO("engine (" << s.pos.x << ", " << s.pos.y << ") oracle (" << ex << ", " << ey << "), radius " << rho);
+  CHECK(std::hypot(s.pos.x - ex, s.pos.y - ey) <= 1e-9 * rho);
+  CHECK(world.stats().collisions() == 0);
+}
+
 TEST_CASE("two equal-q/m balls in B collide again within a period: the last-partner rule is the flight's",
           "[fields][engine]") {
   // Head-on, equal masses and charges: after the first collision the pair touches and recedes,
@@ -628,6 +654,13 @@ TEST_CASE("held-out-oracle scenes: the engine agrees with the brute-force refere
     d.balls.push_back(charged("p", {80.0, 14.0}, {0.5, 1.0}, 1.0, 1.0, 1.0));
     d.balls.push_back(charged("q", {70.0, 27.0}, {0.0, 1.5}, 1.0, 1.0, 1.0));
     compare_with_reference(d, 40.0, 3);
+  }
+  SECTION("one drift-free species in B: crossings keep old predictions and scan the new strip") {
+    // (ChargedFlight::closed_forms(): predictions beyond the cell exit, found before crossings.)
+    WorldDef d = charged_gas(24, 0.2, 1.0, 2.0, 1414, {1.0});
+    d.effects.magnetic = 0.6;
+    d.arena.cell = 2.0;
+    compare_with_reference(d, 6.0, 30);
   }
   SECTION("all three fields in a small memo gas") {
     WorldDef d = charged_gas(16, 0.15, 1.0, 1.5, 272, {1.0, -2.0, 0.0});

@@ -43,6 +43,12 @@ ChargedFlight::ChargedFlight(const WorldDef& def) {
       ++used;
     }
   bracketed_pairs_ = used > 1 || (charged && !def.turtles.empty());
+  // One species of drift-free circles, fixed walls: every time of impact is a closed form exact
+  // over any horizon (pairs: the rotation; faces and ends: the circle's), as with straight flights.
+  bool moving_walls = false;
+  for (const WallDef& w : def.walls) moving_walls = moving_walls || !w.keys.empty();
+  closed_forms_ = !bracketed_pairs_ && !moving_walls;
+  for (std::uint32_t k : of_) closed_forms_ = closed_forms_ && species_[k].w != 0.0 && species_[k].a == Vec2{};
 }
 
 CellExit ChargedFlight::cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const CellBox& b) const {
@@ -64,6 +70,10 @@ CellExit ChargedFlight::cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const Cell
   CellExit e;
   if (quiet > 0.0) {
     e = {quiet, kReplan};
+  } else if (s.a == Vec2{}) {
+    const BoxExit bx = field_box_exit_drift_free(x, f, {b.x_lo, b.y_lo}, {b.x_hi, b.y_hi});
+    e = bx.t == kNever ? CellExit{horizon, kReplan}
+                       : CellExit{bx.t, static_cast<std::uint8_t>(bx.axis == 0 ? (bx.upper ? 1 : 0) : (bx.upper ? 3 : 2))};
   } else {
     e = earlier_exit(field_axis_exit(x.x, f, 0, b.x_lo, b.x_hi, horizon), field_axis_exit(x.y, f, 1, b.y_lo, b.y_hi, horizon));
     if (e.t == kNever) e = {horizon, kReplan};

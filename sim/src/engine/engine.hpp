@@ -98,6 +98,7 @@ class Engine final : public EngineBase {
 
   void advance_to(double t) override;
   void set_event_log(std::vector<Event>* log) override { record_.log = log; }
+  void set_impulse_log(std::vector<Impulse>* log) override { record_.impulses = log; }
   void set_event_limit(std::uint64_t limit) override { event_limit_ = limit; }
   double time() const override { return t_base_ + now_; }
   std::size_t ball_count() const override { return bodies_.balls(); }
@@ -356,7 +357,7 @@ void Engine<F, kBallBall, kStep, kExtras>::predict(std::uint32_t i, int ix, int 
     // Curved flights look no further than the cell exit (or the flight's re-plan time), when the
     // body predicts afresh anyway: the bracketed searches need a finite horizon, and every search
     // is cheaper for it. Nothing found leaves no candidate.
-    p.t_coll = p.t_cross;
+    if (!motion_.flight().closed_forms()) p.t_coll = p.t_cross;
     look_around<kBallBall>(look(), grid_, i, bi, ix, iy, p);
     if (p.kind == Partner::none) p.t_coll = kNever;
   } else if constexpr (!kStep) {

@@ -14,6 +14,7 @@ class EngineBase {
   virtual ~EngineBase() = default;
   virtual void advance_to(double t) = 0;
   virtual void set_event_log(std::vector<Event>* log) = 0;
+  virtual void set_impulse_log(std::vector<Impulse>* log) = 0;
   virtual void set_event_limit(std::uint64_t limit) = 0;
   virtual double time() const = 0;
   virtual std::size_t ball_count() const = 0;

@@ -41,9 +41,15 @@ void Engine<F, kBallBall, kStep, kExtras>::cross(std::uint32_t i) {
   unlink(i);
   link(i, static_cast<std::uint32_t>(grid_.index(ix, iy)));
   if constexpr (F::kBoundedHorizon) {
-    // The old prediction looked only as far as this crossing: predict afresh from the new cell.
-    predict_crossing(i, ix, iy);
-    predict(i, ix, iy);
+    if (motion_.flight().closed_forms()) {
+      // The old prediction is good beyond this crossing (closed forms, no horizon): the new strip.
+      look_at_strip<kBallBall>(look(), grid_, i, b, dir, ix, iy, bodies_.pending[i]);
+      predict_crossing(i, ix, iy);
+    } else {
+      // The old prediction looked only as far as this crossing: predict afresh from the new cell.
+      predict_crossing(i, ix, iy);
+      predict(i, ix, iy);
+    }
   } else {
     look_at_strip<kBallBall>(look(), grid_, i, b, dir, ix, iy, bodies_.pending[i]);
     predict_crossing(i, ix, iy);

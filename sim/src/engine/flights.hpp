@@ -214,6 +214,13 @@ class ChargedFlight {
     if (s.w == 0.0) return v + dt * s.a;
     return field_velocity({v, s.a, s.w}, dt);
   }
+  /// pos and vel together, from one set of coefficients (one sine and cosine instead of two): the
+  /// same expressions, so the same bits, as the two calls.
+  FieldState state(std::uint32_t ball, Vec2 x, Vec2 v, double dt) const {
+    const Species& s = species(ball);
+    if (s.w == 0.0) return {x + dt * v + (0.5 * dt * dt) * s.a, v + dt * s.a};
+    return field_advance(x, {v, s.a, s.w}, dt);
+  }
   CellExit cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const CellBox& b) const;
   double toi_balls(std::uint32_t i, std::uint32_t j, Vec2 r, Vec2 vi, Vec2 vj, double sigma, double t_max) const {
     const Species& si = species(i);
@@ -249,6 +256,11 @@ class ChargedFlight {
     return dot(s.a + s.w * turn_cw(v), n);
   }
   double potential(std::uint32_t ball, Vec2 x) const { return -dot(species(ball).a, x); }
+  /// Every time of impact the scene can ask for is a closed form that needs no horizon (one species
+  /// of drift-free circles among fixed walls): then predictions look as far as they like, and a
+  /// cell crossing keeps the old prediction and looks only at the strip of cells it brings into
+  /// the neighbourhood, as with straight flights (engine.hpp, exact_clock.hpp).
+  bool closed_forms() const { return closed_forms_; }
 
  private:
   std::vector<Species> species_;
@@ -256,12 +268,22 @@ class ChargedFlight {
   /// Some pair needs the bracketed search (two species, or a charged ball and turtles): then a
   /// drift-free circle that never leaves its cell re-plans every few periods (cell_exit).
   bool bracketed_pairs_ = false;
+  bool closed_forms_ = false;
 };
 
 static_assert(Flight<FreeFlight> && Flight<GravityFlight> && Flight<ChargedFlight>);
 
 /// How every body flies: balls by the scene's flight, turtles (ids from `balls` on, kExtras only)
 /// always in straight lines. The one place where motion tells balls and turtles apart.
+
+/// A flight's position and velocity after dt together: its state() when it has one (the charged
+/// flight's shares the trigonometry), else pos() and vel().
+template <class F>
+FieldState flight_state(const F& f, std::uint32_t ball, Vec2 x, Vec2 v, double dt) {
+  if constexpr (requires { f.state(ball, x, v, dt); }) return f.state(ball, x, v, dt);
+  else return {f.pos(ball, x, v, dt), f.vel(ball, v, dt)};
+}
+
 template <Flight F, bool kExtras>
 class Motion {
  public:
@@ -279,6 +301,11 @@ class Motion {
     return is_turtle(id) ? b.x + dt * b.v : flight_.pos(id, b.x, b.v, dt);
   }
   Vec2 vel(const Body& b, std::uint32_t id, double dt) const { return is_turtle(id) ? b.v : flight_.vel(id, b.v, dt); }
+  /// pos and vel at once (a flight with state() computes them together).
+  FieldState state(const Body& b, std::uint32_t id, double dt) const {
+    if (is_turtle(id)) return {b.x + dt * b.v, b.v};
+    return flight_state(flight_, id, b.x, b.v, dt);
+  }
   CellExit cell_exit(std::uint32_t id, Vec2 x, Vec2 v, const CellBox& b) const {
     if (is_turtle(id))
       return earlier_exit(straight_exit(x.x, v.x, b.x_lo, b.x_hi), straight_exit(x.y, v.y, b.y_lo, b.y_hi));

@@ -39,8 +39,9 @@ template <Flight F, bool kExtras>
   const Body& bj = l.bodies.body[j];
   const double dtj = l.now - bj.t;
   const F& f = l.motion.flight();
-  const Vec2 r = f.pos(j, bj.x, bj.v, dtj) + shift - bi.x;
-  const Vec2 vj = f.vel(j, bj.v, dtj);
+  const FieldState sj = flight_state(f, j, bj.x, bj.v, dtj);
+  const Vec2 r = sj.x + shift - bi.x;
+  const Vec2 vj = sj.v;
   const double t = l.now + f.toi_balls(i, j, r, bi.v, vj, bi.r + bj.r, p.t_coll - l.now);
   if (t < p.t_coll) {
     // Checked only for a winner: most candidates miss, and last[j] is a cache miss.
@@ -61,7 +62,10 @@ Changed apply_ball_ball(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, std
   const double sigma = a.r + b.r;
   w.record.note_contact(sigma - norm(F), std::min(a.r, b.r));
   const double e = w.restitution.for_pair(i, j, w.now);
+  const Vec2 va = a.v;
   respond_disc_disc(a.v, b.v, w.bodies.mass[i], w.bodies.mass[j], F, e);
+  if (w.record.impulses) [[unlikely]]
+    w.impulse(EventKind::ball_ball, i, j, w.bodies.mass[i] * (a.v - va), -F);
   ++w.record.stats.ball_ball;
   w.note(EventKind::ball_ball, i, j);
   w.changed(i);
@@ -193,7 +197,10 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
       p.turtles.pushed_by[i - p.bodies.balls()] = mi;
     }
   } else {
+    const Vec2 va = a.v;
     a.v = u + p.bounce(i, a.v - u, n);
+    if (p.record.impulses) [[unlikely]]
+      p.impulse(EventKind::ball_wall, i, w, p.bodies.mass[i] * (a.v - va), std::abs(d) * n);
     ++p.record.stats.ball_wall;
     p.note(EventKind::ball_wall, i, w);
   }
@@ -238,7 +245,9 @@ Changed apply_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint
     p.note(EventKind::turtle_wall_end, i - p.bodies.balls(), end.wall);
     p.touch(i, EventKind::turtle_wall_end, end.wall, F / dist);
   } else {
+    const Vec2 va = a.v;
     a.v = p.bounce(i, a.v, F / dist);
+    if (p.record.impulses) [[unlikely]] p.impulse(EventKind::ball_wall_end, i, end.wall, p.bodies.mass[i] * (a.v - va), F);
     ++p.record.stats.ball_wall_end;
     p.note(EventKind::ball_wall_end, i, end.wall);
   }
@@ -302,7 +311,9 @@ Changed apply_moving_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, st
     p.note(EventKind::turtle_wall_end, i - p.bodies.balls(), m.wall);
     p.touch(i, EventKind::turtle_wall_end, m.wall, F / dist);
   } else {
+    const Vec2 va = a.v;
     a.v = ue + p.bounce(i, a.v - ue, F / dist);
+    if (p.record.impulses) [[unlikely]] p.impulse(EventKind::ball_wall_end, i, m.wall, p.bodies.mass[i] * (a.v - va), F);
     ++p.record.stats.ball_wall_end;
     p.note(EventKind::ball_wall_end, i, m.wall);
   }

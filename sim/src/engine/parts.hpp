@@ -70,6 +70,7 @@ struct EventRecord {
   Stats stats;
   Overlap max_contact;
   std::vector<Event>* log = nullptr;
+  std::vector<Impulse>* impulses = nullptr;  ///< World::set_impulse_log
 
   void note_contact(double depth, double radius) {
     if (depth > max_contact.depth) max_contact.depth = depth;
@@ -113,8 +114,9 @@ void sync_body(BodyStore& bodies, const Motion<F, kExtras>& motion, StepState& s
   Body& b = bodies.body[i];
   const double dt = now - b.t;
   if constexpr (kStep) step.travel[i] += path_length(b.v, dt);
-  b.x = motion.pos(b, i, dt);
-  b.v = motion.vel(b, i, dt);
+  const FieldState s = motion.state(b, i, dt);
+  b.x = s.x;
+  b.v = s.v;
   b.t = now;
 }
 
@@ -137,6 +139,10 @@ struct Parts {
   bool is_turtle(std::uint32_t id) const { return motion.is_turtle(id); }
   void sync(std::uint32_t i) const { sync_body<F, kStep, kExtras>(bodies, motion, step, i, now); }
   void note(EventKind kind, std::uint32_t a, std::uint32_t b) const { record.note(t_base + now, kind, a, b); }
+  /// Ball a received dp in a collision with b (World::set_impulse_log); r as Impulse::r.
+  void impulse(EventKind kind, std::uint32_t a, std::uint32_t b, Vec2 dp, Vec2 r) const {
+    record.impulses->push_back({t_base + now, kind, a, b, dp, r});
+  }
   /// Body i changed course: predictions made with it are stale.
   void changed(std::uint32_t i) const {
     ++bodies.body[i].count;

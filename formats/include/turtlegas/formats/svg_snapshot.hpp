@@ -24,6 +24,8 @@ struct Snapshot {
     double radius = 1.0;
   };
   std::vector<Disc> balls;
+  /// Balls' paths (ball_trails.hpp), world units: drawn under the balls as thin lines.
+  std::vector<std::vector<sim::Vec2>> ball_trails;
   struct Turtle {
     std::string id;
     sim::Vec2 pos;

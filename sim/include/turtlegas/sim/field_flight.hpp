@@ -5,7 +5,7 @@
 #include "turtlegas/sim/vec2.hpp"
 
 // Free flight of a charged disc under uniform fields, exact: pure, stateless functions of the time
-// t (seconds, >= 0) since "now". Convention (docs/physics-fields.md):
+// t (seconds, >= 0) since "now". Convention (docs/physics.md, "Fields: the mathematics"):
 //
 //   dv/dt = a + w (v.y, -v.x),   a = g + (q/m) E,   w = q Bz / m,
 //
@@ -97,7 +97,7 @@ constexpr double field_potential(Vec2 x, double mass, double charge, Vec2 g, Vec
 /// Step mode's kick: the velocity's exact change over dt under a and w with the position held
 /// (uniform fields do not depend on it), i.e. the rotation of v by -w dt combined with the
 /// acceleration, v(dt) of field_velocity. Drift-then-kick per step (today's step mode) is first
-/// order in dt; a half kick, the drift, a half kick (Strang) is second order. docs/physics-fields.md.
+/// order in dt; a half kick, the drift, a half kick (Strang) is second order. docs/physics.md, "Fields: the mathematics".
 Vec2 field_kick(Vec2 v, Vec2 a, double w, double dt);
 /// The rotation alone, R(-w dt) v (for a kick split as a dt/2, rotation, a dt/2: second order).
 Vec2 rotation_kick(Vec2 v, double w, double dt);

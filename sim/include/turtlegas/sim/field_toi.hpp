@@ -9,7 +9,7 @@
 // touching (or overlapping by round-off) and approaching collides at 0; touching and receding
 // looks for the next contact; a graze (tangency, a double root) is not a contact; a bracketed root
 // is returned at the end of its bracket where the bodies are still apart, so a contact never
-// overlaps. Derivations and the proofs that no root is skipped: docs/physics-fields.md.
+// overlaps. Derivations and the proofs that no root is skipped: docs/physics.md, "Fields: the mathematics".
 namespace turtlegas::sim {
 
 /// Two discs whose relative motion is a pure rotation: equal w and equal a (equal q/m in B, any E
@@ -67,6 +67,15 @@ double toi_field_disc_point(Vec2 rel, const FieldFlight& f, double radius, doubl
 /// leaves [lo, hi], and which side (AxisExit of toi.hpp). Without drift along the axis a closed
 /// form per side, else the monotone pieces between the closed-form critical points, bisected.
 AxisExit field_axis_exit(double x, const FieldFlight& f, int axis, double lo, double hi, double horizon);
+
+/// Where a drift-free circle (f.w != 0, f.a == 0) at x leaves the box [lo, hi]: field_axis_exit of
+/// both axes and the earlier of the two (x first at a tie), with one arctangent instead of four.
+struct BoxExit {
+  double t = kNever;
+  int axis = 0;        ///< 0: x, 1: y
+  bool upper = false;  ///< through hi (else lo)
+};
+BoxExit field_box_exit_drift_free(Vec2 x, const FieldFlight& f, Vec2 lo, Vec2 hi);
 
 /// Where a body can be: for w != 0 its centre is, at every t >= 0, exactly `rho` (the gyration
 /// radius) from centre + drift t (the guiding centre), so its disc lies inside the disc of

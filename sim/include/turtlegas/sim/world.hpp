@@ -38,6 +38,20 @@ struct EventLimitReached : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The momentum one collision of a ball exchanged, for observers of a gas (World::set_impulse_log):
+/// wall pressure is the impulse the walls received, the virial pressure the sum of r . dp.
+struct Impulse {
+  double t = 0.0;  ///< seconds
+  EventKind kind = EventKind::ball_ball;  ///< ball_ball, ball_wall or ball_wall_end
+  std::uint32_t a = 0;  ///< the ball
+  std::uint32_t b = 0;  ///< the other ball (ball_ball), or the wall's index
+  /// What ball a received: its mass times its change of velocity. Ball b received -dp, a wall -dp.
+  Vec2 dp;
+  /// ball_ball: centre of a minus centre of b at the contact (the nearest periodic image); a wall
+  /// or a wall end: centre of a minus the contact point on the wall.
+  Vec2 r;
+};
+
 /// Position and velocity of one ball at the world's current time.
 struct BallState {
   Vec2 pos;
@@ -122,6 +136,10 @@ class World {
 
   /// When set, every physical event is appended to *log (nullptr stops logging).
   void set_event_log(std::vector<Event>* log);
+
+  /// When set, every collision of a ball with a ball, a wall or a wall end appends its Impulse to
+  /// *log (nullptr stops it). Costs one test per collision when unset.
+  void set_impulse_log(std::vector<Impulse>* log);
 
   /// A bound on the events served (Stats::events, counted from construction): advance_to throws
   /// EventLimitReached when the next event would exceed it. The world is then in a consistent

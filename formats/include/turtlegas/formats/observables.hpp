@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: MIT
+// Gas observables (`turtlegas run --observe F.json`, docs/physics.md "Gas observables"):
+// temperature, wall pressure from collision impulses, virial pressure (periodic arenas), collision
+// rates, mean free path, the speed histogram beside the 2-D Maxwell-Boltzmann (Rayleigh)
+// distribution and a density profile, over consecutive time windows with block-average error bars.
+// Computed from what the engine reports: the impulse of every collision (World::set_impulse_log)
+// and state samples taken at fixed times. The physics does not depend on where a run is cut, so
+// stopping at the sample times changes nothing.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "turtlegas/sim/world.hpp"
+#include "turtlegas/sim/world_def.hpp"
+
+namespace turtlegas::formats {
+
+struct ObserveOptions {
+  double from = 0.0;       ///< seconds: what happens before is not observed (equilibration)
+  double window = 0.0;     ///< seconds per window (block); 0: a tenth of (until - from)
+  int samples = 20;        ///< state samples per window, evenly spaced, the last at its end
+  char axis = 'y';         ///< the density profile's axis, 'x' or 'y'
+  int profile_bins = 20;   ///< across the arena's extent along the axis
+  int speed_bins = 40;     ///< from 0 to 4 times the rms speed at `from`
+};
+
+/// Checks the options against a run to `until` from `start`; returns an empty string or what is
+/// wrong (naming the option and the fix).
+std::string check_observe(const ObserveOptions& o, double start, double until);
+
+class Observer {
+ public:
+  /// For a run of `world` (built from `def`) to `until`. Installs its impulse log in the world
+  /// (World::set_impulse_log); the world must outlive the observer or be detached first.
+  Observer(sim::World& world, const sim::WorldDef& def, ObserveOptions options, double until);
+  Observer(const Observer&) = delete;
+  Observer& operator=(const Observer&) = delete;
+  ~Observer();
+
+  /// Advances the world to t (>= its time), stopping at every sample time on the way.
+  void advance_to(double t);
+  /// The observer's world no longer reports impulses.
+  void detach();
+  /// Whole windows observed so far.
+  std::size_t windows() const { return done_.size(); }
+  /// Called with every batch of impulses before the observer drops it (another consumer of the
+  /// world's one impulse log: the SVG's ball trails).
+  std::function<void(const std::vector<sim::Impulse>&)> forward;
+  /// The measurements (format turtlegas-observables/1, docs/physics.md).
+  nlohmann::json result() const;
+
+ private:
+  struct Window {
+    double t0 = 0.0, t1 = 0.0;
+    std::uint64_t ball_ball = 0, ball_wall = 0;
+    double virial = 0.0;            ///< sum of r . dp over ball-ball collisions
+    std::vector<double> wall_push;  ///< per wall: normal impulse received
+    int samples = 0;
+    double kT = 0.0, kinetic = 0.0, mean_speed = 0.0, balls = 0.0;  ///< sums over samples
+    std::vector<double> speeds, profile;             ///< counts over samples
+    double speed_overflow = 0.0;
+  };
+  void take_impulses();
+  void sample();
+  Window fresh(double t0) const;
+
+  sim::World* world_;
+  ObserveOptions opt_;
+  std::string name_;
+  sim::Boundary boundary_;
+  double width_, height_;
+  double speed_max_ = 0.0;
+  bool started_ = false;
+  std::vector<double> wall_length_;
+  std::vector<std::string> wall_id_;
+  std::map<double, std::size_t> masses_;  ///< the balls' masses and how many have each
+  std::vector<sim::Impulse> impulses_;
+  Window current_;
+  std::vector<Window> done_;
+  std::size_t next_sample_ = 1;  ///< of the current window, 1..samples
+  std::size_t last_window_ = 0;  ///< windows that fit before until
+};
+
+/// Henderson's equation of state of hard discs, Z = (1 + eta^2/8) / (1 - eta)^2, and its contact
+/// value g(sigma) = (1 - 7 eta/16) / (1 - eta)^2 (Z = 1 + 2 eta g), eta the area fraction.
+double henderson_z(double eta);
+double henderson_contact(double eta);
+
+}  // namespace turtlegas::formats

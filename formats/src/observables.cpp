@@ -1,0 +1,281 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/formats/observables.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace turtlegas::formats {
+namespace {
+
+/// Mean and block standard error of per-window values: the windows are taken as independent
+/// samples (true once a window is much longer than the gas's correlation time).
+nlohmann::json block(const std::vector<double>& x) {
+  const double m = x.empty() ? 0.0 : std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
+  double ss = 0.0;
+  for (double v : x) ss += (v - m) * (v - m);
+  const double n = static_cast<double>(x.size());
+  const double err = x.size() > 1 ? std::sqrt(ss / (n * (n - 1.0))) : 0.0;
+  return {{"mean", m}, {"error", err}};
+}
+
+}  // namespace
+
+double henderson_z(double eta) { return (1.0 + eta * eta / 8.0) / ((1.0 - eta) * (1.0 - eta)); }
+double henderson_contact(double eta) { return (1.0 - 7.0 * eta / 16.0) / ((1.0 - eta) * (1.0 - eta)); }
+
+std::string check_observe(const ObserveOptions& o, double start, double until) {
+  if (!(o.from >= start) || !(o.from < until))
+    return "--observe-from must lie in [" + std::to_string(start) + ", " + std::to_string(until) +
+           ") s, the run's start and --until; give a time before --until";
+  const double window = o.window > 0.0 ? o.window : (until - o.from) / 10.0;
+  if (!(o.window >= 0.0) || !std::isfinite(o.window)) return "--observe-window must be a positive number of seconds";
+  if (o.from + window > until)
+    return "--observe-window " + std::to_string(window) + " s does not fit between --observe-from and --until; give a "
+           "shorter window or a later --until";
+  if (o.samples < 1) return "--observe-samples must be at least 1";
+  if (o.axis != 'x' && o.axis != 'y') return "--observe-axis must be x or y";
+  if (o.profile_bins < 1 || o.speed_bins < 1) return "--observe-bins must be at least 1";
+  return {};
+}
+
+Observer::Observer(sim::World& world, const sim::WorldDef& def, ObserveOptions options, double until)
+    : world_(&world),
+      opt_(options),
+      name_(def.name),
+      boundary_(def.arena.boundary),
+      width_(def.arena.width),
+      height_(def.arena.height) {
+  if (opt_.window <= 0.0) opt_.window = (until - opt_.from) / 10.0;
+  last_window_ = static_cast<std::size_t>(std::floor((until - opt_.from) / opt_.window));
+  for (const sim::WallDef& w : world.walls()) {
+    wall_length_.push_back(norm(w.to - w.from));
+    wall_id_.push_back(w.id);
+  }
+  for (std::size_t i = 0; i < world.ball_count(); ++i) ++masses_[world.mass(i)];
+  world.set_impulse_log(&impulses_);
+}
+
+Observer::~Observer() { detach(); }
+
+void Observer::detach() {
+  if (forward && !impulses_.empty()) forward(impulses_);
+  impulses_.clear();
+  if (world_) world_->set_impulse_log(nullptr);
+  world_ = nullptr;
+}
+
+Observer::Window Observer::fresh(double t0) const {
+  Window w;
+  w.t0 = t0;
+  w.t1 = t0 + opt_.window;
+  w.wall_push.assign(wall_length_.size(), 0.0);
+  w.speeds.assign(static_cast<std::size_t>(opt_.speed_bins), 0.0);
+  w.profile.assign(static_cast<std::size_t>(opt_.profile_bins), 0.0);
+  return w;
+}
+
+void Observer::advance_to(double t) {
+  while (world_ && done_.size() < last_window_) {
+    // The next stop: the start of the observation, then each sample of the current window.
+    const double k = static_cast<double>(done_.size());
+    const double stop = !started_ ? opt_.from
+                                 : opt_.from + opt_.window * (k + static_cast<double>(next_sample_) / opt_.samples);
+    if (stop > t) break;
+    world_->advance_to(std::max(stop, world_->time()));
+    if (!started_) {
+      started_ = true;
+      if (forward) forward(impulses_);
+      impulses_.clear();  // before the observation
+      double v2 = 0.0, n = 0.0;
+      for (std::size_t i = 0; i < world_->ball_count(); ++i) {
+        const sim::BallState b = world_->ball(i);
+        if (b.alive) v2 += dot(b.vel, b.vel), n += 1.0;
+      }
+      speed_max_ = n > 0.0 && v2 > 0.0 ? 4.0 * std::sqrt(v2 / n) : 1.0;
+      current_ = fresh(opt_.from);
+      next_sample_ = 1;
+      continue;
+    }
+    take_impulses();
+    sample();
+    if (++next_sample_ > static_cast<std::size_t>(opt_.samples)) {
+      done_.push_back(std::move(current_));
+      current_ = fresh(opt_.from + opt_.window * (k + 1.0));
+      next_sample_ = 1;
+    }
+  }
+  if (world_ && world_->time() < t) world_->advance_to(t);
+  if (world_ && done_.size() >= last_window_) {  // after the last window
+    if (forward) forward(impulses_);
+    impulses_.clear();
+  }
+}
+
+void Observer::take_impulses() {
+  if (forward) forward(impulses_);
+  for (const sim::Impulse& c : impulses_) {
+    if (c.kind == sim::EventKind::ball_ball) {
+      ++current_.ball_ball;
+      current_.virial += dot(c.r, c.dp);
+    } else {
+      ++current_.ball_wall;
+      const double len = norm(c.r);
+      if (len > 0.0 && c.b < current_.wall_push.size()) current_.wall_push[c.b] += dot(c.dp, c.r) / len;
+    }
+  }
+  impulses_.clear();
+}
+
+void Observer::sample() {
+  const sim::World& w = *world_;
+  double n = 0.0, m_sum = 0.0;
+  sim::Vec2 p{};
+  for (std::size_t i = 0; i < w.ball_count(); ++i) {
+    const sim::BallState b = w.ball(i);
+    if (!b.alive) continue;
+    n += 1.0;
+    m_sum += w.mass(i);
+    p += w.mass(i) * b.vel;
+  }
+  if (n == 0.0) return;
+  // Periodic arenas conserve momentum: the temperature is of the velocities about the centre of
+  // mass's, over 2(N - 1) degrees of freedom. Walls take momentum; there it is 2N, in the lab.
+  const bool periodic = boundary_ == sim::Boundary::periodic;
+  const sim::Vec2 vc = periodic ? p / m_sum : sim::Vec2{};
+  const double dof = periodic ? 2.0 * (n - 1.0) : 2.0 * n;
+  double twice_ke = 0.0, speed = 0.0;
+  const double extent = opt_.axis == 'x' ? width_ : height_;
+  for (std::size_t i = 0; i < w.ball_count(); ++i) {
+    const sim::BallState b = w.ball(i);
+    if (!b.alive) continue;
+    const sim::Vec2 u = b.vel - vc;
+    twice_ke += w.mass(i) * dot(u, u);
+    const double s = norm(b.vel);
+    speed += s;
+    const double sb = s / speed_max_ * opt_.speed_bins;
+    if (sb < opt_.speed_bins) current_.speeds[static_cast<std::size_t>(sb)] += 1.0;
+    else current_.speed_overflow += 1.0;
+    double c = opt_.axis == 'x' ? b.pos.x : b.pos.y;
+    if (periodic) c -= extent * std::floor(c / extent);
+    const double pb = c / extent * opt_.profile_bins;
+    if (pb >= 0.0 && pb < opt_.profile_bins) current_.profile[static_cast<std::size_t>(pb)] += 1.0;
+  }
+  current_.kT += dof > 0.0 ? twice_ke / dof : 0.0;
+  current_.kinetic += twice_ke / 2.0;
+  current_.mean_speed += speed / n;
+  current_.balls += n;
+  ++current_.samples;
+}
+
+nlohmann::json Observer::result() const {
+  const bool periodic = boundary_ == sim::Boundary::periodic;
+  const double area = width_ * height_;
+  const double extent = opt_.axis == 'x' ? width_ : height_;
+  const double across = opt_.axis == 'x' ? height_ : width_;
+  double total_length = 0.0;
+  for (double l : wall_length_) total_length += l;
+  std::vector<double> kT, speed, rate, wall_rate, mfp, p_walls, p_virial, z_virial, density;
+  std::vector<std::vector<double>> per_wall(wall_length_.size());
+  nlohmann::json windows = nlohmann::json::array();
+  for (const Window& w : done_) {
+    const double s = std::max(w.samples, 1);
+    const double n = w.balls / s, T = w.kT / s, dt = w.t1 - w.t0;
+    const double v = w.mean_speed / s;
+    const double nu = n > 0.0 ? 2.0 * static_cast<double>(w.ball_ball) / (n * dt) : 0.0;
+    kT.push_back(T);
+    speed.push_back(v);
+    rate.push_back(nu);
+    wall_rate.push_back(n > 0.0 ? static_cast<double>(w.ball_wall) / (n * dt) : 0.0);
+    mfp.push_back(nu > 0.0 ? v / nu : INFINITY);
+    density.push_back(n / area);
+    double push = 0.0;
+    for (std::size_t k = 0; k < w.wall_push.size(); ++k) {
+      push += w.wall_push[k];
+      per_wall[k].push_back(wall_length_[k] > 0.0 ? w.wall_push[k] / (wall_length_[k] * dt) : 0.0);
+    }
+    p_walls.push_back(total_length > 0.0 ? push / (total_length * dt) : 0.0);
+    nlohmann::json row = {{"t0", w.t0}, {"t1", w.t1}, {"kT", T}, {"mean_speed", v}, {"collision_rate", nu},
+                          {"wall_collision_rate", wall_rate.back()}, {"mean_free_path", mfp.back()},
+                          {"pressure_walls", p_walls.back()}};
+    if (periodic) {
+      // The virial theorem in two dimensions: P A = K + (1/2) <sum r_ij . F_ij>, K the kinetic
+      // energy about the centre of mass ((N - 1) kT: a periodic gas's drift exerts no pressure),
+      // the time average of the forces being the collisions' sum of r . dp over the window.
+      const double P = (w.kinetic / s + w.virial / (2.0 * dt)) / area;
+      p_virial.push_back(P);
+      z_virial.push_back(n * T > 0.0 ? P * area / (n * T) : 0.0);
+      row["pressure_virial"] = P;
+      row["Z_virial"] = z_virial.back();
+    }
+    windows.push_back(row);
+  }
+  nlohmann::json summary = {{"kT", block(kT)},
+                            {"mean_speed", block(speed)},
+                            {"collision_rate", block(rate)},
+                            {"wall_collision_rate", block(wall_rate)},
+                            {"mean_free_path", block(mfp)},
+                            {"number_density", block(density)},
+                            {"pressure_walls", block(p_walls)}};
+  if (periodic) {
+    summary["pressure_virial"] = block(p_virial);
+    summary["Z_virial"] = block(z_virial);
+  }
+  // Histograms: per window, normalised, then block-averaged bin by bin.
+  const double bw = speed_max_ / opt_.speed_bins;
+  nlohmann::json edges = nlohmann::json::array(), dens = nlohmann::json::array(), errs = nlohmann::json::array(),
+                 rayleigh = nlohmann::json::array();
+  const double T = block(kT)["mean"].get<double>();
+  double n_balls = 0.0;
+  for (const auto& [m, c] : masses_) n_balls += static_cast<double>(c);
+  std::vector<double> overflow;
+  for (const Window& w : done_) overflow.push_back(w.speed_overflow / std::max(w.balls, 1.0));
+  for (int b = 0; b <= opt_.speed_bins; ++b) edges.push_back(b * bw);
+  for (int b = 0; b < opt_.speed_bins; ++b) {
+    std::vector<double> f;
+    for (const Window& w : done_) f.push_back(w.speeds[static_cast<std::size_t>(b)] / (std::max(w.balls, 1.0) * bw));
+    const nlohmann::json s = block(f);
+    dens.push_back(s["mean"]);
+    errs.push_back(s["error"]);
+    // The 2-D Maxwell-Boltzmann speed distribution of each mass, m v/kT exp(-m v^2/(2 kT)),
+    // weighted by how many balls have it, averaged over the bin (its integral is exact).
+    double frac = 0.0;
+    const double lo = b * bw, hi = (b + 1) * bw;
+    for (const auto& [m, c] : masses_)
+      if (T > 0.0)
+        frac += static_cast<double>(c) / n_balls *
+                (std::exp(-m * lo * lo / (2.0 * T)) - std::exp(-m * hi * hi / (2.0 * T)));
+    rayleigh.push_back(frac / bw);
+  }
+  nlohmann::json speeds = {{"edges", edges}, {"density", dens}, {"error", errs}, {"rayleigh", rayleigh},
+                           {"overflow", block(overflow)}};
+  const double pw = extent / opt_.profile_bins;
+  nlohmann::json pedges = nlohmann::json::array(), pdens = nlohmann::json::array(), perrs = nlohmann::json::array();
+  for (int b = 0; b <= opt_.profile_bins; ++b) pedges.push_back(b * pw);
+  for (int b = 0; b < opt_.profile_bins; ++b) {
+    std::vector<double> f;
+    for (const Window& w : done_)
+      f.push_back(w.profile[static_cast<std::size_t>(b)] / (std::max(w.samples, 1) * pw * across));
+    const nlohmann::json s = block(f);
+    pdens.push_back(s["mean"]);
+    perrs.push_back(s["error"]);
+  }
+  nlohmann::json walls = nlohmann::json::array();
+  for (std::size_t k = 0; k < wall_length_.size(); ++k)
+    walls.push_back({{"id", wall_id_[k]}, {"length", wall_length_[k]}, {"pressure", block(per_wall[k])}});
+  return {{"format", "turtlegas-observables/1"},
+          {"name", name_},
+          {"boundary", periodic ? "periodic" : boundary_ == sim::Boundary::walls ? "walls" : "none"},
+          {"area", area},
+          {"from", opt_.from},
+          {"window", opt_.window},
+          {"samples_per_window", opt_.samples},
+          {"windows", done_.size()},
+          {"summary", summary},
+          {"per_window", windows},
+          {"speed_histogram", speeds},
+          {"density_profile", {{"axis", std::string(1, opt_.axis)}, {"edges", pedges}, {"density", pdens}, {"error", perrs}}},
+          {"walls", walls}};
+}
+
+}  // namespace turtlegas::formats
