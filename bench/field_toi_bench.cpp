@@ -46,7 +46,7 @@ Case rotating_pair(Rng& rng, int n) {
   for (int k = 0; k < n; ++k) {
     const double w = random_w(rng), speed = rng.log_uniform(1e-3, 1e3), rho = speed / std::abs(w);
     const double sigma = rho * rng.log_uniform(1e-2, 1e2);
-    const Vec2 dv = speed * rng.direction(), r0 = (sigma * 1.000001 + rho * rng.uniform(0, 2.5)) * rng.direction();
+    const Vec2 dv = speed * rng.direction(), r0 = rng.direction_then([&] { return (sigma * 1.000001 + rho * rng.uniform(0, 2.5)); });
     const double H = 1.5 * gyration_period(w);
     c.calls.push_back([=] { return toi_field_disc_disc_rotating(r0, dv, w, sigma, H); });
   }
@@ -61,12 +61,12 @@ Case general_pair(Rng& rng, int n, bool with_turtle) {
     const double qm2 = rng.sign() * rng.log_uniform(1e-6, 1e6);
     const double wmax = std::max(std::abs(qm1 * bz), std::abs(qm2 * bz));
     const double tau = rng.log_uniform(0.3, 3) / wmax, speed = 1.0 / tau;
-    const Vec2 e = (k % 2 ? rng.uniform(0, 2) * speed * std::abs(bz) : 0.0) * rng.direction();
-    const FieldFlight f1 = with_turtle ? FieldFlight{rng.uniform(0, 2) * speed * rng.direction(), {}, 0.0}
-                                       : FieldFlight{rng.uniform(0, 2) * speed * rng.direction(), qm1 * e, qm1 * bz};
-    const FieldFlight f2{rng.uniform(0, 2) * speed * rng.direction(), qm2 * e, qm2 * bz};
+    const Vec2 e = rng.direction_then([&] { return (k % 2 ? rng.uniform(0, 2) * speed * std::abs(bz) : 0.0); });
+    const FieldFlight f1 = with_turtle ? FieldFlight{rng.direction_then([&] { return rng.uniform(0, 2) * speed; }), {}, 0.0}
+                                       : FieldFlight{rng.direction_then([&] { return rng.uniform(0, 2) * speed; }), qm1 * e, qm1 * bz};
+    const FieldFlight f2{rng.direction_then([&] { return rng.uniform(0, 2) * speed; }), qm2 * e, qm2 * bz};
     const double sigma = rng.uniform(0.2, 1.5);
-    const Vec2 r0 = (sigma * 1.000001 + rng.uniform(0.01, 1.5)) * rng.direction();
+    const Vec2 r0 = rng.direction_then([&] { return (sigma * 1.000001 + rng.uniform(0.01, 1.5)); });
     const double H = tau * rng.uniform(1, 8);
     c.calls.push_back([=] { return toi_field_disc_disc(r0, f1, f2, sigma, H); });
   }
@@ -81,15 +81,16 @@ Case wall(Rng& rng, int n, int kind) {
   for (int k = 0; k < n; ++k) {
     const double w = random_w(rng), tau = rng.log_uniform(0.3, 3) / std::abs(w), speed = 1.0 / tau;
     const Vec2 from{rng.uniform(-2, 2), rng.uniform(-2, 2)};
-    const Segment s = make_segment(from, from + rng.uniform(0.5, 4) * rng.direction());
-    Vec2 a = rng.uniform(0, 2) * speed * std::abs(w) * rng.direction();
+    const Segment s = make_segment(from, from + rng.direction_then([&] { return rng.uniform(0.5, 4); }));
+    Vec2 a = rng.direction_then([&] { return rng.uniform(0, 2) * speed * std::abs(w); });
     if (kind == 1) a = rng.uniform(-2, 2) * speed * std::abs(w) * s.n;
     if (kind == 2) a = {};
-    const FieldFlight f{rng.uniform(0.2, 2) * speed * rng.direction(), a, w};
+    const FieldFlight f{rng.direction_then([&] { return rng.uniform(0.2, 2) * speed; }), a, w};
     const double radius = rng.uniform(0.05, 0.8);
     Vec2 rel;
     for (;;) {
-      rel = (s.len * rng.uniform(-0.5, 1.5)) * s.u + rng.uniform(-2, 2) * s.n;
+      const double across = rng.uniform(-2, 2), along = rng.uniform(-0.5, 1.5);  // this order: see Rng
+      rel = (s.len * along) * s.u + across * s.n;
       const double foot = std::clamp(dot(rel, s.u), 0.0, s.len);
       if (norm(rel - foot * s.u) > radius * 1.000001) break;
     }
@@ -103,10 +104,10 @@ Case point(Rng& rng, int n, bool drift) {
   Case c{drift ? "disc-point, with drift (bracketed)" : "disc-point, no drift (closed form)", {}};
   for (int k = 0; k < n; ++k) {
     const double w = random_w(rng), tau = rng.log_uniform(0.3, 3) / std::abs(w), speed = 1.0 / tau;
-    const Vec2 a = (drift ? rng.uniform(0.05, 2) * speed * std::abs(w) : 0.0) * rng.direction();
-    const FieldFlight f{rng.uniform(0.2, 2) * speed * rng.direction(), a, w};
+    const Vec2 a = rng.direction_then([&] { return (drift ? rng.uniform(0.05, 2) * speed * std::abs(w) : 0.0); });
+    const FieldFlight f{rng.direction_then([&] { return rng.uniform(0.2, 2) * speed; }), a, w};
     const double radius = rng.uniform(0.1, 1);
-    const Vec2 rel = (radius * 1.000001 + rng.uniform(0, 3)) * rng.direction();
+    const Vec2 rel = rng.direction_then([&] { return (radius * 1.000001 + rng.uniform(0, 3)); });
     const double H = tau * rng.uniform(2, 12);
     c.calls.push_back([=] { return toi_field_disc_point(rel, f, radius, H); });
   }
@@ -118,9 +119,9 @@ Case cell_exit(Rng& rng, int n, bool drift) {
   for (int k = 0; k < n; ++k) {
     const double w = random_w(rng), tau = rng.log_uniform(0.3, 3) / std::abs(w), speed = 1.0 / tau;
     const int axis = k % 2;
-    Vec2 a = rng.uniform(0.05, 2) * speed * std::abs(w) * rng.direction();
+    Vec2 a = rng.direction_then([&] { return rng.uniform(0.05, 2) * speed * std::abs(w); });
     if (!drift) (axis == 0 ? a.y : a.x) = 0.0;
-    const FieldFlight f{rng.uniform(0.2, 2) * speed * rng.direction(), a, w};
+    const FieldFlight f{rng.direction_then([&] { return rng.uniform(0.2, 2) * speed; }), a, w};
     const double x = rng.uniform(-1, 1), lo = x - rng.uniform(0.05, 2), hi = x + rng.uniform(0.05, 2);
     const double H = tau * rng.uniform(2, 12);
     c.calls.push_back([=] { return field_axis_exit(x, f, axis, lo, hi, H).t; });
@@ -133,8 +134,8 @@ Case today(Rng& rng, int n, int which) {
   const char* names[3] = {"toi_disc_disc (straight)", "toi_disc_segment (parabola)", "toi_disc_point_accel (quartic)"};
   Case c{names[which], {}};
   for (int k = 0; k < n; ++k) {
-    const Vec2 r0 = rng.uniform(1.2, 4) * rng.direction(), v = rng.uniform(0.2, 2) * rng.direction();
-    const Vec2 a = rng.uniform(0.1, 2) * rng.direction();
+    const Vec2 r0 = rng.direction_then([&] { return rng.uniform(1.2, 4); }), v = rng.direction_then([&] { return rng.uniform(0.2, 2); });
+    const Vec2 a = rng.direction_then([&] { return rng.uniform(0.1, 2); });
     const Segment s = make_segment({-2, -1}, {2, -1});
     if (which == 0) c.calls.push_back([=] { return toi_disc_disc(r0, v, 1.0); });
     if (which == 1) c.calls.push_back([=] { return toi_disc_segment(r0 - s.p1, v, a, s, 0.5); });

@@ -33,8 +33,8 @@ FieldFlight random_flight(field_oracle::Rng& rng, double* qm_out = nullptr) {
   f.w = qm * bz;
   f.v = speed * rng.direction();
   const int kind = static_cast<int>(rng.gen() % 4);
-  const Vec2 e = (kind >= 2 ? rng.uniform(0.0, 10.0) * std::abs(bz) * speed : 0.0) * rng.direction();
-  const Vec2 g = (kind % 2 == 1 ? rng.log_uniform(1e-3, 1e3) : 0.0) * rng.direction();
+  const Vec2 e = rng.direction_then([&] { return (kind >= 2 ? rng.uniform(0.0, 10.0) * std::abs(bz) * speed : 0.0); });
+  const Vec2 g = rng.direction_then([&] { return (kind % 2 == 1 ? rng.log_uniform(1e-3, 1e3) : 0.0); });
   f.a = g + qm * e;
   if (qm_out) *qm_out = qm;
   return f;
@@ -168,9 +168,9 @@ TEST_CASE("energy: kinetic plus -m g.x - q E.x is conserved along every flight",
     const double mass = rng.log_uniform(0.1, 10);
     const double qm = rng.sign() * rng.log_uniform(1e-6, 1e6);
     const double bz = rng.sign() * rng.log_uniform(1e-8, 1e6);
-    const Vec2 v0 = rng.log_uniform(1e-2, 1e2) * rng.direction();
-    const Vec2 e = rng.uniform(0, 3) * norm(v0) * std::abs(bz) * rng.direction();
-    const Vec2 g = rng.uniform(0, 10) * rng.direction();
+    const Vec2 v0 = rng.direction_then([&] { return rng.log_uniform(1e-2, 1e2); });
+    const Vec2 e = rng.direction_then([&] { return rng.uniform(0, 3) * norm(v0) * std::abs(bz); });
+    const Vec2 g = rng.direction_then([&] { return rng.uniform(0, 10); });
     const FieldFlight f{v0, g + qm * e, qm * bz};
     const Vec2 x0{rng.uniform(-10, 10), rng.uniform(-10, 10)};
     auto energy = [&](Vec2 x, Vec2 v) { return 0.5 * mass * norm2(v) + field_potential(x, mass, mass * qm, g, e); };
@@ -189,7 +189,7 @@ TEST_CASE("a moving frame sees the extra electric field u x B", "[field][flight]
   field_oracle::Rng rng(kSeed + 4);
   for (int k = 0; k < 1000; ++k) {
     const FieldFlight f = random_flight(rng);
-    const Vec2 u = rng.log_uniform(1e-3, 1e3) * rng.direction();
+    const Vec2 u = rng.direction_then([&] { return rng.log_uniform(1e-3, 1e3); });
     const double t = rng.uniform(0, 5) * std::min(gyration_period(f.w), 1e3);
     // Lab displacement minus the frame's equals the frame flight's displacement; velocities likewise.
     const Vec2 lab = field_displacement(f, t) - t * u;

@@ -12,7 +12,6 @@
 #include <functional>
 #include <vector>
 #include <algorithm>
-#include <numbers>
 #include <random>
 
 #include "field_oracle.hpp"
@@ -25,7 +24,6 @@ using L = long double;
 namespace {
 
 constexpr std::uint64_t kSeed = 20261215;
-constexpr double kPi = std::numbers::pi;
 
 using P2 = field_oracle::V2<L>;
 P2 ld_pos(Vec2 x0, const FieldFlight& f, L t) { return field_oracle::ld_state(x0, f, t).x; }
@@ -143,9 +141,9 @@ TEST_CASE("rotating pair: closed form against the oracle on random scenes", "[fi
     const double rho = speed / std::abs(w);
     const double sigma = rho * rng.log_uniform(1e-2, 1e2);
     const Vec2 dv = speed * rng.direction();
-    const Vec2 r0 = (sigma * (1 + 1e-6) + rho * rng.uniform(0, 2.5)) * rng.direction();
+    const Vec2 r0 = rng.direction_then([&] { return (sigma * (1 + 1e-6) + rho * rng.uniform(0, 2.5)); });
     // A common acceleration (E and g): it must cancel, and the oracle flies each ball with it.
-    const Vec2 a = rng.uniform(0, 3) * speed * std::abs(w) * rng.direction();
+    const Vec2 a = rng.direction_then([&] { return rng.uniform(0, 3) * speed * std::abs(w); });
     const FieldFlight f1{speed * rng.direction(), a, w}, f2{f1.v + dv, a, w};
     const double H = 1.5 * gyration_period(w);
     const double mine = toi_field_disc_disc_rotating(r0, f2.v - f1.v, w, sigma, H);
@@ -163,8 +161,8 @@ TEST_CASE("rotating pair: closed form against the oracle on random scenes", "[fi
 TEST_CASE("rotating pair: w = 0 is toi_disc_disc and a small w tends to it", "[field][toi][pair][continuity]") {
   Rng rng(kSeed + 1);
   for (int k = 0; k < 2000; ++k) {
-    const Vec2 r0 = rng.uniform(2.5, 10) * rng.direction();
-    const Vec2 dv = rng.uniform(0.1, 3) * rng.direction();
+    const Vec2 r0 = rng.direction_then([&] { return rng.uniform(2.5, 10); });
+    const Vec2 dv = rng.direction_then([&] { return rng.uniform(0.1, 3); });
     const double sigma = rng.uniform(0.5, 2);
     const double t0 = toi_disc_disc(r0, dv, sigma);
     INFO("seed " << kSeed + 1 << " case " << k);
@@ -307,14 +305,14 @@ PairScene random_pair(Rng& rng) {
   const double wmax = std::max(std::abs(qm1 * bz), std::abs(qm2 * bz));
   const double tau = rng.log_uniform(0.3, 3) / wmax;
   const double speed = 1.0 / tau;
-  const Vec2 e = (kind >= 3 ? rng.uniform(0, 2) * speed * std::abs(bz) : 0.0) * rng.direction();
-  const Vec2 g = (kind % 2 == 1 ? rng.uniform(0, 2) * speed / tau : 0.0) * rng.direction();
+  const Vec2 e = rng.direction_then([&] { return (kind >= 3 ? rng.uniform(0, 2) * speed * std::abs(bz) : 0.0); });
+  const Vec2 g = rng.direction_then([&] { return (kind % 2 == 1 ? rng.uniform(0, 2) * speed / tau : 0.0); });
   PairScene s;
-  s.f1 = turtle1 ? turtle(rng.uniform(0, 2) * speed * rng.direction())
-                 : FieldFlight{rng.uniform(0, 2) * speed * rng.direction(), g + qm1 * e, qm1 * bz};
-  s.f2 = {rng.uniform(0, 2) * speed * rng.direction(), g + qm2 * e, qm2 * bz};
+  s.f1 = turtle1 ? turtle(rng.direction_then([&] { return rng.uniform(0, 2) * speed; }))
+                 : FieldFlight{rng.direction_then([&] { return rng.uniform(0, 2) * speed; }), g + qm1 * e, qm1 * bz};
+  s.f2 = {rng.direction_then([&] { return rng.uniform(0, 2) * speed; }), g + qm2 * e, qm2 * bz};
   s.sigma = rng.uniform(0.2, 1.5);
-  s.r0 = (s.sigma * (1 + 1e-6) + rng.uniform(0.01, 1.5)) * rng.direction();
+  s.r0 = rng.direction_then([&] { return (s.sigma * (1 + 1e-6) + rng.uniform(0.01, 1.5)); });
   s.H = tau * rng.uniform(1, 8);
   s.len = s.sigma + norm(s.r0);
   return s;
@@ -345,8 +343,8 @@ TEST_CASE("general pair: the bracketed search agrees with the closed forms where
     const double speed = rng.log_uniform(1e-2, 1e2), rho = speed / std::abs(w);
     const double sigma = rho * rng.log_uniform(0.05, 20);
     const Vec2 dv = speed * rng.direction();
-    const Vec2 r0 = (sigma * (1 + 1e-6) + rho * rng.uniform(0, 2.5)) * rng.direction();
-    const Vec2 a = rng.uniform(0, 2) * speed * std::abs(w) * rng.direction();
+    const Vec2 r0 = rng.direction_then([&] { return (sigma * (1 + 1e-6) + rho * rng.uniform(0, 2.5)); });
+    const Vec2 a = rng.direction_then([&] { return rng.uniform(0, 2) * speed * std::abs(w); });
     const FieldFlight f1{speed * rng.direction(), a, w}, f2{f1.v + dv, a, w};
     const double H = 1.2 * gyration_period(w);
     const double closed = toi_field_disc_disc_rotating(r0, dv, w, sigma, H);
@@ -374,9 +372,9 @@ TEST_CASE("general pair: a small w tends to the relative parabola of toi_disc_po
   Rng rng(kSeed + 4);
   int compared = 0;
   for (int k = 0; k < 3000; ++k) {
-    const Vec2 r0 = rng.uniform(2.5, 6) * rng.direction();
-    const FieldFlight f1 = turtle(rng.uniform(0, 1) * rng.direction());
-    const Vec2 v2 = rng.uniform(0.1, 2) * rng.direction(), a2 = rng.uniform(0.1, 2) * rng.direction();
+    const Vec2 r0 = rng.direction_then([&] { return rng.uniform(2.5, 6); });
+    const FieldFlight f1 = turtle(rng.direction_then([&] { return rng.uniform(0, 1); }));
+    const Vec2 v2 = rng.direction_then([&] { return rng.uniform(0.1, 2); }), a2 = rng.direction_then([&] { return rng.uniform(0.1, 2); });
     const double sigma = rng.uniform(0.5, 2);
     const double H = 20;
     const double t0 = toi_disc_point_accel(r0, v2 - f1.v, a2, sigma, H);
@@ -404,7 +402,7 @@ TEST_CASE("under B two discs that have just collided can meet again: skipping th
     const double w1 = rng.uniform(0.5, 2), w2 = equal ? w1 : rng.uniform(0.5, 2);
     FieldFlight f1{rng.direction(), {}, w1}, f2{rng.direction(), {}, w2};
     const double sigma = 1.0;
-    const Vec2 r0 = rng.uniform(1.2, 2.5) * rng.direction();
+    const Vec2 r0 = rng.direction_then([&] { return rng.uniform(1.2, 2.5); });
     const double H = 3 * gyration_period(std::min(w1, w2));
     const double t1 = toi_field_disc_disc(r0, f1, f2, sigma, H);
     if (t1 == kNever) continue;
@@ -447,18 +445,19 @@ WallScene random_wall(Rng& rng, int kind) {
   const double qm = random_qm(rng), bz = random_bz(rng), w = qm * bz;
   const double tau = rng.log_uniform(0.3, 3) / std::abs(w);
   const double speed = 1.0 / tau;
-  const Vec2 a0 = rng.uniform(0, 2) * speed * std::abs(w) * rng.direction();
+  const Vec2 a0 = rng.direction_then([&] { return rng.uniform(0, 2) * speed * std::abs(w); });
   const Vec2 from = Vec2{rng.uniform(-2, 2), rng.uniform(-2, 2)};
-  const Vec2 to = from + rng.uniform(0.5, 4) * rng.direction();
+  const Vec2 to = from + rng.direction_then([&] { return rng.uniform(0.5, 4); });
   sc.s = make_segment(from, to);
   Vec2 a = a0;
   if (kind == 1) a = rng.uniform(-2, 2) * speed * std::abs(w) * sc.s.n;
   if (kind == 2) a = {};
-  sc.f = {rng.uniform(0.2, 2) * speed * rng.direction(), a, w};
+  sc.f = {rng.direction_then([&] { return rng.uniform(0.2, 2) * speed; }), a, w};
   sc.radius = rng.uniform(0.05, 0.8);
   for (;;) {
     // Near the segment: beside it, off its ends, on either face.
-    sc.x0 = sc.s.p1 + (sc.s.len * rng.uniform(-0.5, 1.5)) * sc.s.u + rng.uniform(-2, 2) * sc.s.n;
+    const double across = rng.uniform(-2, 2), along = rng.uniform(-0.5, 1.5);  // this order: see Rng
+    sc.x0 = sc.s.p1 + (sc.s.len * along) * sc.s.u + across * sc.s.n;
     const Vec2 rel = sc.x0 - sc.s.p1;
     const double foot = std::clamp(dot(rel, sc.s.u), 0.0, sc.s.len);
     if (norm(rel - foot * sc.s.u) > sc.radius * (1 + 1e-6)) break;
@@ -538,8 +537,8 @@ TEST_CASE("disc and wall: a small w tends to toi_disc_segment", "[field][toi][wa
     const Segment s = make_segment({0, 0}, {10, 0});
     const Vec2 rel{rng.uniform(-3, 13), rng.uniform(-4, 4)};
     if (std::abs(rel.y) < 0.6) continue;
-    const Vec2 v = rng.uniform(0.5, 4) * rng.direction();
-    const Vec2 a = (k % 3 == 0 ? 0.0 : rng.uniform(0.5, 10)) * rng.direction();
+    const Vec2 v = rng.direction_then([&] { return rng.uniform(0.5, 4); });
+    const Vec2 a = rng.direction_then([&] { return (k % 3 == 0 ? 0.0 : rng.uniform(0.5, 10)); });
     const double t0 = toi_disc_segment(rel, v, a, s, 0.5);
     INFO("seed " << kSeed + 7 << " case " << k);
     REQUIRE(toi_field_disc_segment(rel, {v, a, 0.0}, s, 0.5, kNever) == t0);
@@ -550,6 +549,11 @@ TEST_CASE("disc and wall: a small w tends to toi_disc_segment", "[field][toi][wa
     ++compared;
     for (int e = 4; e <= 28; e += 4) {
       const double w = (k % 2 ? 1 : -1) * std::pow(10.0, -e);
+      // The turning moves the contact along the wall by up to |w| |v| t0^2 / 2 (plus the same of
+      // a): a contact that close to an end may move onto the end, which this function leaves to
+      // the end's own test. (clang's scenes have one at w = 1e-4, 3.7e-3 from the end.)
+      const double drift = std::abs(w) * (norm(v) + norm(a) * t0) * t0 * t0;
+      if (foot < 1e-3 + drift || foot > s.len - 1e-3 - drift) continue;
       const double t = toi_field_disc_segment(rel, {v, a, w}, s, 0.5, 40);
       REQUIRE(std::abs(t - t0) <= 1e-10 * t0 + 1e3 * std::abs(w) * t0 * t0);
     }
@@ -566,10 +570,10 @@ TEST_CASE("disc and wall end: closed form and bracketed against the oracle", "[f
     const double w = random_qm(rng) * random_bz(rng);
     const double tau = rng.log_uniform(0.3, 3) / std::abs(w);
     const double speed = 1.0 / tau;
-    const Vec2 a = (k % 3 == 0 ? 0.0 : rng.uniform(0, 2) * speed * std::abs(w)) * rng.direction();
-    const FieldFlight f{rng.uniform(0.2, 2) * speed * rng.direction(), a, w};
+    const Vec2 a = rng.direction_then([&] { return (k % 3 == 0 ? 0.0 : rng.uniform(0, 2) * speed * std::abs(w)); });
+    const FieldFlight f{rng.direction_then([&] { return rng.uniform(0.2, 2) * speed; }), a, w};
     const double radius = rng.uniform(0.1, 1);
-    const Vec2 rel = (radius * (1 + 1e-6) + rng.uniform(0, 3)) * rng.direction();
+    const Vec2 rel = rng.direction_then([&] { return (radius * (1 + 1e-6) + rng.uniform(0, 3)); });
     const double H = tau * rng.uniform(2, 12);
     const double mine = toi_field_disc_point(rel, f, radius, H);
     auto gap = [&](L t) { return ld_norm(ld_pos(rel, f, t)) - radius; };
@@ -585,8 +589,8 @@ TEST_CASE("disc and wall end: a small w tends to toi_disc_point_accel", "[field]
   Rng rng(kSeed + 9);
   int compared = 0;
   for (int k = 0; k < 3000; ++k) {
-    const Vec2 rel = rng.uniform(1.5, 6) * rng.direction();
-    const Vec2 v = rng.uniform(0.3, 3) * rng.direction(), a = rng.uniform(0.1, 3) * rng.direction();
+    const Vec2 rel = rng.direction_then([&] { return rng.uniform(1.5, 6); });
+    const Vec2 v = rng.direction_then([&] { return rng.uniform(0.3, 3); }), a = rng.direction_then([&] { return rng.uniform(0.1, 3); });
     const double t0 = toi_disc_point_accel(rel, v, a, 1.0, 20);
     if (t0 == kNever || t0 > 15) continue;
     // Away from grazes: the approach speed at contact is a fair share of the speed.
@@ -607,9 +611,9 @@ TEST_CASE("a wall end translating under B: its frame's E' = E + u x B gives the 
   Rng rng(kSeed + 10);
   int compared = 0;
   for (int k = 0; k < 2000; ++k) {
-    const FieldFlight f{rng.uniform(0.2, 2) * rng.direction(), rng.uniform(0, 1) * rng.direction(), rng.sign() * rng.uniform(0.3, 3)};
-    const Vec2 u = rng.uniform(0.1, 2) * rng.direction();
-    const Vec2 rel = rng.uniform(1.2, 4) * rng.direction();
+    const FieldFlight f{rng.direction_then([&] { return rng.uniform(0.2, 2); }), rng.direction_then([&] { return rng.uniform(0, 1); }), rng.sign() * rng.uniform(0.3, 3)};
+    const Vec2 u = rng.direction_then([&] { return rng.uniform(0.1, 2); });
+    const Vec2 rel = rng.direction_then([&] { return rng.uniform(1.2, 4); });
     // The lab: the end is a body moving straight at u; its frame: a fixed point and the field E'.
     const double lab = toi_field_disc_disc_bracketed(rel, turtle(u), f, 1.0, 10);
     const double frame = toi_field_disc_point(rel, in_moving_frame(f, u), 1.0, 10);
@@ -635,9 +639,9 @@ TEST_CASE("cell exits against the oracle, and a small w tends to axis_exit", "[f
     const double tau = rng.log_uniform(0.3, 3) / std::abs(w);
     const double speed = 1.0 / tau;
     const int axis = k % 2;
-    Vec2 a = rng.uniform(0, 2) * speed * std::abs(w) * rng.direction();
+    Vec2 a = rng.direction_then([&] { return rng.uniform(0, 2) * speed * std::abs(w); });
     if (k % 5 == 0) (axis == 0 ? a.y : a.x) = 0.0;  // no drift along the axis: the closed form
-    const FieldFlight f{rng.uniform(0.2, 2) * speed * rng.direction(), a, w};
+    const FieldFlight f{rng.direction_then([&] { return rng.uniform(0.2, 2) * speed; }), a, w};
     const double x = rng.uniform(-1, 1), lo = x - rng.uniform(0.05, 2), hi = x + rng.uniform(0.05, 2);
     const double H = tau * rng.uniform(2, 12);
     const AxisExit mine = field_axis_exit(x, f, axis, lo, hi, H);
@@ -659,7 +663,7 @@ TEST_CASE("cell exits against the oracle, and a small w tends to axis_exit", "[f
   CHECK(sides_right >= tally.agree - 2);
   // Continuity.
   for (int k = 0; k < 500; ++k) {
-    const FieldFlight f{rng.uniform(0.2, 2) * rng.direction(), rng.uniform(0, 2) * rng.direction(), 0.0};
+    const FieldFlight f{rng.direction_then([&] { return rng.uniform(0.2, 2); }), rng.direction_then([&] { return rng.uniform(0, 2); }), 0.0};
     const AxisExit e0 = axis_exit(0.3, f.v.x, f.a.x, -1, 2);
     for (int e = 4; e <= 24; e += 4) {
       const AxisExit e1 = field_axis_exit(0.3, {f.v, f.a, std::pow(10.0, -e)}, 0, -1, 2, 100);
@@ -737,9 +741,9 @@ TEST_CASE("shallow contacts: 1e-9 of the distance deep is a contact, 1e-9 short 
   SECTION("equal pairs, closed form and bracketed") {
     for (int k = 0; k < 400; ++k) {
       const double w = random_qm(rng) * random_bz(rng), speed = rng.log_uniform(1e-2, 1e2), rho = speed / std::abs(w);
-      const Vec2 a = rng.uniform(0, 2) * speed * std::abs(w) * rng.direction();
+      const Vec2 a = rng.direction_then([&] { return rng.uniform(0, 2) * speed * std::abs(w); });
       const FieldFlight f1{speed * rng.direction(), a, w}, f2{speed * rng.direction(), a, w};
-      const Vec2 r0 = rho * rng.uniform(0.5, 3) * rng.direction();
+      const Vec2 r0 = rng.direction_then([&] { return rho * rng.uniform(0.5, 3); });
       const double H = 0.9 * gyration_period(w);
       auto dist = [&](L t) { return ld_norm(ld_pos(r0, f2, t) - ld_pos({}, f1, t)); };
       INFO("seed " << kSeed + 13 << " case " << k);
@@ -751,9 +755,9 @@ TEST_CASE("shallow contacts: 1e-9 of the distance deep is a contact, 1e-9 short 
   SECTION("wall ends, with and without drift") {
     for (int k = 0; k < 400; ++k) {
       const double w = random_qm(rng) * random_bz(rng), tau = rng.log_uniform(0.3, 3) / std::abs(w);
-      const Vec2 a = (k % 2 ? rng.uniform(0, 2) / tau * std::abs(w) : 0.0) * rng.direction();
-      const FieldFlight f{rng.uniform(0.2, 2) / tau * rng.direction(), a, w};
-      const Vec2 rel = rng.uniform(0.1, 3) * rng.direction();
+      const Vec2 a = rng.direction_then([&] { return (k % 2 ? rng.uniform(0, 2) / tau * std::abs(w) : 0.0); });
+      const FieldFlight f{rng.direction_then([&] { return rng.uniform(0.2, 2) / tau; }), a, w};
+      const Vec2 rel = rng.direction_then([&] { return rng.uniform(0.1, 3); });
       const double H = tau * rng.uniform(1, 6);
       auto dist = [&](L t) { return ld_norm(ld_pos(rel, f, t)); };
       INFO("seed " << kSeed + 13 << " case " << k);
@@ -765,10 +769,10 @@ TEST_CASE("shallow contacts: 1e-9 of the distance deep is a contact, 1e-9 short 
     for (int k = 0; k < 600; ++k) {
       const double w = random_qm(rng) * random_bz(rng), tau = rng.log_uniform(0.3, 3) / std::abs(w);
       const Segment s = make_segment(Vec2{-1e6, 0}, Vec2{1e6, 0});  // the foot is always on it
-      Vec2 a = rng.uniform(0, 2) / tau * std::abs(w) * rng.direction();
+      Vec2 a = rng.direction_then([&] { return rng.uniform(0, 2) / tau * std::abs(w); });
       if (k % 3 == 1) a = {a.x, 0.0};  // along the wall: closed form
       if (k % 3 == 2) a = {};
-      const FieldFlight f{rng.uniform(0.2, 2) / tau * rng.direction(), a, w};
+      const FieldFlight f{rng.direction_then([&] { return rng.uniform(0.2, 2) / tau; }), a, w};
       const Vec2 rel{0.0, rng.sign() * rng.uniform(0.1, 3)};
       const double H = tau * rng.uniform(1, 6);
       auto dist = [&](L t) { return std::fabs(ld_pos(rel, f, t).y); };
@@ -848,11 +852,11 @@ TEST_CASE("no NaN and no negative time over the issue's whole field range", "[fi
   for (int k = 0; k < 20000; ++k) {
     const double qm = random_qm(rng), bz = random_bz(rng), w = qm * bz;
     const double speed = rng.log_uniform(1e-9, 1e8);
-    const Vec2 e = rng.log_uniform(1e-6, 1e6) * rng.direction();
+    const Vec2 e = rng.direction_then([&] { return rng.log_uniform(1e-6, 1e6); });
     const FieldFlight f{speed * rng.direction(), Vec2{0, -9.81} + qm * e, w};
     const double radius = rng.log_uniform(1e-3, 10);
-    const Vec2 rel = (radius * rng.uniform(1.001, 5)) * rng.direction();
-    const Segment s = make_segment({-1, -1}, Vec2{-1, -1} + rng.uniform(0.1, 10) * rng.direction());
+    const Vec2 rel = rng.direction_then([&] { return (radius * rng.uniform(1.001, 5)); });
+    const Segment s = make_segment({-1, -1}, Vec2{-1, -1} + rng.direction_then([&] { return rng.uniform(0.1, 10); }));
     const double H = rng.log_uniform(1e-6, 1e3);
     INFO("seed " << kSeed + 12 << " case " << k << " w " << w << " speed " << speed);
     const double t1 = toi_field_disc_point(rel, f, radius, H);
