@@ -31,6 +31,12 @@ struct Rng {
     const double phi = uniform(0.0, 6.283185307179586);
     return {std::cos(phi), std::sin(phi)};
   }
+  /// magnitude() * direction(), the direction drawn first (tests/sim/field_oracle.hpp says why).
+  template <class Magnitude>
+  Vec2 direction_then(Magnitude magnitude) {
+    const Vec2 d = direction();
+    return magnitude() * d;
+  }
 };
 
 double random_w(Rng& rng) { return rng.sign() * rng.log_uniform(1e-6, 1e6) * rng.log_uniform(1e-8, 1e6); }

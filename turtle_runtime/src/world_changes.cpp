@@ -110,7 +110,7 @@ std::size_t WorldServer::spawn_ball(const sim::BallDef& ball) {
     refuse(s, "ball '" + ball.id + "'", e);
   }
   s.def.balls.push_back(ball);
-  s.emit({s.world.time(), "spawn", ball.id, "ball", {}, 0.0, {}, {}});
+  s.emit({s.world.time(), "spawn", ball.id, "ball", {}, 0.0, {}, {}, {}});
   return i;
 }
 
@@ -145,7 +145,7 @@ std::size_t WorldServer::spawn_turtle(const sim::TurtleDef& turtle, TurtleProgra
     throw;
   }
   s.agents.push_back(std::move(agent));
-  s.emit({s.world.time(), "spawn", turtle.id, "turtle", {}, 0.0, {}, {}});
+  s.emit({s.world.time(), "spawn", turtle.id, "turtle", {}, 0.0, {}, {}, {}});
   return k;
 }
 
@@ -172,7 +172,7 @@ void WorldServer::remove_body(const std::string& id) {
     a.in_contact.clear();
     s.world.remove_turtle(k);
   }
-  s.emit({s.world.time(), "remove", id, *ball ? "ball" : "turtle", {}, 0.0, {}, {}});
+  s.emit({s.world.time(), "remove", id, *ball ? "ball" : "turtle", {}, 0.0, {}, {}, {}});
 }
 
 void WorldServer::teleport_ball(const std::string& id, sim::Vec2 pos, sim::Vec2 vel) {
@@ -193,7 +193,7 @@ void WorldServer::teleport_ball(const std::string& id, sim::Vec2 pos, sim::Vec2 
   } catch (const sim::PlacementError& e) {
     refuse(s, "ball '" + id + "'", e);
   }
-  s.emit({s.world.time(), "teleport", id, "ball", {}, 0.0, {}, {}});
+  s.emit({s.world.time(), "teleport", id, "ball", {}, 0.0, {}, {}, {}});
 }
 
 void WorldServer::teleport_turtle(const std::string& id, sim::Vec2 pos, double heading_deg) {
@@ -217,7 +217,7 @@ void WorldServer::teleport_turtle(const std::string& id, sim::Vec2 pos, double h
   }
   Agent& a = *s.agents[k];
   a.in_contact.clear();  // what it touched is where it was
-  s.emit({s.world.time(), "teleport", id, "turtle", {}, 0.0, {}, {}});
+  s.emit({s.world.time(), "teleport", id, "turtle", {}, 0.0, {}, {}, {}});
 }
 
 }  // namespace turtlegas::turtle
