@@ -11,7 +11,10 @@ packages=(
   dpkg-dev binutils   # the Debian package: cpack (dpkg-shlibdeps), tests/package/deb_test.py (readelf)
   clang libclang-rt-14-dev clang-tidy   # the clang and fuzz presets, scripts/tidy.sh
   libopenmpi-dev openmpi-bin   # turtlegas sweep under mpirun (optional at build time; its test runs mpirun)
+  libcairo2-dev   # turtlegas render: PNG pictures and frames
 )
+# Optional: `turtlegas render --video` runs ffmpeg when it is installed (its test is skipped when
+# not). Install it with: apt-get install ffmpeg
 
 missing=()
 for p in "${packages[@]}"; do

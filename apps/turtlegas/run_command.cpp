@@ -29,6 +29,7 @@
 #include "turtlegas/formats/event_log.hpp"
 #include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/names.hpp"
+#include "turtlegas/formats/recording.hpp"
 #include "turtlegas/formats/state_file.hpp"
 #include "turtlegas/formats/stats_file.hpp"
 #include "turtlegas/formats/svg_snapshot.hpp"
@@ -119,20 +120,24 @@ struct Limits {
   std::optional<double> max_wall_seconds;
   std::optional<std::uint64_t> max_events;
   std::optional<double> checkpoint_every;
+  std::optional<double> keyframe_every;  ///< a recording's keyframes: cuts at its multiples
 };
 
 /// Runs chunks until `limits.until` or a stop. `advance(t)` runs to t and returns the engine's
 /// event count; `flush()` writes what the chunk logged; `checkpoint(t, why)` is called at every
-/// multiple of checkpoint_every.
-template <class Advance, class Flush, class AtCheckpoint>
+/// multiple of checkpoint_every; `cut(t, events, at_key)` after every chunk (a recording's
+/// keyframes; the chunks are also cut at every multiple of keyframe_every, and at_key says this is one).
+template <class Advance, class Flush, class AtCheckpoint, class AtCut>
 std::pair<Stop, int> run_in_chunks(double from, const Limits& limits, Pace& pace, Clock::time_point start,
                                    Progress& progress, const char* doing, Advance&& advance, Flush&& flush,
-                                   AtCheckpoint&& checkpoint) {
+                                   AtCheckpoint&& checkpoint, AtCut&& cut) {
   double t = from;
   std::uint64_t events = 0;
   double events_per_second = 0.0;  // simulated, measured over the last chunk
   const double every = limits.checkpoint_every.value_or(0.0);
   double next_checkpoint = every > 0.0 ? (std::floor(t / every) + 1.0) * every : INFINITY;
+  const double key_every = limits.keyframe_every.value_or(0.0);
+  double next_key = key_every > 0.0 ? (std::floor(t / key_every) + 1.0) * key_every : INFINITY;
   while (t < limits.until) {
     if (const int sig = stop_signal()) return {Stop::signal, sig};
     if (limits.max_wall_seconds && seconds_since(start) >= *limits.max_wall_seconds) return {Stop::max_wall_seconds, 0};
@@ -141,7 +146,7 @@ std::pair<Stop, int> run_in_chunks(double from, const Limits& limits, Pace& pace
     // Near --max-events, a chunk of about what is left.
     if (limits.max_events && events_per_second > 0.0)
       chunk = std::min(chunk, std::max(static_cast<double>(*limits.max_events - events) / events_per_second, chunk / 1024));
-    double next = std::min({limits.until, t + chunk, next_checkpoint});
+    double next = std::min({limits.until, t + chunk, next_checkpoint, next_key});
     if (!(next > t)) next = std::nextafter(t, INFINITY);  // a chunk below one ulp of t
     const auto chunk_start = Clock::now();
     const std::uint64_t before = events;
@@ -153,6 +158,9 @@ std::pair<Stop, int> run_in_chunks(double from, const Limits& limits, Pace& pace
     if ((took > 0.25 || done > 0x1p20) && pace.chunk / 2.0 > 0.0) pace.chunk /= 2.0;
     else if (took < 0.05 && done < 0x1p18 && pace.chunk * 2.0 < INFINITY) pace.chunk *= 2.0;
     t = next;
+    const bool at_key = t >= next_key;
+    if (at_key) next_key = (std::floor(t / key_every) + 1.0) * key_every;
+    cut(t, events, at_key);
     note_run_time(t);
     if (t >= next_checkpoint) {
       checkpoint(t, "every " + fmt(every) + " s");
@@ -279,6 +287,14 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
       run->add_option("--checkpoint-every", line.checkpoint_every, "Simulated seconds between checkpoints")
           ->check(real_in(0, big, "seconds", true));
   run->add_option("--resume", opt.resume, "Continue the run a checkpoint was written for (replays it to there)");
+  run->add_option("--record", opt.record,
+                  "Write a recording here (docs/recording.md; play it with `turtlegas replay`, draw it with `render`)");
+  run->add_option("--keyframe-seconds", opt.keyframe_seconds, "A recording's keyframe every this many simulated seconds (0: none)")
+      ->capture_default_str()
+      ->check(real_in(0, big, "seconds"));
+  run->add_option("--keyframe-events", opt.keyframe_events, "A recording's keyframe after this many engine events (0: none)")
+      ->capture_default_str()
+      ->check(integer_in(0, std::numeric_limits<std::int64_t>::max(), "events"));
   return run;
 }
 
@@ -295,7 +311,8 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   std::vector<NamedPath> inputs{{opt.world, "the world file"}};
   for (const std::string& p : opt.plugins) inputs.push_back({p, "--plugin"});
   std::vector<NamedPath> outputs{{opt.events, "--events"}, {opt.state_out, "--state-out"},
-                                 {opt.stats_json, "--stats-json"}, {opt.svg, "--svg"}, {opt.checkpoint, "--checkpoint"}};
+                                 {opt.stats_json, "--stats-json"}, {opt.svg, "--svg"}, {opt.record, "--record"},
+                                 {opt.checkpoint, "--checkpoint"}};  // the checkpoint last: see below
   if (opt.stats) outputs.push_back({"-", "--stats"});
   if (!opt.resume.empty()) {
     std::vector<NamedPath> others(outputs.begin(), outputs.end() - (opt.stats ? 2 : 1));
@@ -303,12 +320,22 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   }
   check_outputs(outputs, inputs);
   if (opt.checkpoint == "-") throw BadInput("--checkpoint needs a file name, not standard output");
+  if (!opt.record.empty()) {
+    if (opt.record == "-") throw BadInput("--record needs a file name, not standard output (replay seeks in it)");
+    if (!opt.resume.empty())
+      throw BadInput("--record with --resume: a recording starts at t = 0; record the run from the start instead");
+    if (!opt.inputs.empty())
+      throw BadInput("--record with --inputs: a recording does not carry the input log yet; record the live run with "
+                     "`turtlegas serve --record` instead, or drop --inputs");
+  }
   std::optional<OutputFile> events_file, state_file, stats_file, svg_file;
   if (!opt.events.empty()) events_file.emplace(opt.events, "--events");
   if (!opt.state_out.empty()) state_file.emplace(opt.state_out, "--state-out");
   if (!opt.stats_json.empty()) stats_file.emplace(opt.stats_json, "--stats-json");
   if (!opt.svg.empty()) svg_file.emplace(opt.svg, "--svg");
   if (!opt.checkpoint.empty()) OutputFile probe(opt.checkpoint, "--checkpoint");  // checks the path only
+  std::optional<OutputFile> record_file;
+  if (!opt.record.empty()) record_file.emplace(opt.record, "--record", OutputFile::Write::growing);
 
   world::Scene scene = load(opt.world, registry);
   sim::WorldDef& def = scene.def;
@@ -332,6 +359,19 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   limits.max_wall_seconds = opt.max_wall_seconds;
   limits.max_events = opt.max_events;
   limits.checkpoint_every = opt.checkpoint_every;
+  if (record_file && opt.keyframe_seconds > 0.0) limits.keyframe_every = opt.keyframe_seconds;
+  std::optional<formats::RecordingWriter> recorder;
+  if (record_file) {
+    formats::RecordingHeader h;
+    h.command = "run";
+    h.world_file = opt.world;
+    h.world = read_world_json(opt.world);
+    h.mode = sim::to_string(mode);
+    h.dt = def.dt;
+    h.until = opt.until;
+    h.keyframes = {opt.keyframe_seconds, opt.keyframe_events};
+    recorder.emplace(record_file->stream(), h);
+  }
   // Exactly one of these runs the scene: the bare engine, or the world server when there are
   // turtles (which then owns the engine).
   std::optional<sim::World> bare;
@@ -378,6 +418,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
         writer->write(bare_events, names);
         events_file->flush();
       }
+      if (write && recorder) recorder->events(bare_events, names);
       bare_events.clear();
     };
   } else {
@@ -407,6 +448,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
         writer->write(server_events);
         events_file->flush();
       }
+      if (write && recorder) recorder->events(server_events);
       server_events.clear();
     };
   }
@@ -444,7 +486,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     to_checkpoint.until = resume->t;
     to_checkpoint.checkpoint_every.reset();
     end = run_in_chunks(world.time(), to_checkpoint, pace, start, progress, "replaying: ", advance,
-                        [&] { flush(false); }, [](double, const std::string&) {});
+                        [&] { flush(false); }, [](double, const std::string&) {}, [](double, std::uint64_t, bool) {});
     if (end.first == Stop::until) {
       const bool same = world.time() == resume->t && world.stats().events == resume->events &&
                         state_hash(world, names) == resume->state_hash;
@@ -454,10 +496,14 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
                                  "deterministic, or a different turtlegas?); rerun from the start");
     }
   }
+  if (recorder) recorder->keyframe(world, names);  // the first, at the start
   if (end.first == Stop::until) {
     limits.until = opt.until;
     end = run_in_chunks(world.time(), limits, pace, start, progress, "", advance, [&] { flush(true); },
-                        [&](double t, const std::string& why) { write_checkpoint_at(t, why); });
+                        [&](double t, const std::string& why) { write_checkpoint_at(t, why); },
+                        [&](double, std::uint64_t events, bool at_key) {
+                          if (recorder && (at_key || recorder->keyframe_due(events))) recorder->keyframe(world, names);
+                        });
   }
   progress.clear();
   if (server) {
@@ -491,6 +537,11 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   run.max_overlap_relative = std::max(now.relative, seen.relative);
 
   if (events_file) events_file->commit();
+  if (recorder) {
+    recorder->keyframe(world, names);  // the last, at the end (none when one is there already)
+    recorder->finish(world.time(), stopped);
+    record_file->commit();
+  }
   if (state_file) {
     formats::write_state(state_file->stream(), world, names);
     state_file->commit();
