@@ -10,6 +10,7 @@ install(TARGETS turtlegas EXPORT turtlegasTargets RUNTIME DESTINATION ${CMAKE_IN
 install(TARGETS turtlegas_controller_sdk EXPORT turtlegasTargets)
 # The controller API and what it includes; tests/package/install_test.py compiles each on its own.
 install(FILES turtle_runtime/include/turtlegas/turtle/turtle.hpp turtle_runtime/include/turtlegas/turtle/registry.hpp
+        turtle_runtime/include/turtlegas/turtle/view.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/turtlegas/turtle)
 install(FILES sim/include/turtlegas/sim/vec2.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/turtlegas/sim)
 

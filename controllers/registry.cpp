@@ -18,6 +18,8 @@ void tag_evader(turtle::Turtle&, const turtle::Params&);
 turtle::ControllerInfo tag_evader_info();
 void tag_random(turtle::Turtle&, const turtle::Params&);
 turtle::ControllerInfo tag_random_info();
+void tag_camera(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo tag_camera_info();
 
 turtle::Registry builtin_registry() {
   turtle::Registry r = turtle::base_registry();
@@ -28,6 +30,7 @@ turtle::Registry builtin_registry() {
   r.add("tag_chaser", tag_chaser, tag_chaser_info());
   r.add("tag_evader", tag_evader, tag_evader_info());
   r.add("tag_random", tag_random, tag_random_info());
+  r.add("tag_camera", tag_camera, tag_camera_info());
   return r;
 }
 

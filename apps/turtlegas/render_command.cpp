@@ -26,6 +26,7 @@
 #include "turtlegas/formats/svg_snapshot.hpp"
 #include "turtlegas/sim/angles.hpp"
 #include "turtlegas/turtle/game.hpp"
+#include "turtlegas/turtle/view.hpp"
 #include "turtlegas/world/file_error.hpp"
 #include "turtlegas/world/world_file.hpp"
 
@@ -134,7 +135,10 @@ cairo_status_t write_to_stream(void* closure, const unsigned char* data, unsigne
 }
 
 void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& win, double width_px,
-               const std::string& it) {
+               const std::string& it, std::uint32_t layers) {
+  const bool walls = layers & turtle::kLayerWalls, balls = layers & turtle::kLayerBalls,
+             turtles = layers & turtle::kLayerTurtles, trails = layers & turtle::kLayerTrails,
+             roles = layers & turtle::kLayerRoles;
   const Layout l = layout_for(win, width_px);
   std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface(
       cairo_image_surface_create(CAIRO_FORMAT_RGB24, l.width, l.height), cairo_surface_destroy);
@@ -161,8 +165,7 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
   cairo_set_font_size(cr, 16);
   set_grey(cr, 0);
   char title[512];
-  std::snprintf(title, sizeof title, "%s - t = %.6g s, %zu balls", snap.title.empty() ? "turtlegas" : snap.title.c_str(),
-                snap.time, snap.balls.size());
+  std::snprintf(title, sizeof title, "%s - t = %.6g s, %zu balls", snap.title.c_str(), snap.time, snap.balls.size());
   std::string text = title;
   if (!snap.turtles.empty())
     text += ", " + std::to_string(snap.turtles.size()) + (snap.turtles.size() == 1 ? " turtle" : " turtles");
@@ -185,6 +188,7 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
   stroke_px(cr, 1);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   for (const auto& wall : snap.walls) {
+    if (!walls) break;
     const sim::WallKey pose = sim::wall_pose(wall, snap.time);
     const bool there = sim::wall_visible(wall, snap.time);
     cairo_move_to(cr, pose.from.x, pose.from.y);
@@ -199,7 +203,7 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
     stroke_px(cr, 2);
     cairo_set_dash(cr, nullptr, 0, 0);
   }
-  for (std::size_t i = 0; i < snap.balls.size(); ++i) {
+  for (std::size_t i = 0; i < snap.balls.size() && balls; ++i) {
     const auto& b = snap.balls[i];
     cairo_arc(cr, b.pos.x, b.pos.y, b.radius, 0, 2 * M_PI);
     set_rgb(cr, speed_colour(speeds[i] / v_scale));
@@ -208,15 +212,15 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
   for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
     const auto& t = snap.turtles[i];
-    if (t.trail.size() < 2) continue;
+    if (t.trail.size() < 2 || !trails) continue;
     cairo_move_to(cr, t.trail[0].x, t.trail[0].y);
     for (std::size_t k = 1; k < t.trail.size(); ++k) cairo_line_to(cr, t.trail[k].x, t.trail[k].y);
     set_rgb(cr, turtle_colours[i % turtle_colours.size()]);
     stroke_px(cr, 1.5);
   }
-  for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
+  for (std::size_t i = 0; i < snap.turtles.size() && turtles; ++i) {
     const auto& t = snap.turtles[i];
-    if (t.id == it) {  // the tag game's "it": a red ring around it
+    if (t.id == it && roles) {  // the tag game's "it": a red ring around it
       cairo_arc(cr, t.pos.x, t.pos.y, t.radius * 1.6, 0, 2 * M_PI);
       cairo_set_source_rgb(cr, 0.85, 0.1, 0.1);
       stroke_px(cr, 3);
@@ -243,6 +247,7 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
   // Ids beside each turtle's upper right, upright.
   cairo_set_font_size(cr, 11 / l.scale);
   for (const auto& t : snap.turtles) {
+    if (!turtles) break;
     cairo_save(cr);
     cairo_translate(cr, t.pos.x, t.pos.y);
     cairo_rotate(cr, -win.angle);
@@ -255,7 +260,7 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
   cairo_restore(cr);
 
   // The legend: a colour bar from 0 (bottom) to v_max (top), when there are balls.
-  if (!snap.balls.empty()) {
+  if (!snap.balls.empty() && balls) {
     const double lx = l.margin + win.w * l.scale + 24.0, ly = l.top + 16.0, lh = 120.0;
     cairo_pattern_t* g = cairo_pattern_create_linear(0, ly + lh, 0, ly);
     for (std::size_t k = 0; k < palette.size(); ++k) {
@@ -300,12 +305,37 @@ class Renderer {
     if (t > server_->time()) server_->run_until(t);
   }
 
-  Window window() const {
+  /// The whole arena, or what view `opt.view` shows now (a view of the world file's, or one a
+  /// program has opened by this time); layers: the view's (turtle/view.hpp).
+  Window window(std::uint32_t& layers) const {
+    layers = turtle::kLayersAll;
     const sim::ArenaDef& a = source_.scene.def.arena;
-    return {a.width / 2, a.height / 2, a.width, a.height, 0.0};
+    if (opt_.view.empty()) return {a.width / 2, a.height / 2, a.width, a.height, 0.0};
+    const std::optional<turtle::View> v = server_->find_view(opt_.view);
+    if (!v) {
+      std::string open;
+      for (const turtle::View& w : server_->views()) open += (open.empty() ? "" : ", ") + w.id;
+      throw BadInput("--view " + opt_.view + ": no view with that id is open at t = " + fmt(server_->time()) +
+                     " s (open then: " + (open.empty() ? "none" : open) + "; the world file's \"views\" and the ones "
+                     "its programs open)");
+    }
+    std::optional<turtle::FollowPose> pose;
+    if (v->follow)
+      if (const auto i = server_->turtle_index(*v->follow)) pose = server_->follow_pose(*i);
+    const turtle::ViewTransform x = turtle::view_transform(*v, pose);
+    layers = v->layers;
+    return {x.center.x, x.center.y, x.size.x, x.size.y, std::atan2(x.up.x, x.up.y)};
   }
 
-  formats::Snapshot snapshot() const { return formats::snapshot_of(*server_, source_.scene.def); }
+  formats::Snapshot snapshot() const {
+    formats::Snapshot s = formats::snapshot_of(*server_, source_.scene.def);
+    if (s.title.empty()) s.title = "turtlegas";
+    if (!opt_.view.empty()) {  // the view's title, as the viewer shows it
+      const std::optional<turtle::View> v = server_->find_view(opt_.view);
+      if (v) s.title = v->title.empty() ? v->id : v->title;
+    }
+    return s;
+  }
 
   std::string it() const {
     if (!server_->game()) return {};
@@ -316,8 +346,16 @@ class Renderer {
   void draw(const std::string& path, const std::string& option) {
     OutputFile out(path, option);
     const formats::Snapshot snap = snapshot();
-    if (path.size() >= 4 && path.substr(path.size() - 4) == ".svg") formats::write_svg(out.stream(), snap, opt_.width);
-    else write_png(out.stream(), snap, window(), opt_.width, it());
+    if (path.size() >= 4 && path.substr(path.size() - 4) == ".svg") {
+      if (!opt_.view.empty())
+        throw BadInput("--view goes with PNG pictures and frames; the SVG is of the whole arena (use --out F.png)");
+      formats::write_svg(out.stream(), snap, opt_.width);
+    }
+    else {
+      std::uint32_t layers = 0;
+      const Window win = window(layers);
+      write_png(out.stream(), snap, win, opt_.width, it(), layers);
+    }
     out.commit();
   }
 
@@ -371,9 +409,6 @@ int render_command(const RenderOptions& opt, const turtle::Registry& registry) {
   if (one && !ends_with(opt.out, ".svg") && !ends_with(opt.out, ".png"))
     throw BadInput("--out " + opt.out + ": the picture's name must end in .svg or .png");
   if (!opt.out.empty() && !one) throw BadInput("--out goes with --at; a sequence goes to --frames DIR or --video F.mp4");
-  if (!opt.view.empty())
-    throw BadInput("--view " + opt.view + ": this turtlegas has no views yet (the world file's \"views\" come with the "
-                   "viewer); leave --view out to draw the whole arena");
   std::string ffmpeg;
   if (!opt.video.empty()) {
     if (!ends_with(opt.video, ".mp4")) throw BadInput("--video " + opt.video + ": the video's name must end in .mp4");

@@ -361,6 +361,18 @@ class World:
     def save(self, file):
         return self.request({"type": "save", "file": file})
 
+    # Views (display windows, docs/viewer.md): a dict as in the world file's "views" list.
+    def view_open(self, view):
+        """Opens a view, e.g. {"id": "v1", "follow": "t1", "size": [200, 150], "rotate": True}."""
+        return self.request({"type": "view_open", "view": dict(view)})
+
+    def view_change(self, view_id, **changes):
+        """Changes the keys given, e.g. view_change("v1", size=[300, 200])."""
+        return self.request({"type": "view_change", "view": dict(changes, id=view_id)})
+
+    def view_close(self, view_id):
+        return self.request({"type": "view_close", "view": view_id})
+
     def load(self, file):
         return self.request({"type": "load", "file": file})
 

@@ -9,6 +9,7 @@
 #include "turtlegas/formats/json_text.hpp"
 #include "turtlegas/server/protocol.hpp"
 #include "turtlegas/sim/angles.hpp"
+#include "turtlegas/turtle/view.hpp"
 
 namespace turtlegas::server {
 namespace {
@@ -35,6 +36,7 @@ void append_clock(std::string& out, const turtle::WorldServer& server, const Fra
   append_number(out, clock.wall);
   out += clock.paused ? ", \"paused\": true, \"speed\": " : ", \"paused\": false, \"speed\": ";
   out += clock.speed.dump();
+  out += ", \"sim_events\": " + std::to_string(server.world().stats().events);  // for events/s
 }
 
 void append_walls(std::string& out, const turtle::WorldServer& server, std::size_t from) {
@@ -48,6 +50,32 @@ void append_walls(std::string& out, const turtle::WorldServer& server, std::size
     append_point(out, walls[k].from);
     out += ", \"to\": ";
     append_point(out, walls[k].to);
+    // Collision layers (the viewer dashes a wall its view's turtle passes through), and the poses
+    // and visibility of a moving wall, for the viewer to place it at a frame's t.
+    out += ", \"layers\": [" + std::to_string(walls[k].layers.category) + ", " + std::to_string(walls[k].layers.mask) + "]";
+    if (!walls[k].keys.empty()) {
+      out += ", \"keys\": [";
+      for (std::size_t q = 0; q < walls[k].keys.size(); ++q) {
+        const sim::WallKey& key = walls[k].keys[q];
+        out += q > 0 ? ", [" : "[";
+        append_number(out, key.t);
+        for (double x : {key.from.x, key.from.y, key.to.x, key.to.y}) {
+          out += ", ";
+          append_number(out, x);
+        }
+        out += ']';
+      }
+      out += ']';
+    }
+    if (!walls[k].visibility.empty()) {
+      out += ", \"visibility\": [";
+      for (std::size_t q = 0; q < walls[k].visibility.size(); ++q) {
+        out += q > 0 ? ", [" : "[";
+        append_number(out, walls[k].visibility[q].t);
+        out += walls[k].visibility[q].visible ? ", true]" : ", false]";
+      }
+      out += ']';
+    }
     out += '}';
   }
   out += ']';
@@ -150,7 +178,7 @@ bool FrameKind::wants(std::string_view event_kind) const {
 
 std::string snapshot_text(const turtle::WorldServer& server, const formats::IdTable& ball_ids,
                           const std::vector<bool>& claimed, const FrameClock& clock, const nlohmann::json& id,
-                          const nlohmann::json& arena) {
+                          const nlohmann::json& arena, const std::vector<TurtleLook>& looks) {
   const sim::World& world = server.world();
   std::string out = "{\"type\": \"snapshot\"";
   if (!id.is_null()) out += ", \"id\": " + id.dump();
@@ -179,18 +207,43 @@ std::string snapshot_text(const turtle::WorldServer& server, const formats::IdTa
     append_turtle_head(out, info, i < claimed.size() && claimed[i]);
     out += ", \"radius\": ";
     append_number(out, world.turtle_radius(i));
+    if (i < looks.size()) {
+      out += ", \"layers\": [" + std::to_string(looks[i].layers.category) + ", " + std::to_string(looks[i].layers.mask) + "]";
+      out += ", \"arcs\": [";
+      for (std::size_t q = 0; q < looks[i].sensors.size(); ++q) {
+        out += q > 0 ? ", [" : "[";
+        append_number(out, looks[i].sensors[q].from);
+        out += ", ";
+        append_number(out, looks[i].sensors[q].to);
+        out += ']';
+      }
+      out += ']';
+    }
     out += ", \"trail\": ";
     append_points(out, server.trail_since(i, 0));
     out += '}';
   }
-  out += "]}";
+  out += "], \"views\": " + views_text(server) + "}";
   return out;
+}
+
+std::string views_text(const turtle::WorldServer& server) {
+  std::string out = "[";
+  for (const turtle::View& v : server.views()) out += (out.size() > 1 ? ", " : "") + turtle::view_json_text(v);
+  return out + "]";
+}
+
+nlohmann::json views_json(const turtle::WorldServer& server) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const turtle::View& v : server.views()) a.push_back(turtle::view_to_json(v));
+  return a;
 }
 
 FrameStream::FrameStream(FrameKind kind, const turtle::WorldServer& server) : kind_(std::move(kind)) {
   trail_sent_.resize(server.turtle_count());
   for (std::size_t i = 0; i < trail_sent_.size(); ++i) trail_sent_[i] = server.trail_size(i);
   walls_sent_ = server.world().walls().size();
+  views_sent_ = server.views_revision();  // the snapshot that follows a subscribe has them
 }
 
 void FrameStream::add_event(std::string_view event_kind, std::string_view line, std::size_t max_events) {
@@ -223,6 +276,12 @@ std::shared_ptr<const std::string> FrameStream::build(const turtle::WorldServer&
   const std::size_t dropped = events_dropped_;
   events_.clear();
   event_count_ = events_dropped_ = 0;
+  // The views, whole, when they changed since the previous frame built (and only then).
+  std::string views;
+  if (server.views_revision() != views_sent_) {
+    views_sent_ = server.views_revision();
+    views = ", \"views\": " + views_text(server);
+  }
 
   auto out = std::make_shared<std::string>();
   if (!kind_.binary) {
@@ -241,11 +300,12 @@ std::shared_ptr<const std::string> FrameStream::build(const turtle::WorldServer&
     }
     s += "], \"walls_from\": " + std::to_string(walls_from) + ", \"walls\": ";
     append_walls(s, server, walls_from);
-    s += ", \"events\": " + tail_events + ", \"events_dropped\": " + std::to_string(dropped) + "}";
+    s += ", \"events\": " + tail_events + ", \"events_dropped\": " + std::to_string(dropped) + views + "}";
     return out;
   }
   // Binary (docs/protocol.md, "Binary frames").
-  std::string tail = "{\"events\": " + tail_events + ", \"events_dropped\": " + std::to_string(dropped) + ", \"trails\": [";
+  std::string tail = "{\"events\": " + tail_events + ", \"events_dropped\": " + std::to_string(dropped) +
+                     ", \"sim_events\": " + std::to_string(world.stats().events) + ", \"trails\": [";
   for (std::size_t i = 0; i < server.turtle_count(); ++i) {
     if (i > 0) tail += ", ";
     tail += "{\"from\": " + std::to_string(from[i]) + ", \"points\": ";
@@ -254,7 +314,7 @@ std::shared_ptr<const std::string> FrameStream::build(const turtle::WorldServer&
   }
   tail += "], \"walls_from\": " + std::to_string(walls_from) + ", \"walls\": ";
   append_walls(tail, server, walls_from);
-  tail += '}';
+  tail += views + '}';
   const std::vector<std::uint32_t> which = balls_in(world, kind_);
   const bool indexed = kind_.region.has_value();
   const std::size_t n = indexed ? which.size() : world.ball_count(), m = server.turtle_count();

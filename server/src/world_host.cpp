@@ -105,6 +105,9 @@ void WorldHost::build_world(world::Scene scene) {
   server_ = world::make_server(scene_, registry_, o);
   server_->set_event_log(&events_);
   slots_.assign(server_->turtle_count(), Slot{});
+  looks_.clear();
+  const sim::WorldDef layered = turtle::with_builder_layers(scene_.def, scene_.programs);
+  for (std::size_t i = 0; i < layered.turtles.size(); ++i) looks_.push_back({layered.turtles[i].layers, scene_.programs[i].sensors});
   wall_changes_.clear();
   takeovers_.clear();
   ended_.reset();
@@ -379,7 +382,8 @@ json WorldHost::world_json() const {
           {"remote", options_.realtime ? "realtime" : "lockstep"},
           {"balls", server_->world().ball_count()},
           {"walls", server_->world().walls().size()},
-          {"turtles", turtles}};
+          {"turtles", turtles},
+          {"views", views_json(*server_)}};
 }
 
 json WorldHost::ok(const json& m, const char* request) const {
@@ -506,8 +510,8 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     welcome["authorized"] = c.authorized;
     welcome["world"] = world_json();
     welcome["status"] = status_json();
-    welcome["capabilities"] = options_.replay ? json{"frames", "binary-frames", "control", "replay"}
-                                              : json{"frames", "binary-frames", "control", "remote", "add_wall", "save", "load"};
+    welcome["capabilities"] = options_.replay ? json{"frames", "binary-frames", "control", "views", "replay"}
+                                              : json{"frames", "binary-frames", "control", "remote", "add_wall", "save", "load", "views"};
     welcome["limits"] = {{"max_message", l.max_message}, {"max_rate", l.max_rate}, {"max_claims", l.max_claims}, {"max_clients", l.max_clients}};
     reply(c, welcome);
     return;
@@ -592,7 +596,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     r["velocities"] = k.velocities;
     if (k.region) r["region"] = *k.region;
     reply(c, r);
-    reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"]));
+    reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"], looks_));
     return;
   }
   if (type == "unsubscribe") {
@@ -601,9 +605,10 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     return;
   }
   if (type == "snapshot") {
-    reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), id, world_json()["arena"]));
+    reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), id, world_json()["arena"], looks_));
     return;
   }
+  if (is_view_message(type)) return handle_view_message(c, m, type);
   if (type == "spawn" || type == "remove" || type == "teleport")
     throw RequestError("unsupported", "\"" + type + "\" is not available: the engine cannot yet add, remove or move bodies in a running world");
 
@@ -947,7 +952,7 @@ void WorldHost::do_file_requests() {
     if (it != clients_.end()) reply(it->second, ok(json{{"id", f.id}}, "load"));
     broadcast(dump({{"type", "world"}, {"world", world_json()}}));
     for (auto& [cid, c] : clients_)
-      if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"]));
+      if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"], looks_));
   }
 }
 
@@ -996,7 +1001,7 @@ void WorldHost::seek(double t) {
   for (auto& [key, s] : streams_) fresh.try_emplace(key, s.kind(), *server_).first->second.next_due = now();
   streams_ = std::move(fresh);
   for (auto& [cid, c] : clients_)
-    if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"]));
+    if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"], looks_));
 }
 
 }  // namespace turtlegas::server

@@ -244,6 +244,26 @@ def check_render():
     _, _, rows = png_pixels(read(png))
     assert near(px(70, 56), body, 16), px(70, 56)
     assert near(px(44, 50), floor), px(44, 50)
+    # --view: a fixed view crops (40 x 40 units around the turtle's start: 20 px a unit) ...
+    run("render", world, "--at", 0, "--view", "corner", "--out", png)
+    w, h, rows = png_pixels(read(png))
+    assert (w, h) == (800 + 24 + 90, 800 + 30 + 24), (w, h)
+    vx = lambda x, y, size, sc: rows[int(top + (size / 2 - y) * sc)][int(left + (x + size / 2) * sc)]
+    assert near(vx(0, 6, 40, 20), body, 16), vx(0, 6, 40, 20)        # the turtle at the view's centre
+    assert near(vx(6, 0, 40, 20), (0x22, 0x22, 0x22), 60)          # its tick, east
+    assert near(vx(0, 15, 40, 20), floor), vx(0, 15, 40, 20)       # outside its radius
+    # ... and a follow view with rotate keeps the moving turtle centred, heading up: at t = 1 s it
+    # is at (70, 50) heading east, and the wall x = 100 is 30 units ahead: at the view's top edge.
+    run("render", world, "--at", 1, "--view", "cam", "--out", png)
+    w, h, rows = png_pixels(read(png))
+    sc = 800 / 60
+    assert near(vx(0, 6, 60, sc), (0x22, 0x22, 0x22), 60), vx(0, 6, 60, sc)   # the tick points up
+    assert near(vx(0, -6, 60, sc), body, 16) and near(vx(6, 0, 60, sc), body, 16) and near(vx(-6, 0, 60, sc), body, 16)
+    edge = [rows[int(top) + k][int(left + 30 * sc)] for k in range(2)]              # the wall, ahead: the top edge
+    assert any(near(c, (0x22, 0x22, 0x22), 60) for c in edge), edge
+    assert near(vx(0, 20, 60, sc), floor), vx(0, 20, 60, sc)
+    p = run("render", world, "--at", 1, "--view", "nope", "--out", png, ok=(2,))
+    assert b"corner" in p.stderr and b"cam" in p.stderr, p.stderr
     # Frames: fps (T1 - T0) + 1 of them, numbered from 0.
     frames = path("frames")
     run("render", world, "--frames", frames, "--fps", 10, "--from", 0.5, "--to", 1.5)
@@ -274,7 +294,10 @@ def main():
         tag = os.path.join(ROOT, "worlds", "tag.json")
         rec = check_recording(tag, 4.0, rng)
         check_replay(rec, tag, 4.0, rng)
-        step = check_recording(os.path.join(ROOT, "worlds", "pen_walls.json"), 3.0, rng, "--mode", "step")
+        check_recording(os.path.join(ROOT, "worlds", "pen_walls.json"), 3.0, rng, "--mode", "step")
+        # Views: a program's view events are in the log, so in the recording (tag_camera opens one).
+        views = check_recording(os.path.join(ROOT, "worlds", "tag_views.json"), 4.0, rng)
+        assert b'"kind": "view"' in read(views), "no view events in the recording of tag_views.json"
         check_killed()
         check_render()
     except AssertionError:

@@ -20,7 +20,7 @@ from turtlegas_client import World, decode_binary_frame
 DOC = os.path.join(ROOT, "docs", "protocol.md")
 REQUESTS = {"hello", "subscribe", "unsubscribe", "snapshot", "pause", "resume", "step", "speed", "run_until",
             "claim", "release", "forward", "back", "left", "right", "wait", "yield", "pen", "add_wall", "save",
-            "load", "ping", "stats"}
+            "load", "view_open", "view_change", "view_close", "ping", "stats"}
 REPLAY_REQUESTS = {"play", "seek", "reverse"}  # `turtlegas replay` only (test_replay_examples)
 
 
@@ -87,6 +87,38 @@ def session(w, save_dir):
     frame = w.frames.get(timeout=10)
     reply_shape("frame", frame, solicited=False)
     check(frame["seq"] >= 1 and len(frame["turtles"]) == 2, "a frame: %r" % frame)
+    # Views: open, change, close, each in the next frame; the errors name the field.
+    check(snap["views"] == [] and w.welcome["world"]["views"] == [], "no views yet: %r" % snap["views"])
+    r = ask(w, doc["view_open"][0])
+    reply_shape("ok", r)
+    check(r["request"] == "view_open" and r["view"]["follow"] == "t1" and r["view"]["rotate"] is True, "view_open: %r" % r)
+
+    def next_views():
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:
+            f = w.frames.get(timeout=10)
+            if f.get("type") == "frame" and "views" in f:
+                return f["views"]
+        check(False, "a frame carries the views within 10 s")
+
+    check([v["id"] for v in next_views()] == ["v1"], "the frame after view_open has v1")
+    r = ask(w, doc["view_change"][0])
+    check(r["view"]["size"] == [300, 200] and r["view"]["offset"] == [0, 30], "view_change keeps the rest: %r" % r)
+    check(next_views()[0]["size"] == [300, 200], "the frame after view_change has the new size")
+    r = ask(w, doc["view_close"][0])
+    check(r["view"] == "v1", "view_close: %r" % r)
+    check(next_views() == [], "the frame after view_close has no views")
+    for bad, code, field in (({"type": "view_close", "view": "v1"}, "unknown_view", "/view"),
+                             ({"type": "view_open", "view": {"id": "v2", "size": [10, 0]}}, "bad_value", "/view/size/1"),
+                             ({"type": "view_open", "view": {"id": "v2", "follow": "nobody"}}, "unknown_turtle", "/view/follow"),
+                             ({"type": "view_open", "view": {"size": [1, 1]}}, "missing_field", "/view"),
+                             ({"type": "view_change", "view": {"id": "v9"}}, "unknown_view", "/view/id")):
+        try:
+            w.request(bad)
+            check(False, "refused: %r" % bad)
+        except Exception as e:
+            check(getattr(e, "reply", {}).get("code") == code and e.reply.get("field") == field,
+                  "%r: %s at %s (got %r)" % (bad, code, field, getattr(e, "reply", e)))
     reply_shape("ok", ask(w, doc["unsubscribe"][0]))
     reply_shape("snapshot", ask(w, doc["snapshot"][0]))
     for kind in ("pause", "resume", "step", "speed", "run_until"):

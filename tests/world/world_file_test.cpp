@@ -168,13 +168,6 @@ TEST_CASE("unknown keys are errors with a suggestion") {
   CHECK_ERROR(world(R"(, "a/b~c": 1)"), "/a~1b~0c", "unknown key \"a/b~c\"");
 }
 
-TEST_CASE("later features are reserved, not unknown") {
-  for (const char* key : {"views"}) {
-    INFO(key);
-    CHECK_ERROR(world(std::string(", \"") + key + "\": []"), std::string("/") + key, "is not supported yet");
-  }
-}
-
 TEST_CASE("electric and magnetic fields and charges are read") {
   const sim::WorldDef def = tw::parse_world(
       world(R"(, "effects": {"electric": [1, -2], "magnetic": 0.5},

@@ -175,6 +175,7 @@ double Turtle::radius() const { return agent_->server->def.turtles[agent_->index
 double Turtle::speed() const { return agent_->server->def.turtles[agent_->index].speed; }
 double Turtle::turn_rate() const { return sim::to_degrees(agent_->server->def.turtles[agent_->index].turn_rate); }
 double Turtle::dt() const { return agent_->server->def.dt; }
+Display Turtle::display() const { return Display(*agent_); }
 nlohmann::json Turtle::game_rules() const {
   return agent_->server->game ? agent_->server->game->rules_for_players() : nlohmann::json::object();
 }

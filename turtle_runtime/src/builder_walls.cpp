@@ -70,10 +70,10 @@ void WorldServer::Impl::lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to) {
     world.add_wall(w);
   } catch (const std::invalid_argument& e) {
     spdlog::warn("turtle '{}' t={:.6g}: wall {} not laid: {}", a.id, now, w.id, e.what());
-    emit({now, "wall-refused", a.id, w.id, {}, 0.0, e.what(), {}});
+    emit({now, "wall-refused", a.id, w.id, {}, 0.0, e.what(), {}, {}});
     return;
   }
-  emit({now, "wall-drawn", a.id, w.id, {}, 0.0, {}, {}});
+  emit({now, "wall-drawn", a.id, w.id, {}, 0.0, {}, {}, {}});
 }
 
 void WorldServer::add_wall(const sim::WallDef& wall) {
@@ -82,7 +82,7 @@ void WorldServer::add_wall(const sim::WallDef& wall) {
   if (s.id_taken(wall.id))
     throw std::invalid_argument("id '" + wall.id + "' is taken; give the wall an id that no wall, ball or turtle has");
   s.world.add_wall(wall);  // throws std::invalid_argument, changing nothing
-  s.emit({s.world.time(), "wall-added", wall.id, {}, {}, 0.0, {}, {}});
+  s.emit({s.world.time(), "wall-added", wall.id, {}, {}, 0.0, {}, {}, {}});
 }
 
 }  // namespace turtlegas::turtle

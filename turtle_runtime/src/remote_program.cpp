@@ -114,7 +114,7 @@ void WorldServer::make_remote(std::size_t i) {
   a.program.controller = std::string(remote_controller_name);
   a.controller = detail::remote_program_for(a);
   s.world.command_turtle(i, {sim::TurtleCommand::Kind::stop, 0.0});
-  s.emit({s.world.time(), "takeover", a.id, {}, {}, 0.0, {}, {}});
+  s.emit({s.world.time(), "takeover", a.id, {}, {}, 0.0, {}, {}, {}});
 }
 
 bool WorldServer::is_remote(std::size_t i) const { return impl_->agents.at(i)->remote; }

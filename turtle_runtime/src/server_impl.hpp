@@ -18,6 +18,7 @@
 #include "turtlegas/turtle/event_names.hpp"
 #include "turtlegas/turtle/game.hpp"
 #include "turtlegas/turtle/remote.hpp"
+#include "turtlegas/turtle/view.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
 namespace turtlegas::turtle {
@@ -36,6 +37,8 @@ class WorldServer::Impl : public GameHost {
   bool boundary_done = false;    // whether the programs have run at boundary `step`
   WorldServer* self = nullptr;   // for the InputSource's at_boundary
   std::vector<RemoteReport> reports;  // the remote programs' reports, until flush_reports()
+  std::vector<View> views;             // the open views (view.cpp), in opening order
+  std::uint64_t views_revision = 0;
 
   Impl(sim::WorldDef d, ServerOptions o) : def(std::move(d)), world(def, o.mode), options(std::move(o)) {}
 

@@ -36,7 +36,7 @@ void TagGame::referee(double t, std::span<const sim::TurtleContact> contacts, Ga
     host.set_it(other, true);
     host.send(it_, Message{nlohmann::json{{"kind", "tag"}, {"it", false}, {"by", ids_[other]}}, t});
     host.send(other, Message{nlohmann::json{{"kind", "tag"}, {"it", true}, {"by", ids_[it_]}}, t});
-    host.log_event(LogEvent{t, "tag", ids_[it_], ids_[other], {}, 0.0, {}, {}});
+    host.log_event(LogEvent{t, "tag", ids_[it_], ids_[other], {}, 0.0, {}, {}, {}});
     last_giver_ = it_;
     last_tag_contact_ = c.t;
     it_ = other;

@@ -151,7 +151,7 @@ bool WorldServer::Impl::resume(Agent& a) {
     world.command_turtle(a.index, {sim::TurtleCommand::Kind::stop, 0.0});
     if (!fault.empty()) {
       spdlog::error("turtle '{}' stopped at t={:.6g}: {}", a.id, now, fault);
-      emit({now, "fault", a.id, {}, {}, 0.0, fault, {}});
+      emit({now, "fault", a.id, {}, {}, 0.0, fault, {}, {}});
       if (a.remote) [[unlikely]] {
         RemoteReport r = report_of(a, RemoteReport::Kind::fault);
         r.fault = fault;
@@ -217,7 +217,7 @@ void WorldServer::Impl::control_step() {
     Agent& a = *agents[c.turtle];
     Touch t = a.make_touch(c);
     if (log) {
-      LogEvent e{now, "touch", a.id, t.what, {}, t.bearing, {}, {}};
+      LogEvent e{now, "touch", a.id, t.what, {}, t.bearing, {}, {}, {}};
       for (std::size_t s = 0; s < a.program.sensors.size(); ++s)
         if (t.fired(s)) e.sensors.push_back(a.program.sensors[s].name);
       emit(std::move(e));
@@ -259,7 +259,7 @@ void WorldServer::Impl::drain_sim_events() {
     for (const sim::Event& e : sim_log) {
       const EventIds ids = name_event(e, names());
       emit({e.t, std::string(sim::to_string(e.kind)), std::string(ids.a), ids.b ? std::string(*ids.b) : std::string(),
-            {}, 0.0, {}, ids.c ? std::string(*ids.c) : std::string()});
+            {}, 0.0, {}, ids.c ? std::string(*ids.c) : std::string(), {}});
     }
   sim_log.clear();
 }

@@ -74,6 +74,7 @@ class Reader : public JsonReader {
   void read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles, std::vector<turtle::TurtleProgram>& programs);
   std::vector<turtle::SensorArc> read_sensors(const json& v, const std::string& path) const;
   void check_script(const json& params, const std::string& path) const;
+  std::vector<turtle::View> read_views(const json& v, const sim::WorldDef& def);
   std::vector<GasSpec> read_gases(const json& v, const sim::WorldDef& def);
   std::string path_of(const sim::DefProblem& p) const;
   void check_gas_ids(const std::vector<GasSpec>& gases) const;

@@ -24,8 +24,8 @@ namespace detail {
 namespace {
 
 /// Features that later versions add to the format: named so that a file written for them fails
-/// with a clear message rather than as an unknown key.
-constexpr std::array<std::string_view, 1> reserved_keys = {"views"};
+/// with a clear message rather than as an unknown key. (None at present: `views` was one.)
+constexpr std::array<std::string_view, 0> reserved_keys = {};
 
 /// The commands of a `draw` builder: the script commands (turtle/script.hpp) of turtle geometry,
 /// without those that only take time.
@@ -295,7 +295,7 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
                             std::string(key) + "\" to keep it in the file)");
   check_keys(doc, "", "the world",
              {"format", "name", "seed", "dt", "arena", "effects", "walls", "balls", "turtles", "gas", "expect", "game",
-              "draw"});
+              "draw", "views"});
 
   Scene scene;
   sim::WorldDef& def = scene.def;
@@ -349,6 +349,7 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
     // their generated ids remain to be checked; that needs only their prefixes, not a million strings.
     check_gas_ids(gases);
   }
+  if (const json* v = find(doc, "views")) scene.views = read_views(*v, def);
   // Scripted test worlds (expect.hpp): read last, so that their ids can name any body.
   if (const json* v = find(doc, "expect")) {
     scene.expect = parse_expect(*v, file(), def);

@@ -31,6 +31,7 @@ struct EventLine {
   const std::vector<std::string>* sensors = nullptr;
   double bearing = 0.0;  ///< degrees clockwise from the heading to the contact point, [0, 360)
   std::string_view message;
+  std::string_view extra;  ///< more members, JSON text without braces (`view` events)
 };
 
 /// Appends one line of the log, newline included.
@@ -62,6 +63,10 @@ inline void append_event(std::string& out, const EventLine& e) {
     out += ", \"message\": ";
     append_json_string(out, e.message);
   }
+  if (!e.extra.empty()) {
+    out += ", ";
+    out += e.extra;
+  }
   out += "}\n";
 }
 
@@ -91,6 +96,7 @@ inline EventLine event_line(const turtle::LogEvent& e) {
     line.bearing = e.bearing;
   }
   line.message = e.message;
+  line.extra = e.extra;
   return line;
 }
 

@@ -40,11 +40,23 @@ struct FrameClock {
   nlohmann::json speed;  ///< a number or "max"
 };
 
+/// What a snapshot says of each turtle beyond its state: its collision layers as the world runs
+/// them (builders in their own category) and its sensor arcs, for the viewer.
+struct TurtleLook {
+  sim::Layers layers;
+  std::vector<turtle::SensorArc> sensors;
+};
+
 /// The snapshot message; `id` echoed when not null. `claimed[i]`: turtle i is claimed; `arena`
-/// the arena's JSON object ({"width", "height", "boundary"}).
+/// the arena's JSON object ({"width", "height", "boundary"}); `looks[i]` turtle i's.
 std::string snapshot_text(const turtle::WorldServer& server, const formats::IdTable& ball_ids,
                           const std::vector<bool>& claimed, const FrameClock& clock, const nlohmann::json& id,
-                          const nlohmann::json& arena);
+                          const nlohmann::json& arena, const std::vector<TurtleLook>& looks);
+
+/// The open views as a JSON array of view objects (turtle/view.hpp), in opening order.
+nlohmann::json views_json(const turtle::WorldServer& server);
+/// The same as JSON text (turtle::view_json_text), for snapshots and frames.
+std::string views_text(const turtle::WorldServer& server);
 
 /// The frames of one subscription kind.
 class FrameStream {
@@ -63,6 +75,7 @@ class FrameStream {
   FrameKind kind_;
   std::vector<std::size_t> trail_sent_;
   std::size_t walls_sent_ = 0;
+  std::uint64_t views_sent_ = 0;  ///< the views_revision() the last frame carried
   std::string events_;
   std::size_t event_count_ = 0, events_dropped_ = 0;
 };

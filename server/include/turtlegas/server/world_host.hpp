@@ -37,6 +37,9 @@
 
 namespace turtlegas::server {
 
+/// view_open, view_change or view_close (view_messages.cpp).
+bool is_view_message(const std::string& type);
+
 /// `turtlegas replay` (docs/recording.md): the host plays a recording instead of serving a live
 /// world. The world is the recording's, re-simulated (the run is deterministic, so the states are
 /// the recorded run's to the bit); time goes from 0 to `end` and back (seek, reverse); nothing a
@@ -142,6 +145,9 @@ class WorldHost {
   bool wait_inbox_until(double steady_deadline);  ///< true when something arrived
   void handle(Inbound& in);
   void handle_message(ClientState& c, const nlohmann::json& m);
+  /// view_open, view_change, view_close (view_messages.cpp).
+  void handle_view_message(ClientState& c, const nlohmann::json& m, const std::string& type);
+  std::string open_views_list() const;
   void at_boundary(turtle::WorldServer& server, std::uint64_t step);
   std::optional<turtle::RemoteCommand> next_command(std::uint64_t step, std::size_t turtle);
   void on_report(const turtle::RemoteReport& r);
@@ -182,6 +188,7 @@ class WorldHost {
   std::optional<std::ofstream> events_file_, inputs_file_;
   std::optional<formats::EventLogWriter> events_writer_;
   std::vector<Slot> slots_;
+  std::vector<TurtleLook> looks_;  ///< snapshots' turtle layers and sensor arcs
   std::map<std::uint64_t, ClientState> clients_;
   std::map<std::string, FrameStream> streams_;
   std::deque<WallChange> wall_changes_;

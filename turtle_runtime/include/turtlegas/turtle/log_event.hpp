@@ -17,6 +17,9 @@ struct LogEvent {
   double bearing = 0.0;              ///< touch only, degrees
   std::string message;               ///< `fault` events: what went wrong
   std::string c;                     ///< `wedged`, `crushed`: the second obstacle
+  /// More members for the line, as JSON text without braces (`view` events: `"op": "open",
+  /// "view": {...}`); empty for every other kind.
+  std::string extra;
 };
 
 }  // namespace turtlegas::turtle

@@ -35,6 +35,7 @@
 #include <nlohmann/json.hpp>
 
 #include "turtlegas/sim/vec2.hpp"
+#include "turtlegas/turtle/view.hpp"
 
 namespace turtlegas::turtle {
 
@@ -212,6 +213,11 @@ class Turtle {
   /// The rules of the world's game as JSON; {} when the world has no game. The tag game gives
   /// {"kind": "tag", "no_tag_back": <seconds>}.
   nlohmann::json game_rules() const;
+
+  /// The world's views (view.hpp): open, change and close display windows, e.g. one that follows
+  /// this turtle while it is "it". Changes apply at the control boundary the program runs at, are
+  /// logged as `view` events by this turtle's id, and never change the physics.
+  Display display() const;
 
   /// This turtle seen through a mirror whose line has heading `axis_degrees` (Logo degrees; 0, the
   /// default, is a vertical line), to run a program as its own mirror image (the `mirror`

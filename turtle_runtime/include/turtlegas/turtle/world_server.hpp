@@ -40,6 +40,7 @@
 #include "turtlegas/turtle/log_event.hpp"
 #include "turtlegas/turtle/registry.hpp"
 #include "turtlegas/turtle/turtle.hpp"
+#include "turtlegas/turtle/view.hpp"
 
 namespace turtlegas::turtle {
 
@@ -175,6 +176,27 @@ class WorldServer {
   /// delivered go to the remote program. Throws std::logic_error if the turtle is remote already
   /// or when not called from InputSource::at_boundary.
   void make_remote(std::size_t i);
+  // Views (view.hpp): display data, never physics. Each change below applies at once, at time()
+  // (programs and a host's messages run at control boundaries), bumps views_revision() and is
+  // logged as a `view` event {"op": "open"|"change"|"close", "by": <turtle id, when a program
+  // made it>, "view": {...}}; docs/viewer.md. All throw std::invalid_argument (a ViewError for a
+  // bad view), changing nothing, for an id that is taken (open) or unknown (change, close) and
+  // a follow that names no turtle.
+  /// The world file's views, before the run starts: not logged (they are in the world file).
+  void set_views(std::vector<View> views);
+  void open_view(const View& v, const std::string& by = {});
+  void change_view(const View& v, const std::string& by = {});
+  void close_view(const std::string& id, const std::string& by = {});
+  std::optional<View> find_view(const std::string& id) const;
+  /// The open views, in the order they were opened.
+  const std::vector<View>& views() const;
+  /// Counts the changes to views() (0 before any): frames send the views again when it moved.
+  std::uint64_t views_revision() const;
+  /// Where turtle i is, for view_transform.
+  FollowPose follow_pose(std::size_t i) const;
+  /// The index of the turtle with that id, or nullopt.
+  std::optional<std::size_t> turtle_index(const std::string& id) const;
+
   /// Bytes of program stack actually reserved per turtle (stack plus guard page).
   std::size_t stack_reservation() const;
 

@@ -21,6 +21,8 @@ struct Scene {
   std::vector<turtle::TurtleProgram> programs;
   /// The world's game (the `game` key): the tag rules, when the world plays tag.
   std::optional<turtle::TagRules> game;
+  /// The `views` list (display windows, turtle/view.hpp); follows name turtles of def.
+  std::vector<turtle::View> views;
   /// The `expect` list of a scripted test world (empty when the file has none).
   Expectations expect;
 };
