@@ -12,7 +12,10 @@ packages=(
   clang libclang-rt-14-dev clang-tidy   # the clang and fuzz presets, scripts/tidy.sh
   libopenmpi-dev openmpi-bin   # turtlegas sweep under mpirun (optional at build time; its test runs mpirun)
   chromium   # the viewer's browser tests (tests/server/test_browser.py) and bench/viewer_bench.py, headless
+  libcairo2-dev   # turtlegas render: PNG pictures and frames
 )
+# Optional: `turtlegas render --video` runs ffmpeg when it is installed (its test is skipped when
+# not). Install it with: apt-get install ffmpeg
 
 missing=()
 for p in "${packages[@]}"; do

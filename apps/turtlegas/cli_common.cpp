@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <system_error>
 #include <vector>
 
@@ -18,6 +19,16 @@ world::Scene load(const std::string& file, const turtle::Registry& registry) {
     return world::load_scene(file, registry);
   } catch (const world::WorldFileError& e) {
     throw BadInput(e.what());
+  }
+}
+
+nlohmann::ordered_json read_world_json(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw BadInput(file + ": cannot read it");
+  try {
+    return nlohmann::ordered_json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw BadInput(file + ": not JSON (" + std::string(e.what()) + ")");
   }
 }
 

@@ -17,6 +17,7 @@
 #include "cli_common.hpp"
 #include "controllers_command.hpp"
 #include "plugins.hpp"
+#include "render_command.hpp"
 #include "run_command.hpp"
 #include "serve_command.hpp"
 #include "sweep_command.hpp"
@@ -71,6 +72,12 @@ int run(int argc, char** argv) {
   ServeCommandOptions serve_opt;  // `turtlegas serve` (serve_command.hpp)
   CLI::App* serve = add_serve_command(app, serve_opt);
   serve->add_option("--plugin", plugins, plugin_help);
+  ServeCommandOptions replay_opt;  // `turtlegas replay` (serve_command.hpp)
+  CLI::App* replay = add_replay_command(app, replay_opt);
+  replay->add_option("--plugin", plugins, plugin_help);
+  RenderOptions render_opt;  // `turtlegas render` (render_command.hpp)
+  CLI::App* render = add_render_command(app, render_opt);
+  render->add_option("--plugin", plugins, plugin_help);
   SweepOptions sweep_opt;  // `turtlegas sweep` (sweep_command.hpp)
   CLI::App* sweep = add_sweep_command(app, sweep_opt);
   sweep->add_option("--plugin", plugins, plugin_help);
@@ -89,6 +96,8 @@ int run(int argc, char** argv) {
     if (*test) return test_command(test_opt, registry, plugins);
     if (*tag) return run_tag_command(tag_opt, registry);
     if (*serve) return serve_command(serve_opt, registry);
+    if (*replay) return serve_command(replay_opt, registry);
+    if (*render) return render_command(render_opt, registry);
     if (*sweep) return sweep_command(sweep_opt, registry, plugins);
     return run_command(run_line.options(), registry);
   } catch (const BadInput& e) {

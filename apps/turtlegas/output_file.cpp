@@ -64,7 +64,7 @@ bool same_file(const std::string& a, const std::string& b) {
 
 }  // namespace
 
-OutputFile::OutputFile(const std::string& path, std::string_view option) : path_(path), option_(option) {
+OutputFile::OutputFile(const std::string& path, std::string_view option, Write how) : path_(path), option_(option) {
   const std::string opt(option);
   if (path == "-") {
     kind_ = Kind::standard_output;
@@ -86,6 +86,12 @@ OutputFile::OutputFile(const std::string& path, std::string_view option) : path_
   const fs::path dir = target_.parent_path().empty() ? fs::path(".") : target_.parent_path();
   if (!fs::is_directory(dir, ec))
     throw BadInput(opt + ": directory '" + dir.string() + "' does not exist; create it first");
+  if (how == Write::growing) {
+    kind_ = Kind::direct;
+    out_.open(target_, std::ios::binary | std::ios::trunc);
+    if (!out_) throw BadInput(opt + ": cannot write '" + path + "'; check the permissions of it and its directory");
+    return;
+  }
   tmp_ = dir / ("." + target_.filename().string() + ".tmp-" + std::to_string(::getpid()));
   out_.open(tmp_, std::ios::binary | std::ios::trunc);
   if (!out_) throw BadInput(opt + ": cannot write in '" + dir.string() + "'; check its permissions");

@@ -23,9 +23,15 @@ namespace turtlegas::apps {
 /// Opening checks the path (BadInput for a missing directory, a directory given as the file, or
 /// one that cannot be written in), so a bad path costs nothing. The temporary file is removed by
 /// the destructor unless committed, and by a fatal signal or exit() (remove_temporaries()).
+///
+/// A growing output (a recording, docs/recording.md) is instead written in place under its own
+/// name from the start, and left as far as it got when the run dies: such a file marks its own
+/// end, and its reader says how much of an unfinished one it recovered, so a cut file is never
+/// taken for a whole one.
 class OutputFile {
  public:
-  OutputFile(const std::string& path, std::string_view option);
+  enum class Write { replace, growing };
+  OutputFile(const std::string& path, std::string_view option, Write how = Write::replace);
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;
   ~OutputFile();

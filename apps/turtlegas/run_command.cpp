@@ -31,6 +31,7 @@
 #include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/names.hpp"
 #include "turtlegas/formats/observables.hpp"
+#include "turtlegas/formats/recording.hpp"
 #include "turtlegas/formats/state_file.hpp"
 #include "turtlegas/formats/stats_file.hpp"
 #include "turtlegas/formats/svg_snapshot.hpp"
@@ -122,20 +123,24 @@ struct Limits {
   std::optional<double> max_wall_seconds;
   std::optional<std::uint64_t> max_events;
   std::optional<double> checkpoint_every;
+  std::optional<double> keyframe_every;  ///< a recording's keyframes: cuts at its multiples
 };
 
 /// Runs chunks until `limits.until` or a stop. `advance(t)` runs to t and returns the engine's
 /// event count; `flush()` writes what the chunk logged; `checkpoint(t, why)` is called at every
-/// multiple of checkpoint_every.
-template <class Advance, class Flush, class AtCheckpoint>
+/// multiple of checkpoint_every; `cut(t, events, at_key)` after every chunk (a recording's
+/// keyframes; the chunks are also cut at every multiple of keyframe_every, and at_key says this is one).
+template <class Advance, class Flush, class AtCheckpoint, class AtCut>
 std::pair<Stop, int> run_in_chunks(double from, const Limits& limits, Pace& pace, Clock::time_point start,
                                    Progress& progress, const char* doing, Advance&& advance, Flush&& flush,
-                                   AtCheckpoint&& checkpoint) {
+                                   AtCheckpoint&& checkpoint, AtCut&& cut) {
   double t = from;
   std::uint64_t events = 0;
   double events_per_second = 0.0;  // simulated, measured over the last chunk
   const double every = limits.checkpoint_every.value_or(0.0);
   double next_checkpoint = every > 0.0 ? (std::floor(t / every) + 1.0) * every : INFINITY;
+  const double key_every = limits.keyframe_every.value_or(0.0);
+  double next_key = key_every > 0.0 ? (std::floor(t / key_every) + 1.0) * key_every : INFINITY;
   while (t < limits.until) {
     if (const int sig = stop_signal()) return {Stop::signal, sig};
     if (limits.max_wall_seconds && seconds_since(start) >= *limits.max_wall_seconds) return {Stop::max_wall_seconds, 0};
@@ -144,7 +149,7 @@ std::pair<Stop, int> run_in_chunks(double from, const Limits& limits, Pace& pace
     // Near --max-events, a chunk of about what is left.
     if (limits.max_events && events_per_second > 0.0)
       chunk = std::min(chunk, std::max(static_cast<double>(*limits.max_events - events) / events_per_second, chunk / 1024));
-    double next = std::min({limits.until, t + chunk, next_checkpoint});
+    double next = std::min({limits.until, t + chunk, next_checkpoint, next_key});
     if (!(next > t)) next = std::nextafter(t, INFINITY);  // a chunk below one ulp of t
     const auto chunk_start = Clock::now();
     const std::uint64_t before = events;
@@ -156,6 +161,9 @@ std::pair<Stop, int> run_in_chunks(double from, const Limits& limits, Pace& pace
     if ((took > 0.25 || done > 0x1p20) && pace.chunk / 2.0 > 0.0) pace.chunk /= 2.0;
     else if (took < 0.05 && done < 0x1p18 && pace.chunk * 2.0 < INFINITY) pace.chunk *= 2.0;
     t = next;
+    const bool at_key = t >= next_key;
+    if (at_key) next_key = (std::floor(t / key_every) + 1.0) * key_every;
+    cut(t, events, at_key);
     note_run_time(t);
     if (t >= next_checkpoint) {
       checkpoint(t, "every " + fmt(every) + " s");
@@ -301,6 +309,14 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
   run->add_option("--observe-speed-bins", opt.observe_speed_bins, "Bins of the speed histogram (0 to 4 rms speeds)")
       ->capture_default_str()
       ->check(integer_in(1, 100000, "bins"));
+  run->add_option("--record", opt.record,
+                  "Write a recording here (docs/recording.md; play it with `turtlegas replay`, draw it with `render`)");
+  run->add_option("--keyframe-seconds", opt.keyframe_seconds, "A recording's keyframe every this many simulated seconds (0: none)")
+      ->capture_default_str()
+      ->check(real_in(0, big, "seconds"));
+  run->add_option("--keyframe-events", opt.keyframe_events, "A recording's keyframe after this many engine events (0: none)")
+      ->capture_default_str()
+      ->check(integer_in(0, std::numeric_limits<std::int64_t>::max(), "events"));
   return run;
 }
 
@@ -318,7 +334,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   for (const std::string& p : opt.plugins) inputs.push_back({p, "--plugin"});
   std::vector<NamedPath> outputs{{opt.events, "--events"}, {opt.state_out, "--state-out"},
                                  {opt.stats_json, "--stats-json"}, {opt.svg, "--svg"}, {opt.observe, "--observe"},
-                                 {opt.checkpoint, "--checkpoint"}};
+                                 {opt.record, "--record"}, {opt.checkpoint, "--checkpoint"}};  // the checkpoint last: see below
   if (opt.stats) outputs.push_back({"-", "--stats"});
   if (!opt.resume.empty()) {
     std::vector<NamedPath> others(outputs.begin(), outputs.end() - (opt.stats ? 2 : 1));
@@ -326,6 +342,13 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   }
   check_outputs(outputs, inputs);
   if (opt.checkpoint == "-") throw BadInput("--checkpoint needs a file name, not standard output");
+  if (!opt.record.empty()) {
+    if (opt.record == "-") throw BadInput("--record needs a file name, not standard output (replay seeks in it)");
+    if (!opt.resume.empty())
+      throw BadInput("--record with --resume: a recording starts at t = 0; record the run from the start instead");
+    if (!opt.inputs.empty())
+      throw BadInput("--record with --inputs: a recording does not carry the input log yet; drop one of the two");
+  }
   std::optional<OutputFile> events_file, state_file, stats_file, svg_file, observe_file;
   formats::ObserveOptions observing;
   if (!opt.observe.empty()) {
@@ -343,6 +366,8 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   if (!opt.stats_json.empty()) stats_file.emplace(opt.stats_json, "--stats-json");
   if (!opt.svg.empty()) svg_file.emplace(opt.svg, "--svg");
   if (!opt.checkpoint.empty()) OutputFile probe(opt.checkpoint, "--checkpoint");  // checks the path only
+  std::optional<OutputFile> record_file;
+  if (!opt.record.empty()) record_file.emplace(opt.record, "--record", OutputFile::Write::growing);
 
   world::Scene scene = load(opt.world, registry);
   sim::WorldDef& def = scene.def;
@@ -366,6 +391,19 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   limits.max_wall_seconds = opt.max_wall_seconds;
   limits.max_events = opt.max_events;
   limits.checkpoint_every = opt.checkpoint_every;
+  if (record_file && opt.keyframe_seconds > 0.0) limits.keyframe_every = opt.keyframe_seconds;
+  std::optional<formats::RecordingWriter> recorder;
+  if (record_file) {
+    formats::RecordingHeader h;
+    h.command = "run";
+    h.world_file = opt.world;
+    h.world = read_world_json(opt.world);
+    h.mode = sim::to_string(mode);
+    h.dt = def.dt;
+    h.until = opt.until;
+    h.keyframes = {opt.keyframe_seconds, opt.keyframe_events};
+    recorder.emplace(record_file->stream(), h);
+  }
   // Exactly one of these runs the scene: the bare engine, or the world server when there are
   // turtles (which then owns the engine).
   std::optional<sim::World> bare;
@@ -450,6 +488,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
         writer->write(bare_events, names);
         events_file->flush();
       }
+      if (write && recorder) recorder->events(bare_events, names);
       bare_events.clear();
     };
   } else {
@@ -479,6 +518,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
         writer->write(server_events);
         events_file->flush();
       }
+      if (write && recorder) recorder->events(server_events);
       server_events.clear();
     };
   }
@@ -524,7 +564,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     to_checkpoint.until = resume->t;
     to_checkpoint.checkpoint_every.reset();
     end = run_in_chunks(world.time(), to_checkpoint, pace, start, progress, "replaying: ", advance,
-                        [&] { flush(false); }, [](double, const std::string&) {});
+                        [&] { flush(false); }, [](double, const std::string&) {}, [](double, std::uint64_t, bool) {});
     if (end.first == Stop::until) {
       const bool same = world.time() == resume->t && world.stats().events == resume->events &&
                         state_hash(world, current_names()) == resume->state_hash;
@@ -534,10 +574,14 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
                                  "deterministic, or a different turtlegas?); rerun from the start");
     }
   }
+  if (recorder) recorder->keyframe(world, names);  // the first, at the start
   if (end.first == Stop::until) {
     limits.until = opt.until;
     end = run_in_chunks(world.time(), limits, pace, start, progress, "", advance, [&] { flush(true); },
-                        [&](double t, const std::string& why) { write_checkpoint_at(t, why); });
+                        [&](double t, const std::string& why) { write_checkpoint_at(t, why); },
+                        [&](double, std::uint64_t events, bool at_key) {
+                          if (recorder && (at_key || recorder->keyframe_due(events))) recorder->keyframe(world, names);
+                        });
   }
   progress.clear();
   if (server) {
@@ -577,6 +621,11 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   run.max_overlap_relative = std::max(now.relative, seen.relative);
 
   if (events_file) events_file->commit();
+  if (recorder) {
+    recorder->keyframe(world, names);  // the last, at the end (none when one is there already)
+    recorder->finish(world.time(), stopped);
+    record_file->commit();
+  }
   if (state_file) {
     formats::write_state(state_file->stream(), world, current_names());
     state_file->commit();

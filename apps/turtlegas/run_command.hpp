@@ -34,6 +34,11 @@ struct RunOptions {
   std::string checkpoint;
   std::optional<double> checkpoint_every;
   std::string resume;
+  /// A recording (docs/recording.md): written to `record`, a keyframe every `keyframe_seconds`
+  /// simulated seconds and after every `keyframe_events` engine events (0 turns either off).
+  std::string record;
+  double keyframe_seconds = 1.0;
+  std::uint64_t keyframe_events = 100000;
   std::vector<std::string> plugins;  ///< for the output-is-an-input check
   /// Gas observables (formats/observables.hpp) written to `observe`, with their options.
   std::string observe;

@@ -7,7 +7,12 @@
 #include <stdexcept>
 #include <system_error>
 
+#include <spdlog/spdlog.h>
+
 #include "cli_common.hpp"
+#include "turtlegas/formats/recording.hpp"
+#include "turtlegas/world/file_error.hpp"
+#include "turtlegas/world/world_file.hpp"
 #include "turtlegas/server/serve.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 
@@ -42,6 +47,22 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommandOptions& opt) {
   s->add_option("--program-budget", opt.program_budget,
                 "Wall-clock seconds a turtle program may run without issuing a command before its world ends")
       ->capture_default_str();
+  return s;
+}
+
+CLI::App* add_replay_command(CLI::App& app, ServeCommandOptions& opt) {
+  CLI::App* s = app.add_subcommand(
+      "replay", "Serve a recording (run --record) to the viewer and the protocol: play, pause, seek, reverse, speed");
+  s->add_option("recording", opt.replay, "The recording (format turtlegas-recording/1, docs/recording.md)")->required();
+  s->add_option("--bind", opt.bind, "Address to listen on; other than loopback needs --token")->capture_default_str();
+  s->add_option("--port", opt.port, "HTTP and WebSocket port (0: any free port)")->capture_default_str();
+  s->add_option("--line-port", opt.line_port, "TCP-lines port (default: --port + 1; any free port when --port is 0)");
+  s->add_option("--speed", opt.speed, "Simulated seconds per wall second, 0.01 to 1000, or max")->capture_default_str();
+  s->add_flag("--paused", opt.paused, "Start paused");
+  s->add_option("--token", opt.token, "Token that control messages need");
+  s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the source tree's server/web)");
+  s->add_option("--max-clients", opt.max_clients, "Connections at most (WebSocket and TCP lines)")->capture_default_str();
+  s->add_option("--stack-kib", opt.stack_kib, "Each turtle program's stack, KiB")->capture_default_str();
   return s;
 }
 
@@ -102,8 +123,39 @@ int serve_command(const ServeCommandOptions& opt, const turtle::Registry& regist
   h.limits.max_rate = opt.max_rate;
   if (h.limits.max_websocket_read < opt.max_message) h.limits.max_websocket_read = opt.max_message;
 
-  world::Scene scene = load(opt.world, registry);
-  {
+  world::Scene scene;
+  if (!opt.replay.empty()) {
+    // The recording's world, re-simulated: the run is deterministic, so its states are the
+    // recorded ones to the bit (docs/recording.md, "Replay").
+    formats::Recording rec;
+    try {
+      rec = formats::read_recording(opt.replay);
+    } catch (const std::invalid_argument& e) {
+      throw BadInput(e.what());
+    }
+    if (!rec.warning.empty()) spdlog::warn("{}; the replay ends there", rec.warning);
+    const std::string label = rec.header.world_file + " (recorded in " + opt.replay + ")";
+    h.world_text = rec.header.world.dump(2);
+    try {
+      scene = world::parse_scene(h.world_text, label, registry);
+    } catch (const world::WorldFileError& e) {
+      throw BadInput(opt.replay + ": the recorded world does not load here: " + std::string(e.what()));
+    }
+    scene.def.dt = rec.header.dt;
+    const auto mode = sim::mode_from_string(rec.header.mode);
+    if (!mode) throw BadInput(opt.replay + ": /mode '" + rec.header.mode + "' is not exact or step; the recording is damaged");
+    h.mode = *mode;
+    h.world_file = label;
+    server::ReplaySource r;
+    r.path = opt.replay;
+    r.end = rec.end;
+    r.dt = rec.header.dt;
+    r.complete = rec.complete;
+    for (const formats::Keyframe& k : rec.keyframes) r.keyframes.push_back(k.t);
+    h.replay = std::move(r);
+    h.until.reset();
+  } else {
+    scene = load(opt.world, registry);
     std::ifstream in(opt.world, std::ios::binary);
     std::ostringstream text;
     text << in.rdbuf();

@@ -30,9 +30,14 @@ struct ServeCommandOptions {
   bool realtime = false;
   std::size_t stack_kib = 32;
   double program_budget = 2.0;
+  std::string replay;  ///< `turtlegas replay R.tgrec`: the recording served (docs/recording.md)
 };
 
 CLI::App* add_serve_command(CLI::App& app, ServeCommandOptions& opt);
+/// `turtlegas replay R.tgrec [--port P] [--bind A] ...`: a recording served as `serve` serves a
+/// world, to the same viewers and protocol, with play, pause, seek, reverse and speed. Its options
+/// are serve's that make sense for a recording; serve_command() runs it.
+CLI::App* add_replay_command(CLI::App& app, ServeCommandOptions& opt);
 int serve_command(const ServeCommandOptions& opt, const turtle::Registry& registry);
 
 }  // namespace turtlegas::apps

@@ -39,7 +39,8 @@ const std::vector<std::string>& message_types() {
   static const std::vector<std::string> types = {
       "hello", "subscribe", "unsubscribe", "snapshot", "pause", "resume", "step", "speed", "run_until",
       "claim", "release", "forward", "back", "left", "right", "wait", "yield", "pen", "add_wall",
-      "save", "load", "spawn", "remove", "teleport", "view_open", "view_change", "view_close", "ping", "stats"};
+      "save", "load", "spawn", "remove", "teleport", "view_open", "view_change", "view_close", "ping", "stats",
+      "play", "seek", "reverse"};
   return types;
 }
 

@@ -201,9 +201,15 @@ int WorldHost::run() {
       continue;
     }
     double target = server_->world().dt() > 0.0 ? static_cast<double>(server_->step() + 1) * scene_.def.dt : 0.0;
+    if (options_.replay && !replay_target(target)) {  // at an end of the recording: it pauses there
+      paused_ = true;
+      steps_left_ = 0;
+      broadcast_status();
+      continue;
+    }
     if (options_.until && target > *options_.until) target = *options_.until;
     if (speed_ > 0.0 && steps_left_ == 0) {
-      const double due = anchor_wall_ + (target - anchor_sim_) / speed_;
+      const double due = anchor_wall_ + std::abs(target - anchor_sim_) / speed_;
       if (t_now < due) {
         wait_inbox_until(std::min(deadline, due));
         continue;
@@ -213,7 +219,8 @@ int WorldHost::run() {
         anchor_sim_ = target;
       }
     }
-    step_world(target);
+    if (options_.replay && target < server_->time()) seek(target);
+    else step_world(target);
     bool changed = false;
     if (steps_left_ > 0 && --steps_left_ == 0) changed = true;
     if (pause_at_ && server_->time() >= *pause_at_) {
@@ -345,12 +352,15 @@ void WorldHost::broadcast(const std::string& text) {
 void WorldHost::broadcast_status() { broadcast(dump({{"type", "status"}, {"status", status_json()}})); }
 
 json WorldHost::status_json() const {
-  return {{"t", server_->time()},
+  json st = {{"t", server_->time()},
           {"step", server_->step()},
           {"paused", paused_ && steps_left_ == 0},
           {"speed", speed_ > 0.0 ? json(speed_) : json("max")},
           {"until", pause_at_ ? json(*pause_at_) : json(nullptr)},
           {"ended", ended_ ? json(*ended_) : json(nullptr)}};
+  if (options_.replay)
+    st["replay"] = {{"end", options_.replay->end}, {"reverse", reverse_}, {"complete", options_.replay->complete}};
+  return st;
 }
 
 json WorldHost::world_json() const {
@@ -502,7 +512,9 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     welcome["authorized"] = c.authorized;
     welcome["world"] = world_json();
     welcome["status"] = status_json();
-    welcome["capabilities"] = {"frames", "binary-frames", "control", "remote", "add_wall", "spawn", "remove", "teleport", "save", "load", "views"};
+    welcome["capabilities"] = options_.replay ? json{"frames", "binary-frames", "control", "views", "replay"}
+                                              : json{"frames", "binary-frames", "control", "remote", "add_wall", "spawn",
+                                                     "remove", "teleport", "save", "load", "views"};
     welcome["limits"] = {{"max_message", l.max_message}, {"max_rate", l.max_rate}, {"max_claims", l.max_claims}, {"max_clients", l.max_clients}};
     reply(c, welcome);
     return;
@@ -605,6 +617,30 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     return;  // answered at the next boundary
   }
 
+  if (type == "play" || type == "seek" || type == "reverse") {
+    if (!options_.replay)
+      throw RequestError("not_replay", "\"" + type + "\" is for recordings: it works in `turtlegas replay R.tgrec`, not in a live world");
+    const double end = options_.replay->end;
+    pause_at_.reset();
+    steps_left_ = 0;
+    if (type == "seek") {
+      const double t = number_field(m, "t", R"({"type": "seek", "t": 2.5})");
+      if (!(t >= 0.0 && t <= end))
+        throw RequestError("bad_value", "/t must be from 0 to the recording's end, " + fmt(end) + " s", "/t");
+      seek(t);
+      paused_ = true;
+    } else {
+      reverse_ = type == "reverse";
+      paused_ = false;
+      reanchor();
+    }
+    reply(c, ok(m, type.c_str()));
+    broadcast_status();
+    return;
+  }
+  if (options_.replay && type != "pause" && type != "resume" && type != "step" && type != "speed" && type != "run_until")
+    require_not_replay(type);
+
   if (type == "pause" || type == "resume" || type == "step" || type == "speed" || type == "run_until") {
     require_live();
     if (type == "pause" || type == "resume") pause_at_.reset();  // both cancel a run_until's stop
@@ -613,6 +649,7 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
       steps_left_ = 0;
     } else if (type == "resume") {
       paused_ = false;
+      reverse_ = false;  // a replay: forward, as play
       steps_left_ = 0;
       reanchor();
     } else if (type == "step") {
@@ -640,6 +677,9 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
       const double t = number_field(m, "t", R"({"type": "run_until", "t": 10})");
       if (!(t > server_->time()))
         throw RequestError("bad_value", "/t must be later than the world's time (" + fmt(server_->time()) + " s)", "/t");
+      if (options_.replay && t > options_.replay->end)
+        throw RequestError("bad_value", "/t must be at most the recording's end, " + fmt(options_.replay->end) + " s", "/t");
+      reverse_ = false;
       pause_at_ = t;
       paused_ = false;
       steps_left_ = 0;
@@ -741,6 +781,10 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
 }
 
 void WorldHost::at_boundary(turtle::WorldServer& server, std::uint64_t step) {
+  // A replay has no remote turtles and takes no changes; and its messages must wait for the main
+  // loop: a seek handled here, inside run_until, would rebuild the world under it, and a state
+  // request would see a seek's way rather than its end.
+  if (options_.replay) return;
   drain_inbox();
   while (!takeovers_.empty()) {
     const Takeover t = takeovers_.front();
@@ -916,6 +960,54 @@ void WorldHost::do_file_requests() {
     for (auto& [cid, c] : clients_)
       if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"], looks_));
   }
+}
+
+void WorldHost::require_not_replay(const std::string& type) const {
+  if (options_.replay)
+    throw RequestError("replay", "\"" + type + "\" would change the world, and this is a replay of " + options_.replay->path +
+                                     ": it can only play, pause, seek, reverse, step and change speed");
+}
+
+bool WorldHost::replay_target(double& target) {
+  const double t = server_->time(), dt = scene_.def.dt, end = options_.replay->end;
+  if (!reverse_ || steps_left_ > 0) {
+    if (t >= end) return false;
+    if (!(target > t)) target = std::nextafter(t, INFINITY);
+    target = std::min(target, end);
+    return true;
+  }
+  if (t <= 0.0) return false;
+  target = dt > 0.0 ? std::max(0.0, (std::ceil(t / dt) - 1.0) * dt) : 0.0;
+  if (!(target < t)) target = std::max(0.0, target - dt);
+  return true;
+}
+
+void WorldHost::seek(double t) {
+  const bool rebuild = t < server_->time();
+  fan_out_events();
+  if (rebuild) {
+    world::Scene scene = world::parse_scene(world_text(), options_.world_file, registry_);
+    scene.def.dt = options_.replay->dt;
+    build_world(std::move(scene));
+  }
+  in_step_ = true;
+  try {
+    server_->run_until(t);
+  } catch (const std::exception& e) {
+    in_step_ = false;
+    events_.clear();
+    end_world(e.what());
+    return;
+  }
+  in_step_ = false;
+  events_.clear();  // what happened on the way is not shown: the viewer jumps
+  reanchor();
+  if (!rebuild) return;
+  std::map<std::string, FrameStream> fresh;
+  for (auto& [key, s] : streams_) fresh.try_emplace(key, s.kind(), *server_).first->second.next_due = now();
+  streams_ = std::move(fresh);
+  for (auto& [cid, c] : clients_)
+    if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"], looks_));
 }
 
 }  // namespace turtlegas::server

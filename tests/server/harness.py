@@ -23,9 +23,9 @@ def world(name):
 
 
 class Server:
-    def __init__(self, world_file, *args, start_timeout=30.0):
+    def __init__(self, world_file, *args, start_timeout=30.0, command="serve"):
         self.stderr = tempfile.TemporaryFile()
-        cmd = [BIN, "serve", world_file, "--port", "0", *map(str, args)]
+        cmd = [BIN, command, world_file, "--port", "0", *map(str, args)]
         self.cmd = cmd
         self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.stderr)
         lines = []

@@ -10,16 +10,18 @@ import os
 import re
 import shutil
 import struct
+import subprocess
 import tempfile
 import time
 
-from harness import ROOT, Server, check, main, world
+from harness import BIN, ROOT, Server, check, main, world
 from turtlegas_client import World, decode_binary_frame
 
 DOC = os.path.join(ROOT, "docs", "protocol.md")
 REQUESTS = {"hello", "subscribe", "unsubscribe", "snapshot", "pause", "resume", "step", "speed", "run_until",
             "claim", "release", "forward", "back", "left", "right", "wait", "yield", "pen", "add_wall", "save",
             "load", "view_open", "view_change", "view_close", "ping", "stats", "spawn", "remove", "teleport"}
+REPLAY_REQUESTS = {"play", "seek", "reverse"}  # `turtlegas replay` only (test_replay_examples)
 
 
 def doc_examples():
@@ -33,7 +35,7 @@ def doc_examples():
             objects = [json.loads(line) for line in block.splitlines() if line.strip()]
         for o in objects:
             kind = o["type"]
-            is_request = kind in REQUESTS and ("protocol" in o or kind != "hello") and kind not in ("stats", "snapshot") or \
+            is_request = kind in REPLAY_REQUESTS or kind in REQUESTS and ("protocol" in o or kind != "hello") and kind not in ("stats", "snapshot") or \
                 (kind in ("stats", "snapshot") and set(o) <= {"type", "id"})
             (requests if is_request else replies).setdefault(kind, []).append(o)
     return requests, replies
@@ -293,6 +295,44 @@ def test_resume_cancels_run_until():
         s.stop()
 
 
+def test_replay_examples():
+    """The replay messages' examples, to `turtlegas replay` of a recording; a live world refuses them."""
+    check(REQUESTS_DOC.keys() >= REPLAY_REQUESTS, "the page has an example of every replay request")
+    d = tempfile.mkdtemp()
+    try:
+        rec = os.path.join(d, "square.tgrec")
+        subprocess.run([BIN, "run", os.path.join(ROOT, "worlds", "square.json"), "--until", "5", "--record", rec],
+                       check=True, timeout=120)
+        with Server(rec, "--paused", command="replay") as s:
+            w = World.connect("127.0.0.1", s.line_port)
+            check("replay" in w.welcome["capabilities"] and "remote" not in w.welcome["capabilities"], "replay capabilities")
+            reply_shape("welcome", w.welcome)
+            for kind in ("seek", "reverse", "play"):
+                for example in REQUESTS_DOC[kind]:
+                    r = ask(w, example)
+                    reply_shape("ok", r)
+                    check(r["request"] == kind and r["status"]["replay"]["end"] == 5, "ok names its request: %r" % r)
+            w.pause()
+            wall = {k: v for k, v in REQUESTS_DOC["add_wall"][0].items() if k != "id"}
+            for kind, m in (("claim", {"type": "claim", "turtle": "cw"}), ("add_wall", wall)):
+                try:
+                    w.request(m)
+                    check(False, kind + " is refused in a replay")
+                except Exception as e:
+                    check(e.reply["code"] == "replay", "%s: code replay (%r)" % (kind, e.reply))
+            w.close()
+        with Server(world("protocol_room.json"), "--paused") as s:
+            w = World.connect("127.0.0.1", s.line_port)
+            try:
+                w.request({"type": "seek", "t": 1})
+                check(False, "a live world refuses seek")
+            except Exception as e:
+                check(e.reply["code"] == "not_replay", "seek in a live world: not_replay (%r)" % e.reply)
+            w.close()
+    finally:
+        shutil.rmtree(d)
+
+
 if __name__ == "__main__":
-    main([test_doc_examples_over_lines, test_doc_examples_over_websocket, test_binary_frames, test_region,
+    main([test_replay_examples, test_doc_examples_over_lines, test_doc_examples_over_websocket, test_binary_frames, test_region,
           test_resume_cancels_run_until])

@@ -40,6 +40,18 @@ namespace turtlegas::server {
 /// view_open, view_change or view_close (view_messages.cpp).
 bool is_view_message(const std::string& type);
 
+/// `turtlegas replay` (docs/recording.md): the host plays a recording instead of serving a live
+/// world. The world is the recording's, re-simulated (the run is deterministic, so the states are
+/// the recorded run's to the bit); time goes from 0 to `end` and back (seek, reverse); nothing a
+/// client sends changes the world (claims, commands, walls, save and load are refused).
+struct ReplaySource {
+  std::string path;           ///< the recording, for messages
+  double end = 0.0;           ///< the last time the recording vouches for
+  double dt = 0.0;            ///< the recorded run's (after its --dt), for the rebuilt worlds
+  bool complete = true;       ///< false: it was cut, and `end` is its last keyframe's time
+  std::vector<double> keyframes;  ///< their times
+};
+
 struct HostOptions {
   std::string world_file;   ///< as given, for messages
   std::string world_text;   ///< GET /api/world
@@ -56,6 +68,7 @@ struct HostOptions {
   std::size_t stack_bytes = 32 * 1024;
   double program_budget = 2.0;
   Limits limits;
+  std::optional<ReplaySource> replay;  ///< set: a replay (ReplaySource)
 };
 
 class WorldHost {
@@ -173,6 +186,12 @@ class WorldHost {
   void write_input(const std::string& line);
   double now() const;  ///< steady clock, seconds
   void reanchor();
+  void require_not_replay(const std::string& type) const;
+  /// A replay to time t: on from now when t is later, else the world rebuilt from its file and
+  /// re-simulated from 0 (its events dropped); subscribers get a fresh snapshot after a rebuild.
+  void seek(double t);
+  /// A replay's next target when it plays, forward or in reverse, and whether it has one.
+  bool replay_target(double& target);
 
   HostOptions options_;
   const turtle::Registry& registry_;
@@ -201,6 +220,7 @@ class WorldHost {
   bool stopping_ = false;
   std::string stop_reason_;
   bool in_step_ = false;
+  bool reverse_ = false;  ///< a replay plays backwards
   std::uint64_t frames_built_ = 0;
   mutable std::mutex text_mutex_;  // options_.world_text, read by HTTP sessions
   // The inbox.

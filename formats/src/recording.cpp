@@ -1,0 +1,278 @@
+// SPDX-License-Identifier: MIT
+#include "turtlegas/formats/recording.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+#include <string_view>
+
+#include "turtlegas/formats/json_text.hpp"
+#include "turtlegas/formats/state_file.hpp"
+
+namespace turtlegas::formats {
+namespace {
+
+using nlohmann::json;
+
+bool starts_with(std::string_view s, std::string_view p) { return s.substr(0, p.size()) == p; }
+
+}  // namespace
+
+RecordingWriter::RecordingWriter(std::ostream& out, const RecordingHeader& h) : out_(out), policy_(h.keyframes) {
+  // Ordered, so that the format comes first (nlohmann::json sorts its keys).
+  const nlohmann::ordered_json header = {
+      {"format", recording_format},
+      {"command", h.command},
+      {"world_file", h.world_file},
+      {"mode", h.mode},
+      {"dt", h.dt},
+      {"until", h.until},
+      {"keyframes", {{"every_seconds", h.keyframes.seconds}, {"every_events", h.keyframes.events}}},
+      {"world", h.world},
+  };
+  buf_ = header.dump();
+  buf_ += '\n';
+  put();
+}
+
+void RecordingWriter::events(std::span<const turtle::LogEvent> events) {
+  buf_.clear();
+  for (const turtle::LogEvent& e : events) append_event(buf_, event_line(e));
+  lines_ += events.size();
+  put();
+}
+
+void RecordingWriter::put() {
+  out_.write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+  offset_ += buf_.size();
+}
+
+bool RecordingWriter::keyframe_due(std::uint64_t engine_events) const {
+  if (index_.empty()) return true;
+  return policy_.events > 0 && engine_events - last_events_ >= policy_.events;
+}
+
+void RecordingWriter::keyframe(const sim::World& world, const RunNames& names) {
+  if (!index_.empty() && world.time() == index_.back().t) return;  // one keyframe a time
+  std::ostringstream state;
+  write_state(state, world, names);
+  std::string text = state.str();
+  // The state file's layout has newlines between bodies; a recording has one line a keyframe.
+  // (Ids are JSON strings, whose control characters are escaped, so every raw newline is layout.)
+  std::erase(text, '\n');
+  const std::vector<sim::WallDef>& walls = world.walls();
+  if (!base_walls_) base_walls_ = walls.size();
+  buf_ = "{\"keyframe\": " + std::to_string(index_.size()) + ", \"t\": ";
+  append_number(buf_, world.time());
+  buf_ += ", \"events\": " + std::to_string(world.stats().events) + ", \"lines\": " + std::to_string(lines_) +
+          ", \"walls\": " + std::to_string(walls.size()) + ", \"added_walls\": [";
+  for (std::size_t i = *base_walls_; i < walls.size(); ++i) {
+    if (i > *base_walls_) buf_ += ", ";
+    buf_ += '[';
+    append_number(buf_, walls[i].from.x);
+    buf_ += ", ";
+    append_number(buf_, walls[i].from.y);
+    buf_ += ", ";
+    append_number(buf_, walls[i].to.x);
+    buf_ += ", ";
+    append_number(buf_, walls[i].to.y);
+    buf_ += ']';
+  }
+  buf_ += "], \"state\": " + text + "}\n";
+  index_.push_back({world.time(), offset_, lines_, world.stats().events});
+  last_events_ = world.stats().events;
+  put();
+  out_.flush();
+}
+
+void RecordingWriter::finish(double t, const std::string& stopped) {
+  using ojson = nlohmann::ordered_json;
+  ojson entries = ojson::array();
+  for (const Entry& e : index_) entries.push_back({{"t", e.t}, {"offset", e.offset}, {"lines", e.lines}, {"events", e.events}});
+  const std::uint64_t at = offset_;
+  buf_ = ojson{{"index", entries}, {"end", t}, {"lines", lines_}, {"stopped", stopped}}.dump() + "\n";
+  buf_ += "{\"end_of_recording\": " + std::to_string(at) + "}\n";
+  put();
+  out_.flush();
+}
+
+namespace {
+
+RecordingHeader parse_header(const std::string& line, const std::string& path) {
+  const std::string where = path + ": ";
+  nlohmann::ordered_json h;
+  try {
+    h = nlohmann::ordered_json::parse(line);
+  } catch (const json::exception&) {
+    throw std::invalid_argument(where + "not a recording (its first line is not JSON); write one with `turtlegas run "
+                                        "WORLD --until T --record R.tgrec`");
+  }
+  if (!h.is_object() || h.value("format", std::string()) != recording_format)
+    throw std::invalid_argument(where + "not a recording: /format must be \"" + std::string(recording_format) +
+                                "\" (write one with `turtlegas run WORLD --until T --record R.tgrec`)");
+  RecordingHeader r;
+  try {
+    r.world_file = h.at("world_file").get<std::string>();
+    r.world = h.at("world");
+    r.mode = h.at("mode").get<std::string>();
+    r.dt = h.at("dt").get<double>();
+    r.until = h.at("until").get<double>();
+    r.command = h.value("command", std::string("run"));
+    r.keyframes.seconds = h.at("keyframes").at("every_seconds").get<double>();
+    r.keyframes.events = h.at("keyframes").at("every_events").get<std::uint64_t>();
+  } catch (const json::exception& e) {
+    throw std::invalid_argument(where + "the header (line 1) lacks a key or has one of the wrong type (" +
+                                std::string(e.what()) + "); the recording is damaged");
+  }
+  if (!r.world.is_object()) throw std::invalid_argument(where + "/world: not an object; the recording is damaged");
+  return r;
+}
+
+Keyframe parse_keyframe(const json& j) {
+  Keyframe k;
+  k.t = j.at("t").get<double>();
+  k.events = j.at("events").get<std::uint64_t>();
+  k.lines = j.at("lines").get<std::uint64_t>();
+  return k;
+}
+
+std::string human_bytes(std::uint64_t b) {
+  std::ostringstream s;
+  if (b < 10000) s << b << " bytes";
+  else s << (b + 512) / 1024 << " KiB";
+  return s.str();
+}
+
+}  // namespace
+
+Recording read_recording(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::invalid_argument(path + ": no such file, or it cannot be read");
+  Recording r;
+  in.seekg(0, std::ios::end);
+  r.bytes = static_cast<std::uint64_t>(in.tellg());
+  in.seekg(0);
+  std::string line;
+  if (!std::getline(in, line) || in.eof())
+    throw std::invalid_argument(path + ": not a recording, or cut before the end of its header (line 1)");
+  r.header = parse_header(line, path);
+  const std::uint64_t header_end = line.size() + 1;
+
+  // The fast way: the last line names the index's offset.
+  if (r.bytes > header_end) {
+    const std::uint64_t tail = std::min<std::uint64_t>(r.bytes - header_end, 64);
+    std::string last(tail, '\0');
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(r.bytes - tail));
+    in.read(last.data(), static_cast<std::streamsize>(tail));
+    if (!last.empty() && last.back() == '\n') {
+      last.pop_back();
+      const std::size_t nl = last.rfind('\n');
+      const std::string end_line = nl == std::string::npos ? last : last.substr(nl + 1);
+      if (starts_with(end_line, "{\"end_of_recording\":")) {
+        try {
+          const std::uint64_t at = json::parse(end_line).at("end_of_recording").get<std::uint64_t>();
+          in.clear();
+          in.seekg(static_cast<std::streamoff>(at));
+          std::string index_line;
+          std::getline(in, index_line);
+          const json idx = json::parse(index_line);
+          for (const json& e : idx.at("index")) {
+            Keyframe k;
+            k.t = e.at("t").get<double>();
+            k.offset = e.at("offset").get<std::uint64_t>();
+            k.lines = e.at("lines").get<std::uint64_t>();
+            k.events = e.at("events").get<std::uint64_t>();
+            r.keyframes.push_back(std::move(k));
+          }
+          r.end = idx.at("end").get<double>();
+          r.stopped = idx.value("stopped", std::string());
+          r.complete = true;
+        } catch (const json::exception&) {
+          r.keyframes.clear();  // a damaged index: the scan below
+        }
+      }
+    }
+  }
+  if (r.complete && !r.keyframes.empty()) return r;
+
+  // The slow way: every line, keeping what precedes the last whole keyframe.
+  r.complete = false;
+  in.clear();
+  in.seekg(static_cast<std::streamoff>(header_end));
+  std::uint64_t offset = header_end, lines = 0;
+  while (std::getline(in, line)) {
+    const bool whole = !in.eof();  // a last line without its newline was cut
+    if (!whole) break;
+    if (starts_with(line, "{\"keyframe\":")) {
+      try {
+        Keyframe k = parse_keyframe(json::parse(line));
+        k.offset = offset;
+        r.keyframes.push_back(std::move(k));
+      } catch (const json::exception&) {
+        break;  // a damaged keyframe: nothing after it is vouched for
+      }
+    } else if (starts_with(line, "{\"t\":")) {
+      ++lines;
+    } else if (starts_with(line, "{\"index\":") || starts_with(line, "{\"end_of_recording\":")) {
+      // A finished recording whose end line is damaged: what precedes is whole.
+    } else {
+      break;
+    }
+    offset += line.size() + 1;
+  }
+  if (r.keyframes.empty())
+    throw std::invalid_argument(path + ": the recording has no whole keyframe (it was cut before the first, at t = 0); "
+                                       "record the run again");
+  const Keyframe& last = r.keyframes.back();
+  r.end = last.t;
+  r.dropped_events = lines - last.lines;
+  r.dropped_bytes = r.bytes - last.offset;
+  std::ostringstream w;
+  w << path << ": the recording is incomplete (no index at its end: the run was killed, or the file was cut); "
+    << "recovered " << r.keyframes.size() << " keyframe" << (r.keyframes.size() == 1 ? "" : "s") << ", t = 0 to "
+    << last.t << " s and " << last.lines << " events; dropped what follows the last keyframe (" << r.dropped_events
+    << " events, " << human_bytes(r.dropped_bytes) << " including the keyframe line's own state)";
+  r.warning = w.str();
+  return r;
+}
+
+Keyframe read_keyframe(const std::string& path, const Keyframe& at) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::invalid_argument(path + ": cannot be read");
+  in.seekg(static_cast<std::streamoff>(at.offset));
+  std::string line;
+  std::getline(in, line);
+  try {
+    const json j = json::parse(line);
+    Keyframe k = parse_keyframe(j);
+    k.offset = at.offset;
+    k.state = j.at("state");
+    k.walls = j.at("walls").get<std::uint64_t>();
+    k.added_walls = j.at("added_walls");
+    return k;
+  } catch (const json::exception& e) {
+    throw std::invalid_argument(path + ": the keyframe at byte " + std::to_string(at.offset) + " is damaged (" + e.what() +
+                                ")");
+  }
+}
+
+std::string recording_events(const std::string& path, std::uint64_t lines) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::invalid_argument(path + ": cannot be read");
+  std::string line, out;
+  std::getline(in, line);  // the header
+  std::uint64_t n = 0;
+  while (n < lines && std::getline(in, line)) {
+    if (!starts_with(line, "{\"t\":")) continue;
+    out += line;
+    out += '\n';
+    ++n;
+  }
+  return out;
+}
+
+}  // namespace turtlegas::formats
