@@ -574,13 +574,13 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
                                  "deterministic, or a different turtlegas?); rerun from the start");
     }
   }
-  if (recorder) recorder->keyframe(world, names);  // the first, at the start
+  if (recorder) recorder->keyframe(world, current_names());  // the first, at the start
   if (end.first == Stop::until) {
     limits.until = opt.until;
     end = run_in_chunks(world.time(), limits, pace, start, progress, "", advance, [&] { flush(true); },
                         [&](double t, const std::string& why) { write_checkpoint_at(t, why); },
                         [&](double, std::uint64_t events, bool at_key) {
-                          if (recorder && (at_key || recorder->keyframe_due(events))) recorder->keyframe(world, names);
+                          if (recorder && (at_key || recorder->keyframe_due(events))) recorder->keyframe(world, current_names());
                         });
   }
   progress.clear();
@@ -622,7 +622,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
 
   if (events_file) events_file->commit();
   if (recorder) {
-    recorder->keyframe(world, names);  // the last, at the end (none when one is there already)
+    recorder->keyframe(world, current_names());  // the last, at the end (none when one is there already)
     recorder->finish(world.time(), stopped);
     record_file->commit();
   }
