@@ -45,19 +45,11 @@ void tag_camera(turtle::Turtle& t, const turtle::Params& p) {
     if (t.it()) {
       const auto moved = t.forward(leg * (0.5 + t.uniform()));
       sync_view(t, view, camera);
-      if (moved.touched()) {
-        if (moved.touch().kind != "turtle") t.back(back_off);
-        detail::turn_away(t, moved.touch().bearing, 70.0);
-      } else {
-        t.right((2.0 * t.uniform() - 1.0) * 90.0);
-      }
+      detail::after_sweep(t, moved, back_off);
     } else {
       const auto still = t.wait(1.0);
       sync_view(t, view, camera);
-      if (still.touched() && still.touch().kind == "turtle" && !t.it()) {
-        detail::turn_away(t, still.touch().bearing, 30.0);
-        t.forward(flee);
-      }
+      detail::flee_touch(t, still, flee);
     }
   }
 }

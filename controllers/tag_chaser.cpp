@@ -51,20 +51,10 @@ void tag_chaser(turtle::Turtle& t, const turtle::Params& p) {
         t.forward(lunge);
         continue;
       }
-      const auto moved = t.forward(leg * (0.5 + t.uniform()));
-      if (moved.touched()) {
-        if (moved.touch().kind != "turtle") t.back(back_off);
-        detail::turn_away(t, moved.touch().bearing, 70.0);
-      } else {
-        t.right((2.0 * t.uniform() - 1.0) * 90.0);
-      }
+      detail::after_sweep(t, t.forward(leg * (0.5 + t.uniform())), back_off);
     } else {
       pending.reset();
-      const auto still = t.wait(1.0);
-      if (still.touched() && still.touch().kind == "turtle" && !t.it()) {
-        detail::turn_away(t, still.touch().bearing, 30.0);
-        t.forward(flee);
-      }
+      detail::flee_touch(t, t.wait(1.0), flee);
     }
   }
 }
