@@ -16,6 +16,7 @@
 
 #include "bench_common.hpp"
 #include "fiber.hpp"
+#include "turtle_lattice.hpp"
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/turtle/world_server.hpp"
@@ -77,35 +78,7 @@ int main(int argc, char** argv) {
   }
   const long rss0 = status_kib("VmRSS");
 
-  // A square arena with walls and a few interior walls; turtles on a lattice, 30 units apart,
-  // radius 5, headings spread round the compass.
-  const int side = static_cast<int>(std::ceil(std::sqrt(turtles)));
-  const double pitch = 30.0, size = side * pitch + 40.0;
-  sim::WorldDef def;
-  def.name = "turtle bench";
-  def.seed = 1;
-  def.dt = 0.1;
-  def.arena.width = def.arena.height = size;
-  def.arena.boundary = sim::Boundary::walls;
-  for (int k = 1; k < 4; ++k) {
-    const double y = 20.0 + pitch * (k * side / 4);  // midway between two lattice rows
-    def.walls.push_back({"bar" + std::to_string(k), {size * 0.2, y}, {size * 0.8, y}});
-  }
-  std::vector<turtle::TurtleProgram> programs;
-  for (int k = 0; k < turtles; ++k) {
-    sim::TurtleDef t;
-    t.id = "t" + std::to_string(k);
-    t.pos = {20.0 + pitch * (k % side) + pitch / 2, 20.0 + pitch * (k / side) + pitch / 2};
-    t.heading = std::fmod(k * 2.399963, 2 * M_PI);  // golden-angle spread
-    t.radius = 5;
-    t.speed = 20;
-    t.turn_rate = M_PI;
-    def.turtles.push_back(t);
-    turtle::TurtleProgram p;
-    p.controller = controller;
-    p.params = {{"step", 60.0}, {"back_off", 2.0}};
-    programs.push_back(p);
-  }
+  const auto [def, programs] = bench::turtle_lattice(turtles, "turtle bench", 1, controller);
   turtle::ServerOptions options;
   options.mode = mode;
   options.stack_bytes = stack_kib * 1024;

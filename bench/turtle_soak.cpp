@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "turtle_lattice.hpp"
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/turtle/world_server.hpp"
@@ -38,35 +39,9 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  // Turtles of radius 5 on a lattice 30 apart, headings spread round the compass, wandering with
-  // random turns; three interior bars.
-  const int side = static_cast<int>(std::ceil(std::sqrt(turtles)));
-  const double pitch = 30.0, size = side * pitch + 40.0, radius = 5.0;
-  sim::WorldDef def;
-  def.name = "turtle soak";
-  def.seed = 17;
-  def.dt = 0.1;
-  def.arena.width = def.arena.height = size;
-  def.arena.boundary = sim::Boundary::walls;
-  for (int k = 1; k < 4; ++k) {
-    const double y = 20.0 + pitch * (k * side / 4);
-    def.walls.push_back({"bar" + std::to_string(k), {size * 0.2, y}, {size * 0.8, y}});
-  }
-  std::vector<turtle::TurtleProgram> programs;
-  for (int k = 0; k < turtles; ++k) {
-    sim::TurtleDef t;
-    t.id = "t" + std::to_string(k);
-    t.pos = {20.0 + pitch * (k % side) + pitch / 2, 20.0 + pitch * (k / side) + pitch / 2};
-    t.heading = std::fmod(k * 2.399963, 2 * M_PI);
-    t.radius = radius;
-    t.speed = 20;
-    t.turn_rate = M_PI;
-    def.turtles.push_back(t);
-    turtle::TurtleProgram p;
-    p.controller = "wander";
-    p.params = {{"step", 60.0}, {"back_off", 2.0}};
-    programs.push_back(p);
-  }
+  // Turtles of radius 5 on a lattice 30 apart, wandering with random turns; three interior bars.
+  const auto [def, programs] = bench::turtle_lattice(turtles, "turtle soak", 17, "wander");
+  const double radius = 5.0, size = def.arena.width;
   turtle::ServerOptions options;
   options.mode = mode;
   options.program_budget = 10.0;
