@@ -26,7 +26,8 @@
 #   SCALING_ROUNDS [3]
 #   PER_DISC     collisions per disc of the shared start's equilibration [10]
 #   CORE         taskset core, empty for none [1]
-#   PEERS_DIR    the peers' sources [../shared/peers beside the checkout]
+#   PEERS_DIR    the peers' sources [../shared/peers beside the checkout, or beside the main
+#                checkout when this is a git worktree]
 #   BUILD_DIR    turtlegas build [build-bench]; an existing Release build is reused as it is
 #   PEER_BUILD   [build-peers]; its starts/ keeps the equilibrated starts between runs
 #
@@ -41,6 +42,11 @@ main() {
   build=${BUILD_DIR:-$root/build-bench}
   peer_build=${PEER_BUILD:-$root/build-peers}
   peers_dir=${PEERS_DIR:-$root/../shared/peers}
+  if [[ -z ${PEERS_DIR:-} && ! -d $peers_dir ]]; then
+    # A git worktree (../wt/NAME) sits one level deeper than the main checkout: look beside that.
+    common=$(git -C "$root" rev-parse --path-format=absolute --git-common-dir 2>/dev/null || true)
+    [[ -n $common ]] && peers_dir=$(dirname "$(dirname "$common")")/shared/peers
+  fi
   quick=0
   if [[ ${1:-} == --quick ]]; then quick=1; fi
 
