@@ -171,6 +171,7 @@ void WorldHost::drain_inbox() {
   std::deque<Inbound> batch;
   {
     std::lock_guard lock(mutex_);
+    if (inbox_.empty()) return;  // most boundaries: no deque to build (it allocates) and free
     batch.swap(inbox_);
   }
   for (Inbound& in : batch) handle(in);
