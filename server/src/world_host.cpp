@@ -696,6 +696,8 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     const bool takeover = optional_bool(m, "takeover", ex).value_or(false);
     Slot& s = slots_[i];
     const std::string& tid = scene_.def.turtles[i].id;
+    if (server_->turtle_status(i).gone)
+      throw RequestError("unknown_turtle", "/turtle: '" + tid + "' is no longer in the world (removed, crushed or out of an open arena); claim a turtle that is", "/turtle");
     if (s.owner == c.client->id) throw RequestError("claimed", "/turtle: this connection has claimed '" + tid + "' already", "/turtle");
     if (s.owner != 0 || std::any_of(takeovers_.begin(), takeovers_.end(), [&](const Takeover& t) { return t.turtle == i; }))
       throw RequestError("claimed", "/turtle: '" + tid + "' is claimed by another connection; it is free again when that one releases it or closes", "/turtle");
@@ -742,6 +744,8 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     const turtle::RemoteCommand cmd = read_command(m, type);  // the message first, then the turtle's state
     Slot& s = slots_[i];
     const std::string& tid = scene_.def.turtles[i].id;
+    if (server_->turtle_status(i).gone)
+      throw RequestError("unknown_turtle", "/turtle: '" + tid + "' is no longer in the world (removed, crushed or out of an open arena)", "/turtle");
     if (s.owner != c.client->id)
       throw RequestError("not_claimed", "/turtle: claim '" + tid + "' first: {\"type\": \"claim\", \"turtle\": \"" + tid + "\"}", "/turtle");
     if (s.busy)
