@@ -220,6 +220,7 @@ int WorldHost::run() {
         anchor_sim_ = target;
       }
     }
+    step_end_ = server_->step() + 1;
     if (options_.replay && target < server_->time()) seek(target);
     else step_world(target);
     bool changed = false;
@@ -659,7 +660,11 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
       if (auto v = optional_number(m, "steps", R"({"type": "step", "steps": 1})")) n = *v;
       if (!(n >= 1 && n <= 1e6 && n == std::floor(n)))
         throw RequestError("bad_value", "/steps must be a whole number from 1 to 1000000", "/steps");
-      steps_left_ = static_cast<std::uint64_t>(n);
+      // Counted from the boundary it is handled at. Handled inside a step, at the boundary that
+      // step ends on (a lockstep wait there, a remote turtle asked for its command), that step's
+      // own end counts one off: add it, or a `step` sent while the previous one runs is
+      // swallowed by it, and a change waiting for the boundary it asks for never comes.
+      steps_left_ = static_cast<std::uint64_t>(n) + (in_step_ && server_->step() == step_end_ ? 1 : 0);
       paused_ = true;
     } else if (type == "speed") {
       const auto f = m.find("factor");

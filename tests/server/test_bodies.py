@@ -33,6 +33,12 @@ def change(w, message, steps=1):
             return n
 
 
+def settle(w, step):
+    """Until the world has paused after boundary `step` (its status says so)."""
+    while not (w.status and w.status.get("paused") and w.status["step"] >= step):
+        w.notices.get(timeout=30)
+
+
 def code(reply):
     return reply.get("code") if reply["type"] == "error" else "ok"
 
@@ -65,6 +71,10 @@ def session(a, b, mode):
     # A remote turtle (no controller given), claimed by the other connection.
     r = change(a, {"type": "spawn", "turtle": {"id": "t-new", "pos": [300, 100], "heading": 0, "speed": 30}})
     check(code(r) == "ok" and r["kind"] == "turtle" and r["index"] == 2, "spawned a turtle: %r" % r)
+    # Claimed only once the step that spawned it has ended: a claim that lands during that
+    # boundary makes the world wait there for t-new's command (lockstep), and the teleport below
+    # would then wait for a boundary that never comes (the lockstep timeout ends the world).
+    settle(a, r["status"]["step"])
     t = b.claim("t-new")
     r = change(a, {"type": "remove", "body": "t-new"}, steps=0)
     check(code(r) == "claimed", "removing another connection's turtle is refused: %r" % r)
