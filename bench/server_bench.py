@@ -30,7 +30,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "tests", "server"))
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 import harness  # noqa: E402
-from turtlegas_client import World  # noqa: E402
+from turtlegas_client import Closed, World  # noqa: E402
 
 
 def gas_world(n, path):
@@ -196,12 +196,84 @@ def sim_speed_bench(pairs, until, d):
     return {"until": until, "bare_s": bare, "with_50_viewers_s": watched, "median_ratio": statistics.median(ratios)}
 
 
+def cpp_sim_speed_bench(pairs, until, n_balls, viewers, d, reader):
+    """Simulation speed of an n_balls gas at --speed max with `viewers` C++ readers of binary
+    frames at 30/s (bench/server_viewers) against none: wall seconds to --until, interleaved
+    pairs (bare, watched), and the median ratio watched / bare."""
+    import subprocess
+    w = gas_world(n_balls, os.path.join(d, "gas%d.json" % n_balls))
+
+    def one(k):
+        with harness.Server(w, "--speed", "max", "--paused", "--until", until) as s:
+            p = None
+            if k:
+                p = subprocess.Popen([reader, str(s.http_port), str(k), "30", "600", "binary"],
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                time.sleep(1.5)  # all connected and subscribed
+            World.connect("127.0.0.1", s.line_port).resume()
+            a = time.perf_counter()
+            s.wait(600)
+            wall = time.perf_counter() - a
+            if p:
+                p.kill()
+                p.wait()
+            return wall
+
+    ratios, bare, watched = [], [], []
+    for _ in range(pairs):
+        b = one(0)
+        v = one(viewers)
+        bare.append(b)
+        watched.append(v)
+        ratios.append(v / b)
+    return {"balls": n_balls, "viewers": viewers, "reader": "C++ binary/ws", "until": until, "bare_s": bare,
+            "with_viewers_s": watched, "ratios": ratios, "median_ratio": statistics.median(ratios)}
+
+
+def per_step_wall_follower_bench(until, d):
+    """A wall follower written as a robot control loop: one command per control step (a step's
+    worth of forward, or of turning), deciding on each result. Each command is one round trip and
+    one control step, so commands/s is the round-trip rate. One turtle, one connection, lockstep."""
+    with harness.Server(harness.world("remote_followers.json"), "--speed", "max", "--paused", "--until", until,
+                        "--inputs-out", os.path.join(d, "inputs_step.jsonl")) as s:
+        w = World.connect("127.0.0.1", s.line_port)
+        t = w.claim("righty")
+        info = w.welcome["world"]
+        dt = info["dt"]
+        step_len, step_turn = 40 * dt, 180 * dt  # the turtle's speed and turn rate (remote_followers.json)
+        w.resume()
+        a = time.perf_counter()
+        try:
+            turning = 0  # steps of turning left still to do
+            probe = 0
+            while True:
+                if turning:
+                    t.left(step_turn)
+                    turning -= 1
+                    continue
+                r = t.forward(step_len)
+                if r.touched:
+                    t.back(step_len)
+                    turning = int(round(90 / step_turn))
+                    continue
+                probe += 1
+                if probe % 15 == 0:  # now and then, lean towards the wall on the right
+                    t.right(step_turn)
+        except Closed:
+            pass
+        wall = time.perf_counter() - a
+        s.wait(60)
+        commands = sum(1 for _ in open(os.path.join(d, "inputs_step.jsonl"))) - 1
+    return {"python per-step wall follower (1 turtle)": {"commands": commands, "steps": int(round(until / dt)),
+                                                          "wall_s": wall, "commands_per_s": commands / wall}}
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--turtlegas", default=os.path.join(ROOT, "build", "release", "turtlegas"))
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--cpp-viewers", help="bench/server_viewers (built with the benchmarks): C++ readers for the binary frames")
-    ap.add_argument("--only", choices=("frames", "latency", "speed"), help="run one part")
+    ap.add_argument("--only", choices=("frames", "latency", "speed", "cpp-frames", "cpp-speed", "per-step"), help="run one part")
     a = ap.parse_args()
     harness.BIN = a.turtlegas
     secs = 2.0 if a.quick else 4.0
@@ -218,6 +290,13 @@ def main():
             print(json.dumps(latency_bench(500 if a.quick else 2000, d)), flush=True)
         if a.only in (None, "speed"):
             print(json.dumps(sim_speed_bench(3 if a.quick else 5, 20 if a.quick else 40, d)), flush=True)
+        if a.only == "cpp-frames":
+            for viewers in (1, 10, 50):
+                print(json.dumps(cpp_frames_bench(10000, viewers, secs, d, a.cpp_viewers)), flush=True)
+        if a.only in (None, "cpp-speed") and a.cpp_viewers:
+            print(json.dumps(cpp_sim_speed_bench(3 if a.quick else 5, 20 if a.quick else 40, 10000, 50, d, a.cpp_viewers)), flush=True)
+        if a.only in (None, "per-step"):
+            print(json.dumps(per_step_wall_follower_bench(100 if a.quick else 300, d)), flush=True)
 
 
 if __name__ == "__main__":

@@ -213,8 +213,16 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
   for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
     const auto& t = snap.turtles[i];
     if (t.trail.size() < 2 || !trails) continue;
-    cairo_move_to(cr, t.trail[0].x, t.trail[0].y);
-    for (std::size_t k = 1; k < t.trail.size(); ++k) cairo_line_to(cr, t.trail[k].x, t.trail[k].y);
+    bool gap = true;  // a break between strokes (the pen lifted, or a teleport)
+    for (const sim::Vec2 p : t.trail) {
+      if (turtle::is_trail_break(p)) {
+        gap = true;
+        continue;
+      }
+      if (gap) cairo_move_to(cr, p.x, p.y);
+      else cairo_line_to(cr, p.x, p.y);
+      gap = false;
+    }
     set_rgb(cr, turtle_colours[i % turtle_colours.size()]);
     stroke_px(cr, 1.5);
   }

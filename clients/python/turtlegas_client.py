@@ -14,15 +14,25 @@ result are handed to the turtle's on_touch / on_message handlers (in the calling
 before the command returns), as a C++ program's handlers see them. Several turtles can be driven
 from one connection, each from its own thread (`World.run_turtles`), which a lockstep world needs
 when one client drives two turtles.
+
+Replies are read by the thread that waits for them: no reader thread stands between the socket
+and a command's caller (a hand-off between threads costs tens of microseconds, more than the rest
+of a round trip; docs/performance.md, "The world server"). When several threads wait, one reads
+for all and passes the others' messages on. Frames and notices are read the same way, by
+`world.frames.get()` and `world.notices.get()`; `World.connect(..., background=True)` starts a
+thread that keeps reading when nobody waits (a viewer that does other work between frames).
 """
 
 import base64
+import collections
 import json
 import os
 import queue
+import select
 import socket
 import struct
 import threading
+import time
 
 PROTOCOL = "turtlegas/1"
 
@@ -84,21 +94,41 @@ class Result:
 
 # ---- transports ---------------------------------------------------------------------------------
 
+def _wait_readable(sock, deadline):
+    """Blocks until `sock` has data; TimeoutError at `deadline` (time.monotonic(), None: never)."""
+    if deadline is None:
+        return
+    left = max(0.0, deadline - time.monotonic())
+    if not select.select([sock], [], [], left)[0]:
+        raise TimeoutError
+
+
 class _Lines:
     def __init__(self, host, port, timeout):
         self.sock = socket.create_connection((host, port), timeout=timeout)
         self.sock.settimeout(None)
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.file = self.sock.makefile("rb")
+        self.buf = bytearray()
 
     def send(self, text):
         self.sock.sendall(text.encode("utf-8") + b"\n")
 
-    def receive(self):
-        line = self.file.readline()
-        if not line:
-            return None
-        return line.decode("utf-8")
+    def receive(self, deadline=None):
+        """The next line (str); None at the end; TimeoutError at `deadline` (nothing is lost)."""
+        while True:
+            i = self.buf.find(b"\n")
+            if i >= 0:
+                line = bytes(self.buf[:i])
+                del self.buf[:i + 1]
+                return line.decode("utf-8", "replace")
+            _wait_readable(self.sock, deadline)
+            try:
+                chunk = self.sock.recv(262144)
+            except OSError:
+                return None
+            if not chunk:
+                return None
+            self.buf += chunk
 
     def close(self):
         try:
@@ -117,14 +147,21 @@ class _WebSocket:
         key = base64.b64encode(os.urandom(16)).decode()
         self.sock.sendall(("GET %s HTTP/1.1\r\nHost: %s:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
                            "Sec-WebSocket-Key: %s\r\nSec-WebSocket-Version: 13\r\n\r\n" % (path, host, port, key)).encode())
-        self.file = self.sock.makefile("rb")
-        status = self.file.readline()
-        if b" 101 " not in status:
+        self.buf = bytearray()
+        while b"\r\n\r\n" not in self.buf:
+            chunk = self.sock.recv(4096)
+            if not chunk:
+                raise ConnectionError("WebSocket upgrade: the server closed the connection")
+            self.buf += chunk
+        head, _, rest = bytes(self.buf).partition(b"\r\n\r\n")
+        self.buf = bytearray(rest)
+        status = head.split(b"\r\n", 1)[0]
+        if b" 101 " not in status + b" ":
             raise ConnectionError("WebSocket upgrade refused: %r" % status)
-        while self.file.readline() not in (b"\r\n", b""):
-            pass
         self.sock.settimeout(None)
         self.lock = threading.Lock()
+        self.message = b""   # a fragmented message so far
+        self.kind = None
 
     def _frame(self, opcode, payload):
         head = bytes([0x80 | opcode])
@@ -136,7 +173,7 @@ class _WebSocket:
         else:
             head += bytes([0x80 | 127]) + struct.pack("!Q", n)
         mask = os.urandom(4)
-        masked = bytes(b ^ mask[i % 4] for i, b in enumerate(payload)) if n < 4096 else _mask(payload, mask)
+        masked = bytes(b ^ mask[i % 4] for i, b in enumerate(payload)) if n < 64 else _mask(payload, mask)
         with self.lock:
             self.sock.sendall(head + mask + masked)
 
@@ -146,24 +183,31 @@ class _WebSocket:
     def send_raw(self, opcode, payload):
         self._frame(opcode, payload)
 
-    def _read(self, n):
-        data = self.file.read(n)
-        if data is None or len(data) < n:
-            raise EOFError
-        return data
+    def _need(self, n, deadline):
+        while len(self.buf) < n:
+            _wait_readable(self.sock, deadline)
+            chunk = self.sock.recv(max(262144, n - len(self.buf)))
+            if not chunk:
+                raise EOFError
+            self.buf += chunk
 
-    def receive(self):
-        """The next text message (str) or binary message (bytes); None at the end."""
+    def receive(self, deadline=None):
+        """The next text message (str) or binary message (bytes); None at the end; TimeoutError
+        at `deadline` (a frame is taken from the buffer only once it is whole: nothing is lost)."""
         try:
-            message = b""
             while True:
-                b0, b1 = self._read(2)
-                opcode, n = b0 & 0x0F, b1 & 0x7F
+                self._need(2, deadline)
+                b0, b1 = self.buf[0], self.buf[1]
+                opcode, n, off = b0 & 0x0F, b1 & 0x7F, 2
                 if n == 126:
-                    n = struct.unpack("!H", self._read(2))[0]
+                    self._need(4, deadline)
+                    n, off = struct.unpack_from("!H", self.buf, 2)[0], 4
                 elif n == 127:
-                    n = struct.unpack("!Q", self._read(8))[0]
-                payload = self._read(n)
+                    self._need(10, deadline)
+                    n, off = struct.unpack_from("!Q", self.buf, 2)[0], 10
+                self._need(off + n, deadline)
+                payload = bytes(self.buf[off:off + n])
+                del self.buf[:off + n]
                 if opcode == 0x8:
                     return None
                 if opcode == 0x9:
@@ -172,10 +216,13 @@ class _WebSocket:
                 if opcode == 0xA:
                     continue
                 if opcode in (0x1, 0x2):
-                    kind = opcode
-                message += payload
+                    self.kind = opcode
+                self.message += payload
                 if b0 & 0x80:
-                    return message.decode("utf-8") if kind == 0x1 else message
+                    message, self.message = self.message, b""
+                    return message.decode("utf-8", "replace") if self.kind == 0x1 else message
+        except TimeoutError:
+            raise
         except (EOFError, OSError, ValueError):
             return None
 
@@ -222,22 +269,54 @@ def decode_binary_frame(data):
 
 # ---- the world ----------------------------------------------------------------------------------
 
+_NOTHING = object()
+
+
+class Mailbox:
+    """Frames or notices as they arrive: get() reads the connection while it waits (queue-like;
+    queue.Empty at the timeout)."""
+
+    def __init__(self, world):
+        self._world = world
+        self._items = collections.deque()
+
+    def get(self, block=True, timeout=None):
+        def take():
+            return self._items.popleft() if self._items else _NOTHING
+        got = self._world._wait(take, timeout if block else 0.0, closed_value=None)
+        if got is _NOTHING:
+            raise queue.Empty
+        return got
+
+    def get_nowait(self):
+        return self.get(block=False)
+
+    def qsize(self):
+        return len(self._items)
+
+    def empty(self):
+        return not self._items
+
+
 class World:
     """One connection to a served world. Thread-safe: any thread may send and wait."""
 
-    def __init__(self, transport, token=None):
+    def __init__(self, transport, token=None, background=False):
         self._t = transport
-        self._lock = threading.Lock()
+        self._cv = threading.Condition()
+        self._reading = False     # a thread is reading the connection for everyone
         self._next_id = 0
-        self._waiting = {}        # id -> queue of the reply
+        self._replies = {}        # id -> the reply, until its requester takes it
         self._turtles = {}        # turtle id -> RemoteTurtle
         self._closed = False
         self.bye = None
         self.status = None
-        self.frames = queue.Queue()   # frames and snapshots, when subscribed (newest last)
-        self.notices = queue.Queue()  # status, world and unsolicited errors
-        self._reader = threading.Thread(target=self._read_loop, daemon=True)
-        self._reader.start()
+        self.frames = Mailbox(self)   # frames and snapshots, when subscribed (oldest first)
+        self.notices = Mailbox(self)  # status, world and unsolicited errors
+        self._reader = None
+        if background:
+            self._reader = threading.Thread(target=self._read_on, daemon=True)
+            self._reader.start()
         hello = {"type": "hello", "protocol": PROTOCOL}
         if token is not None:
             hello["token"] = token
@@ -245,53 +324,102 @@ class World:
         self.status = self.welcome.get("status")
 
     @classmethod
-    def connect(cls, host="127.0.0.1", port=8081, token=None, timeout=10.0):
+    def connect(cls, host="127.0.0.1", port=8081, token=None, timeout=10.0, background=False):
         """Over TCP lines (the server's --line-port)."""
-        return cls(_Lines(host, port, timeout), token)
+        return cls(_Lines(host, port, timeout), token, background)
 
     @classmethod
-    def connect_ws(cls, host="127.0.0.1", port=8080, token=None, timeout=10.0, path="/ws"):
+    def connect_ws(cls, host="127.0.0.1", port=8080, token=None, timeout=10.0, path="/ws", background=False):
         """Over the WebSocket at ws://host:port/ws."""
-        return cls(_WebSocket(host, port, path, timeout), token)
+        return cls(_WebSocket(host, port, path, timeout), token, background)
 
     # -- plumbing --
-    def _read_loop(self):
-        while True:
-            text = self._t.receive()
-            if text is None:
-                break
-            if isinstance(text, bytes):
-                self.frames.put(decode_binary_frame(text))
-                continue
-            try:
-                m = json.loads(text)
-            except ValueError:
-                continue
-            kind = m.get("type")
-            if kind == "bye":
-                self.bye = m
-                continue
-            if kind in ("frame", "snapshot") and "id" not in m:
-                self.frames.put(m)
-                continue
-            if kind in ("touch", "message", "fault") and "id" not in m:
-                t = self._turtles.get(m.get("turtle"))
-                if t is not None:
-                    t._inbox.put(m)
-                continue
-            if kind == "status":
-                self.status = m.get("status")
-            with self._lock:
-                q = self._waiting.pop(m.get("id"), None) if "id" in m else None
-            if q is not None:
-                q.put(m)
-            else:
-                self.notices.put(m)
-        with self._lock:
-            self._closed = True
-            waiting, self._waiting = self._waiting, {}
-        for q in waiting.values():
-            q.put(None)
+    def _dispatch(self, text):
+        """Files one incoming message where its reader will look (under self._cv)."""
+        if isinstance(text, bytes):
+            self.frames._items.append(decode_binary_frame(text))
+            return
+        try:
+            m = json.loads(text)
+        except ValueError:
+            return
+        kind = m.get("type")
+        if kind == "bye":
+            self.bye = m
+            return
+        if kind in ("frame", "snapshot") and "id" not in m:
+            self.frames._items.append(m)
+            return
+        if kind in ("touch", "message", "fault") and "id" not in m:
+            t = self._turtles.get(m.get("turtle"))
+            if t is not None:
+                t._inbox.append(m)
+            return
+        if kind == "status":
+            self.status = m.get("status")
+        rid = m.get("id")
+        if rid is not None and rid in self._replies and self._replies[rid] is None:
+            self._replies[rid] = m
+        else:
+            self.notices._items.append(m)
+
+    def _wait(self, take, timeout=None, closed_value=_NOTHING):
+        """Until take() (called under the lock) gives something other than _NOTHING. While no
+        other thread reads the connection, this one does, filing what it reads for the others.
+        At the timeout: _NOTHING; when the connection closes first: closed_value, or Closed."""
+        deadline = None if timeout is None else time.monotonic() + timeout
+        with self._cv:
+            while True:
+                got = take()
+                if got is not _NOTHING:
+                    return got
+                if self._closed:
+                    if closed_value is _NOTHING:
+                        raise Closed(self.bye)
+                    return _NOTHING if closed_value is None else closed_value
+                if not self._reading:
+                    self._reading = True
+                    break
+                left = None if deadline is None else deadline - time.monotonic()
+                if left is not None and left <= 0:
+                    return _NOTHING
+                self._cv.wait(left)
+        try:
+            while True:
+                try:
+                    text = self._t.receive(deadline)
+                except TimeoutError:
+                    return _NOTHING
+                with self._cv:
+                    if text is None:
+                        self._closed = True
+                        if closed_value is _NOTHING:
+                            raise Closed(self.bye)
+                        return _NOTHING if closed_value is None else closed_value
+                    self._dispatch(text)
+                    got = take()
+                    if got is not _NOTHING:
+                        return got
+                    self._cv.notify_all()  # it was another thread's
+        finally:
+            with self._cv:
+                self._reading = False
+                self._cv.notify_all()  # one of the waiters reads on
+
+    def _read_on(self):
+        try:
+            self._wait(lambda: _NOTHING)
+        except Closed:
+            pass
+
+    def wait_closed(self, timeout=None):
+        """Reads (filing what comes) until the server closes the connection; whether it did."""
+        self._wait(lambda: True if self._closed else _NOTHING, timeout, closed_value=True)
+        return self._closed
+
+    @property
+    def closed(self):
+        return self._closed
 
     def send(self, message):
         """Sends a message as is (no id added); returns nothing."""
@@ -300,31 +428,37 @@ class World:
     def request(self, message, timeout=None):
         """Sends `message` with a fresh id and returns the reply; raises ServerError on an error
         reply, Closed when the server closes first."""
-        q = queue.Queue()
-        with self._lock:
+        with self._cv:
             if self._closed:
                 raise Closed(self.bye)
             self._next_id += 1
             rid = self._next_id
-            self._waiting[rid] = q
+            self._replies[rid] = None
         m = dict(message)
         m["id"] = rid
         self._t.send(json.dumps(m))
+
+        def take():
+            r = self._replies.get(rid)
+            if r is None:
+                return _NOTHING
+            del self._replies[rid]
+            return r
         try:
-            reply = q.get(timeout=timeout)
-        except queue.Empty:
-            with self._lock:
-                self._waiting.pop(rid, None)
+            reply = self._wait(take, timeout)
+        finally:
+            with self._cv:
+                self._replies.pop(rid, None)
+        if reply is _NOTHING:
             raise TimeoutError("no reply to %s within %s s" % (message.get("type"), timeout))
-        if reply is None:
-            raise Closed(self.bye)
         if reply.get("type") == "error":
             raise ServerError(reply)
         return reply
 
     def close(self):
         self._t.close()
-        self._reader.join(timeout=5)
+        if self._reader is not None:
+            self._reader.join(timeout=5)
 
     # -- the API --
     def claim(self, turtle, takeover=False):
@@ -421,7 +555,7 @@ class RemoteTurtle:
         self.world = world
         self.id = turtle_id
         self.sensors = sensors
-        self._inbox = queue.Queue()
+        self._inbox = collections.deque()  # touches, messages, faults (filed by World._dispatch)
         self.touches = []    # every touch interrupt, in order
         self.messages = []   # every message, in order
         self.fault = None
@@ -438,8 +572,8 @@ class RemoteTurtle:
     def _deliver(self):
         while True:
             try:
-                m = self._inbox.get_nowait()
-            except queue.Empty:
+                m = self._inbox.popleft()
+            except IndexError:
                 return
             if m["type"] == "touch":
                 touch = Touch(m["touch"])

@@ -137,12 +137,18 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
   // Trails under the turtles, so a turtle is never hidden by its own path.
   for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
     const auto& t = snap.turtles[i];
-    if (t.trail.size() < 2) continue;
-    out << "<polyline class=\"trail\" fill=\"none\" stroke=\"" << turtle_colours[i % turtle_colours.size()]
-        << "\" stroke-width=\"1.5\" stroke-linejoin=\"round\" vector-effect=\"non-scaling-stroke\" points=\"";
-    for (std::size_t k = 0; k < t.trail.size(); ++k)
-      out << (k == 0 ? "" : " ") << fmt(t.trail[k].x) << ',' << fmt(t.trail[k].y);
-    out << "\"/>\n";
+    // One polyline per stroke: a break (the pen lifted, or a teleport) draws nothing across it.
+    for (std::size_t from = 0; from < t.trail.size();) {
+      std::size_t to = from;
+      while (to < t.trail.size() && !turtle::is_trail_break(t.trail[to])) ++to;
+      if (to - from >= 2) {
+        out << "<polyline class=\"trail\" fill=\"none\" stroke=\"" << turtle_colours[i % turtle_colours.size()]
+            << "\" stroke-width=\"1.5\" stroke-linejoin=\"round\" vector-effect=\"non-scaling-stroke\" points=\"";
+        for (std::size_t k = from; k < to; ++k) out << (k == from ? "" : " ") << fmt(t.trail[k].x) << ',' << fmt(t.trail[k].y);
+        out << "\"/>\n";
+      }
+      from = to + 1;
+    }
   }
   for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
     const auto& t = snap.turtles[i];

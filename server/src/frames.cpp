@@ -18,6 +18,10 @@ using formats::append_json_string;
 using formats::append_number;
 
 void append_point(std::string& out, sim::Vec2 p) {
+  if (turtle::is_trail_break(p)) {  // between two strokes of a trail
+    out += "null";
+    return;
+  }
   out += '[';
   append_number(out, p.x);
   out += ", ";

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "turtlegas/formats/json_text.hpp"
 #include "turtlegas/sim/suggest.hpp"
 
 namespace turtlegas::server {
@@ -158,39 +159,135 @@ std::string_view pen_name(bool down, turtle::PenMode mode) {
   return mode == turtle::PenMode::wall ? "wall" : "line";
 }
 
+namespace {
+
+// A double as nlohmann's dump writes the value: the shortest text that reads back to it, with
+// ".0" on integral values so that clients parse a float (Python's json gives an int otherwise).
+void append_double(std::string& out, double v) {
+  if (v == 0.0) v = 0.0;  // no "-0.0"
+  const std::size_t from = out.size();
+  formats::append_number(out, v);
+  if (out.find_first_of(".en", from) == std::string::npos) out += ".0";
+}
+
+void append_key(std::string& out, std::string_view key) {
+  out += '"';
+  out += key;
+  out += "\":";
+}
+
+void append_touch(std::string& out, const turtle::Touch& touch) {
+  out += "{\"bearing\":";
+  append_double(out, touch.bearing);
+  out += ",\"bits\":";
+  out += std::to_string(touch.sensors);
+  out += ",\"kind\":";
+  formats::append_json_string(out, touch.kind);
+  out += ",\"sensors\":[";
+  bool first = true;
+  if (touch.sensor_names)
+    for (std::size_t k = 0; k < touch.sensor_names->size(); ++k)
+      if (touch.fired(k)) {
+        if (!first) out += ',';
+        first = false;
+        formats::append_json_string(out, (*touch.sensor_names)[k]);
+      }
+  out += "],\"t\":";
+  append_double(out, touch.t);
+  out += ",\"what\":";
+  formats::append_json_string(out, touch.what);
+  out += '}';
+}
+
+}  // namespace
+
+// Written by hand, not through a json object: a remote turtle's every command is answered by one
+// of these, and building and dumping the object cost ~35,000 instructions a report (callgrind,
+// docs/performance.md "The world server"). Keys in nlohmann's (alphabetical) order, numbers as it
+// writes them, so that the text is what `touch_json` and dump() gave (tests/server/cpp/report_test).
 std::string report_text(const turtle::RemoteReport& r, std::string_view turtle_id, const json& id) {
   using Kind = turtle::RemoteReport::Kind;
-  json out;
+  std::string out;
+  out.reserve(320);
+  out += '{';
   switch (r.kind) {
-    case Kind::result: {
-      out["type"] = "result";
-      if (!id.is_null()) out["id"] = id;
-      out["turtle"] = turtle_id;
-      out["command"] = turtle::to_string(r.command.kind);
-      if (turtle::takes_amount(r.command.kind)) out["amount"] = r.command.amount;
-      out["done"] = r.result.done();
-      out["touched"] = r.result.touched();
-      if (r.result.touched()) out["touch"] = touch_json(r.result.touch());
+    case Kind::result:
+      if (turtle::takes_amount(r.command.kind)) {
+        append_key(out, "amount");
+        append_double(out, r.command.amount);
+        out += ',';
+      }
+      append_key(out, "command");
+      formats::append_json_string(out, turtle::to_string(r.command.kind));
+      out += ',';
+      append_key(out, "done");
+      append_double(out, r.result.done());
+      out += ',';
+      if (!id.is_null()) {
+        append_key(out, "id");
+        out += id.dump(-1, ' ', false, json::error_handler_t::replace);
+        out += ',';
+      }
+      append_key(out, "state");
+      out += "{\"heading\":";
+      append_double(out, r.heading);
+      out += r.it ? ",\"it\":true" : ",\"it\":false";
+      out += ",\"odometer\":";
+      append_double(out, r.odometer);
+      out += ",\"pen\":";
+      formats::append_json_string(out, pen_name(r.pen_down, r.pen_mode));
+      if (r.position) {
+        out += ",\"pos\":[";
+        append_double(out, r.position->x);
+        out += ',';
+        append_double(out, r.position->y);
+        out += ']';
+      }
+      out += "},";
       break;
-    }
     case Kind::touch:
-      out = {{"type", "touch"}, {"turtle", turtle_id}, {"touch", touch_json(r.touch)}};
+    case Kind::fault:
       break;
     case Kind::message:
-      out = {{"type", "message"}, {"turtle", turtle_id}, {"data", r.message.data}, {"sent", r.message.t}};
-      break;
-    case Kind::fault:
-      out = {{"type", "fault"}, {"turtle", turtle_id}, {"message", r.fault}};
+      append_key(out, "data");
+      out += r.message.data.dump(-1, ' ', false, json::error_handler_t::replace);
+      out += ',';
       break;
   }
-  out["t"] = r.t;
-  out["step"] = r.step;
-  if (r.kind == Kind::result) {
-    json state = {{"heading", r.heading}, {"odometer", r.odometer}, {"pen", pen_name(r.pen_down, r.pen_mode)}, {"it", r.it}};
-    if (r.position) state["pos"] = {r.position->x, r.position->y};
-    out["state"] = std::move(state);
+  if (r.kind == Kind::fault) {
+    append_key(out, "message");
+    formats::append_json_string(out, r.fault);
+    out += ',';
   }
-  return out.dump(-1, ' ', false, json::error_handler_t::replace);
+  if (r.kind == Kind::message) {
+    append_key(out, "sent");
+    append_double(out, r.message.t);
+    out += ',';
+  }
+  append_key(out, "step");
+  out += std::to_string(r.step);
+  out += ',';
+  append_key(out, "t");
+  append_double(out, r.t);
+  out += ',';
+  if (r.kind == Kind::touch || (r.kind == Kind::result && r.result.touched())) {
+    append_key(out, "touch");
+    append_touch(out, r.kind == Kind::touch ? r.touch : r.result.touch());
+    out += ',';
+  }
+  if (r.kind == Kind::result) out += r.result.touched() ? "\"touched\":true," : "\"touched\":false,";
+  append_key(out, "turtle");
+  formats::append_json_string(out, turtle_id);
+  out += ",\"type\":";
+  static constexpr std::string_view types[] = {"\"result\"", "\"touch\"", "\"message\"", "\"fault\""};
+  switch (r.kind) {
+    case Kind::result: out += types[0]; break;
+    case Kind::touch: out += types[1]; break;
+    case Kind::message: out += types[2]; break;
+    case Kind::fault: out += types[3]; break;
+  }
+  out += '}';
+  return out;
 }
 
 void check_plain_name(const std::string& name) {

@@ -171,6 +171,7 @@ void WorldHost::drain_inbox() {
   std::deque<Inbound> batch;
   {
     std::lock_guard lock(mutex_);
+    if (inbox_.empty()) return;  // most boundaries: no deque to build (it allocates) and free
     batch.swap(inbox_);
   }
   for (Inbound& in : batch) handle(in);
@@ -219,6 +220,7 @@ int WorldHost::run() {
         anchor_sim_ = target;
       }
     }
+    step_end_ = server_->step() + 1;
     if (options_.replay && target < server_->time()) seek(target);
     else step_world(target);
     bool changed = false;
@@ -658,7 +660,11 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
       if (auto v = optional_number(m, "steps", R"({"type": "step", "steps": 1})")) n = *v;
       if (!(n >= 1 && n <= 1e6 && n == std::floor(n)))
         throw RequestError("bad_value", "/steps must be a whole number from 1 to 1000000", "/steps");
-      steps_left_ = static_cast<std::uint64_t>(n);
+      // Counted from the boundary it is handled at. Handled inside a step, at the boundary that
+      // step ends on (a lockstep wait there, a remote turtle asked for its command), that step's
+      // own end counts one off: add it, or a `step` sent while the previous one runs is
+      // swallowed by it, and a change waiting for the boundary it asks for never comes.
+      steps_left_ = static_cast<std::uint64_t>(n) + (in_step_ && server_->step() == step_end_ ? 1 : 0);
       paused_ = true;
     } else if (type == "speed") {
       const auto f = m.find("factor");
@@ -695,6 +701,8 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     const bool takeover = optional_bool(m, "takeover", ex).value_or(false);
     Slot& s = slots_[i];
     const std::string& tid = scene_.def.turtles[i].id;
+    if (server_->turtle_status(i).gone)
+      throw RequestError("unknown_turtle", "/turtle: '" + tid + "' is no longer in the world (removed, crushed or out of an open arena); claim a turtle that is", "/turtle");
     if (s.owner == c.client->id) throw RequestError("claimed", "/turtle: this connection has claimed '" + tid + "' already", "/turtle");
     if (s.owner != 0 || std::any_of(takeovers_.begin(), takeovers_.end(), [&](const Takeover& t) { return t.turtle == i; }))
       throw RequestError("claimed", "/turtle: '" + tid + "' is claimed by another connection; it is free again when that one releases it or closes", "/turtle");
@@ -741,6 +749,8 @@ void WorldHost::handle_message(ClientState& c, const json& m) {
     const turtle::RemoteCommand cmd = read_command(m, type);  // the message first, then the turtle's state
     Slot& s = slots_[i];
     const std::string& tid = scene_.def.turtles[i].id;
+    if (server_->turtle_status(i).gone)
+      throw RequestError("unknown_turtle", "/turtle: '" + tid + "' is no longer in the world (removed, crushed or out of an open arena)", "/turtle");
     if (s.owner != c.client->id)
       throw RequestError("not_claimed", "/turtle: claim '" + tid + "' first: {\"type\": \"claim\", \"turtle\": \"" + tid + "\"}", "/turtle");
     if (s.busy)

@@ -532,9 +532,13 @@
       for (const t of S.turtles) {
         if (!t.trail.length) continue;
         ctx.beginPath();
-        ctx.moveTo(t.trail[0][0], t.trail[0][1]);
-        for (let k = 1; k < t.trail.length; k++) ctx.lineTo(t.trail[k][0], t.trail[k][1]);
-        if (t.pen !== 'up') ctx.lineTo(t.x, t.y);
+        let gap = true;  // null in a trail: a break between strokes (pen lifted, or a teleport)
+        for (const p of t.trail) {
+          if (!p) { gap = true; continue; }
+          if (gap) ctx.moveTo(p[0], p[1]); else ctx.lineTo(p[0], p[1]);
+          gap = false;
+        }
+        if (t.pen !== 'up' && !gap) ctx.lineTo(t.x, t.y);
         ctx.stroke();
       }
     }

@@ -344,3 +344,58 @@ TEST_CASE("step() is the boundary last reached", "[runtime]") {
   CHECK(s.step() == 7);
   CHECK(s.time() == 0.1 * 7);
 }
+
+TEST_CASE("a trail breaks where the pen was up and where a pen-down turtle was teleported", "[runtime][trail]") {
+  sim::WorldDef d = arena();
+  d.turtles.push_back(body("t1", {100, 100}, 90));  // east: a dash, a gap, a dash
+  d.turtles.push_back(body("t2", {100, 250}, 0));   // north with the pen down, then teleported
+  struct Teleport : InputSource {
+    void at_boundary(WorldServer& s, std::uint64_t step) override {
+      if (step == 15) s.teleport_turtle("t2", {300, 200}, 0);
+    }
+    std::optional<RemoteCommand> next(std::uint64_t, std::size_t) override { return std::nullopt; }
+  };
+  ServerOptions options;
+  options.input = std::make_shared<Teleport>();
+  TurtleProgram dashes = program("script");
+  dashes.params = nlohmann::json::parse(
+      R"({"commands": [["pendown"], ["forward", 50], ["penup"], ["forward", 50], ["pendown"], ["forward", 50]]})");
+  TurtleProgram jumper = program("script");
+  jumper.params = nlohmann::json::parse(R"({"commands": [["pendown"], ["forward", 50], ["wait", 2], ["forward", 30]]})");
+  WorldServer s(d, {dashes, jumper}, base_registry(), options);
+  s.run_until(6.0);
+  // The strokes: runs of points between breaks, repeated points dropped.
+  auto strokes = [](const std::vector<sim::Vec2>& trail) {
+    std::vector<std::vector<sim::Vec2>> out(1);
+    for (const sim::Vec2 p : trail) {
+      if (is_trail_break(p)) {
+        if (!out.back().empty()) out.emplace_back();
+        continue;
+      }
+      if (out.back().empty() || std::hypot(p.x - out.back().back().x, p.y - out.back().back().y) > 1e-9) out.back().push_back(p);
+    }
+    if (out.back().empty()) out.pop_back();
+    return out;
+  };
+  auto near = [](sim::Vec2 p, double x, double y) { return std::abs(p.x - x) < 1e-9 && std::abs(p.y - y) < 1e-9; };
+  const auto t1 = strokes(s.turtle(0).trail);
+  REQUIRE(t1.size() == 2);  // not one line through the gap from x = 150 to 200
+  REQUIRE(t1[0].size() == 2);
+  CHECK(near(t1[0][0], 100, 100));
+  CHECK(near(t1[0][1], 150, 100));
+  REQUIRE(t1[1].size() == 2);
+  CHECK(near(t1[1][0], 200, 100));
+  CHECK(near(t1[1][1], 250, 100));
+  const auto t2 = strokes(s.turtle(1).trail);
+  REQUIRE(t2.size() == 2);  // not one line from where it was to where it was put
+  REQUIRE(t2[0].size() == 2);
+  CHECK(near(t2[0][0], 100, 250));
+  CHECK(near(t2[0][1], 100, 300));
+  REQUIRE(t2[1].size() == 2);
+  CHECK(near(t2[1][0], 300, 200));
+  CHECK(near(t2[1][1], 300, 230));
+  // trail_since carries the breaks too (frames send trails by parts).
+  std::size_t breaks = 0;
+  for (const sim::Vec2 p : s.trail_since(1, 0)) breaks += is_trail_break(p) ? 1 : 0;
+  CHECK(breaks == 1);
+}

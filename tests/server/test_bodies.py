@@ -33,6 +33,12 @@ def change(w, message, steps=1):
             return n
 
 
+def settle(w, step):
+    """Until the world has paused after boundary `step` (its status says so)."""
+    while not (w.status and w.status.get("paused") and w.status["step"] >= step):
+        w.notices.get(timeout=30)
+
+
 def code(reply):
     return reply.get("code") if reply["type"] == "error" else "ok"
 
@@ -65,6 +71,10 @@ def session(a, b, mode):
     # A remote turtle (no controller given), claimed by the other connection.
     r = change(a, {"type": "spawn", "turtle": {"id": "t-new", "pos": [300, 100], "heading": 0, "speed": 30}})
     check(code(r) == "ok" and r["kind"] == "turtle" and r["index"] == 2, "spawned a turtle: %r" % r)
+    # Claimed only once the step that spawned it has ended: a claim that lands during that
+    # boundary makes the world wait there for t-new's command (lockstep), and the teleport below
+    # would then wait for a boundary that never comes (the lockstep timeout ends the world).
+    settle(a, r["status"]["step"])
     t = b.claim("t-new")
     r = change(a, {"type": "remove", "body": "t-new"}, steps=0)
     check(code(r) == "claimed", "removing another connection's turtle is refused: %r" % r)
@@ -126,6 +136,63 @@ def served_and_replayed(mode):
         check(open(replay, "rb").read() == log, "%s: the input log replays headless to the same event log" % mode)
 
 
+def mirror_and_removed(mode):
+    """A spawned `mirror` turtle runs its program reflected; a removed turtle cannot be claimed
+    (or taken over); the run replays headless from its input log."""
+    with tempfile.TemporaryDirectory() as d:
+        served, replay, inputs = (os.path.join(d, n) for n in ("served.jsonl", "replay.jsonl", "inputs.jsonl"))
+        with Server(world("bodies_room.json"), "--paused", "--speed", "max", "--mode", mode, "--until", UNTIL,
+                    "--events", served, "--inputs-out", inputs) as s:
+            a = World.connect("127.0.0.1", s.line_port)
+            # The mirror image (about x = 200) of "turn right 90, forward 50": left 90, then 50 west.
+            mirror = {"of": "script", "params": {"commands": [["right", 90], ["forward", 50]]}, "through": [200, 0]}
+            r = change(a, {"type": "spawn", "turtle": {"id": "t-m", "pos": [300, 150], "heading": 0, "speed": 50,
+                                                       "turn_rate": 180, "controller": "mirror", "params": mirror}})
+            check(code(r) == "ok" and r["kind"] == "turtle" and r["index"] == 2, "a mirror turtle spawned: %r" % r)
+            bad = dict(mirror, of="nobody")
+            r = change(a, {"type": "spawn", "turtle": {"id": "t-bad", "pos": [300, 80], "controller": "mirror", "params": bad}})
+            check(code(r) in ("bad_value", "refused") and "nobody" in r["message"], "a mirror of nothing is refused: %r" % r)
+            r = change(a, {"type": "remove", "body": "t1"})
+            check(code(r) == "ok", "the remote turtle t1 removed: %r" % r)
+            r = change(a, {"type": "remove", "body": "t2"})
+            check(code(r) == "ok", "t2 (a program) removed: %r" % r)
+            for msg in ({"type": "claim", "turtle": "t1"}, {"type": "claim", "turtle": "t2", "takeover": True}):
+                r = change(a, msg, steps=0)
+                check(code(r) == "unknown_turtle" and "removed" in r["message"] and r.get("field") == "/turtle",
+                      "a removed turtle cannot be claimed: %r -> %r" % (msg, r))
+            r = change(a, {"type": "forward", "turtle": "t1", "amount": 10}, steps=0)
+            check(code(r) == "unknown_turtle", "nor driven: %r" % r)
+            a.step(60)  # 3 s: the turn (0.5 s) and the 50 units (1 s) are done
+            while a.status is None or not a.status.get("paused") or a.status["t"] < 3:
+                a.notices.get(timeout=30)
+            snap = a.snapshot()
+            tm = [x for x in snap["turtles"] if x["id"] == "t-m"][0]
+            check(abs(tm["pos"][0] - 250) < 1e-9 and abs(tm["pos"][1] - 150) < 1e-9 and abs(tm["heading"] - 270) < 1e-9,
+                  "the mirror turned left and drove west to (250, 150): %r" % tm)
+            gone = {x["id"]: x["gone"] for x in snap["turtles"]}
+            check(gone == {"t1": True, "t2": True, "t-m": False}, "the removed turtles are gone: %r" % gone)
+            # A pen-down turtle teleported: its trail breaks (null) rather than joining the two places.
+            pen = {"of": "script", "params": {"commands": [["forward", 20], ["wait", 100]]}}
+            r = change(a, {"type": "spawn", "turtle": {"id": "t-pen", "pos": [100, 220], "heading": 90, "speed": 40,
+                                                       "pen": "down", "controller": "mirror", "params": pen}})
+            check(code(r) == "ok", "a pen-down turtle spawned: %r" % r)
+            r = change(a, {"type": "teleport", "body": "t-pen", "pos": [100, 100]}, steps=3)
+            check(code(r) == "ok", "teleported: %r" % r)
+            trail = [x for x in a.snapshot()["turtles"] if x["id"] == "t-pen"][0]["trail"]
+            check(None in trail, "the trail has a break: %r" % trail)
+            k = trail.index(None)
+            check(trail[k - 1][0] > 100 and trail[k - 1][1] == 220 and trail[k + 1] == [100, 100] and None not in trail[k + 1:],
+                  "the stroke ends where it was, the next starts at (100, 100): %r" % trail)
+            a.resume()
+            check(s.wait(60) == 0, "serve exits 0 at --until: " + s.err())
+        run(["run", world("bodies_room.json"), "--until", UNTIL, "--mode", mode, "--inputs", inputs, "--events", replay])
+        check(open(replay, "rb").read() == open(served, "rb").read(), "%s: the mirror spawn replays headless" % mode)
+
+
+def test_mirror_and_removed():
+    mirror_and_removed("exact")
+
+
 def test_bodies_exact():
     served_and_replayed("exact")
 
@@ -135,4 +202,4 @@ def test_bodies_step():
 
 
 if __name__ == "__main__":
-    main([test_bodies_exact, test_bodies_step])
+    main([test_bodies_exact, test_bodies_step, test_mirror_and_removed])

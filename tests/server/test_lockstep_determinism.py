@@ -109,5 +109,37 @@ def test_bad_input_logs_are_bad_input():
                   "exit 2 naming the file and the problem (%s): %d %s" % (words, r.returncode, r.stderr))
 
 
+def test_step_sent_during_a_step():
+    """A `step` handled while a step runs (here: the world waits inside it for a claimed turtle's
+    command) runs its steps from that boundary; it used to be swallowed by the running step (the
+    world paused one boundary later instead of `steps`, and a change waiting for that boundary
+    never came)."""
+    with Server(world("remote_followers.json"), "--speed", "max", "--paused") as s:
+        w = World.connect("127.0.0.1", s.line_port)
+        t = w.claim("righty")
+        k = w.welcome["status"]["step"]
+        w.step(1)        # from boundary k, where the world waits for righty's command, to k + 1
+        r = t.yield_()   # taken at k, ends at k + 1: the world waits there again, inside the step
+        check(r.step == k + 1, "the yield ended at k + 1: %r" % r.reply)
+        w.step(2)        # handled during that wait, at boundary k + 1: two steps from there
+        # Each yield ends at the next boundary; the world pauses after a boundary once righty's
+        # next command is in. Sent without waiting for a result that a paused world never gives.
+        steps, paused = [], None
+        for n in range(1, 10):
+            w.send({"type": "yield", "turtle": "righty", "id": 5000 + n})
+            while paused is None:
+                m = w.notices.get(timeout=10)
+                if m.get("id") == 5000 + n:
+                    steps.append(m["step"])
+                    break
+                if m["type"] == "status" and m["status"]["paused"]:
+                    paused = m["status"]["step"]
+            if paused is not None:
+                break
+        check(paused == k + 3, "paused at boundary %d + 3 (got %r; yields ended at %r)" % (k, paused, steps))
+        check(steps == [k + 2, k + 3], "one yield a boundary: %r" % steps)
+
+
 if __name__ == "__main__":
-    main([test_python_lockstep_equals_cpp_headless, test_takeover_and_add_wall_replay, test_bad_input_logs_are_bad_input])
+    main([test_python_lockstep_equals_cpp_headless, test_takeover_and_add_wall_replay, test_bad_input_logs_are_bad_input,
+          test_step_sent_during_a_step])

@@ -205,6 +205,7 @@ def with_server(connect):
             w = connect(s)
             session(w, d)
             check(s.stop() == 0, "SIGINT: exit 0")
+            check(w.wait_closed(timeout=10), "the server closes the connection on SIGINT")
             check(w.bye and w.bye["reason"] == "signal", "bye on SIGINT: %r" % w.bye)
     finally:
         shutil.rmtree(d)

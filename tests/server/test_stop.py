@@ -24,9 +24,9 @@ def stop_with(sig):
             time.sleep(1.0)
             check(s.stop(sig) == 0, "exit 0 on signal %d: %s" % (sig, s.err()[-2000:]))
             for w in (a, b):
-                w._reader.join(timeout=10)
+                closed = w.wait_closed(timeout=10)
                 check(w.bye and w.bye["reason"] == "signal", "bye before the close: %r" % w.bye)
-                check(not w._reader.is_alive(), "the server closed the connection")
+                check(closed, "the server closed the connection")
             t = a.bye["t"]
             dt = a.welcome["world"]["dt"]
             check(t > 0 and abs(t / dt - round(t / dt)) < 1e-9, "stopped at a control boundary (t=%r, dt=%r)" % (t, dt))

@@ -31,7 +31,7 @@ def viewer(s, k, counts):
         try:
             w.frames.get(timeout=1)
         except queue.Empty:
-            if not w._reader.is_alive():
+            if w.closed:
                 break
             continue
         n += 1

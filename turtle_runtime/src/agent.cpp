@@ -134,7 +134,11 @@ void Turtle::pen_down(PenMode mode) {
     throw std::logic_error("turtle '" + agent_->id +
                            "' may not lay walls: give it \"builder\": true (or \"pen\": \"wall\") in the world file, "
                            "so that the world server can give it a collision category of its own");
-  if (!agent_->pen_down) agent_->trail.push_back(agent_->server->world.turtle(agent_->index).pos);
+  if (!agent_->pen_down) {
+    // A new stroke: the last one (if any) ended where the pen went up, not here.
+    if (!agent_->trail.empty() && !is_trail_break(agent_->trail.back())) agent_->trail.push_back(trail_break);
+    agent_->trail.push_back(agent_->server->world.turtle(agent_->index).pos);
+  }
   agent_->pen_down = true;
   agent_->pen_mode = mode;
 }

@@ -210,6 +210,7 @@ void WorldServer::teleport_turtle(const std::string& id, sim::Vec2 pos, double h
   sim::WorldDef one;
   one.turtles.push_back(d);
   check_entry(s, std::move(one));
+  const sim::Vec2 was = s.world.turtle(k).pos;
   try {
     s.world.teleport_turtle(k, pos, d.heading);
   } catch (const sim::PlacementError& e) {
@@ -217,6 +218,11 @@ void WorldServer::teleport_turtle(const std::string& id, sim::Vec2 pos, double h
   }
   Agent& a = *s.agents[k];
   a.in_contact.clear();  // what it touched is where it was
+  if (a.pen_down) {  // the stroke ends where it was; the next starts here, no line between
+    a.trail.push_back(was);
+    a.trail.push_back(trail_break);
+    a.trail.push_back(pos);
+  }
   s.emit({s.world.time(), "teleport", id, "turtle", {}, 0.0, {}, {}, {}});
 }
 

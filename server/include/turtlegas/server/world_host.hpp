@@ -215,6 +215,7 @@ class WorldHost {
   double speed_ = 1.0;  ///< 0: as fast as possible
   std::optional<double> pause_at_;
   std::uint64_t steps_left_ = 0;  ///< > 0: a `step` request is running
+  std::uint64_t step_end_ = 0;    ///< the boundary the running step_world ends on
   double anchor_sim_ = 0.0, anchor_wall_ = 0.0;
   std::optional<std::string> ended_;
   bool stopping_ = false;

@@ -29,6 +29,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -102,6 +103,12 @@ struct BusyLoopError : std::runtime_error {
 
 class Game;  // game.hpp
 
+/// In a turtle's trail, the marker between two strokes (both coordinates NaN): the pen went up
+/// and down again elsewhere, or the turtle was teleported with its pen down. Drawing code starts a
+/// new polyline after it; the protocol writes it as `null` (docs/protocol.md, "The snapshot").
+inline constexpr sim::Vec2 trail_break{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+inline bool is_trail_break(sim::Vec2 p) { return p.x != p.x; }
+
 /// The turtle program running now on this process's simulation thread, for a crash report: a
 /// fatal signal or an exit() inside a controller's code can then name the turtle and the time.
 /// Plain pointers into the server's own strings, valid while that program runs; all null when
@@ -152,7 +159,7 @@ class WorldServer {
     bool pen_down = false;
     bool finished = false;  ///< the program returned (the turtle is parked)
     std::string fault;      ///< non-empty when the program failed (threw, overflowed its stack)
-    std::vector<sim::Vec2> trail;  ///< pen-down path, in world units
+    std::vector<sim::Vec2> trail;  ///< pen-down path, in world units; breaks marked (is_trail_break)
     PenMode pen_mode = PenMode::line;
     bool it = false;      ///< "it" in the world's game
     bool remote = false;  ///< runs the remote program (remote.hpp)
@@ -164,7 +171,9 @@ class WorldServer {
   /// Turtle i without its trail (TurtleInfo::trail empty): for frames, which send trails by parts.
   TurtleInfo turtle_status(std::size_t i) const;
   /// The pen-down path's committed points (those a command's end or a pen_down added) from index
-  /// `from` on; without the live tip. Empty when from >= trail_size(i).
+  /// `from` on; without the live tip. Empty when from >= trail_size(i). A trail is one polyline
+  /// per stroke: where the pen went down again after a gap, or a pen-down turtle was teleported,
+  /// a break marker (is_trail_break) separates the strokes.
   std::vector<sim::Vec2> trail_since(std::size_t i, std::size_t from) const;
   std::size_t trail_size(std::size_t i) const;
   /// The controller turtle i runs now ("remote" once make_remote made it so).
