@@ -42,7 +42,7 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommandOptions& opt) {
       ->capture_default_str()
       ->check(integer_in(0, std::numeric_limits<std::int64_t>::max(), "events"));
   s->add_option("--save-dir", opt.save_dir, "The only directory save and load may touch");
-  s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the source tree's server/web)");
+  s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the installed share/turtlegas/web beside the program, else the source tree's server/web)");
   s->add_option("--max-clients", opt.max_clients, "Connections at most (WebSocket and TCP lines)")->capture_default_str();
   s->add_option("--max-claims", opt.max_claims, "Claimed turtles per connection at most")->capture_default_str();
   s->add_option("--max-message", opt.max_message, "Bytes per message at most")->capture_default_str();
@@ -71,7 +71,7 @@ CLI::App* add_replay_command(CLI::App& app, ServeCommandOptions& opt) {
   s->add_option("--speed", opt.speed, "Simulated seconds per wall second, 0.01 to 1000, or max")->capture_default_str();
   s->add_flag("--paused", opt.paused, "Start paused");
   s->add_option("--token", opt.token, "Token that control messages need");
-  s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the source tree's server/web)");
+  s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the installed share/turtlegas/web beside the program, else the source tree's server/web)");
   s->add_option("--max-clients", opt.max_clients, "Connections at most (WebSocket and TCP lines)")->capture_default_str();
   s->add_option("--stack-kib", opt.stack_kib, "Each turtle program's stack, KiB")->capture_default_str();
   return s;
