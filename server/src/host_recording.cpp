@@ -50,7 +50,8 @@ void WorldHost::start_recording() {
 
 void WorldHost::advance(double target) {
   if (!recorder_) {
-    server_->run_until(target);
+    if (options_.replay) replay_run_until(target);
+    else server_->run_until(target);
     return;
   }
   // Cut at every multiple of the keyframe period, as `run --record` cuts its chunks there (a run
@@ -129,6 +130,35 @@ void WorldHost::reopen_client_views() {
       spdlog::info("replay: view '{}' is not shown at t={}: {}", v.id, server_->time(), e.what());
     }
   }
+}
+
+void WorldHost::plan_snapshots() {
+  max_snapshots_ = 0;
+  if (!options_.replay || !options_.replay->inputs.empty() || !server_->snapshot()) return;
+  // About 400 bytes a ball in the engine and the scene; at most 512 MiB of snapshots.
+  const double bytes = 400.0 * static_cast<double>(server_->world().ball_count() + 16);
+  max_snapshots_ = static_cast<std::size_t>(std::clamp(512.0 * 1024 * 1024 / bytes, 1.0, 4096.0));
+}
+
+void WorldHost::replay_run_until(double t) {
+  const std::vector<double>& keys = options_.replay->keyframes;
+  for (auto k = std::upper_bound(keys.begin(), keys.end(), server_->time());
+       k != keys.end() && *k <= t && snapshots_.size() < max_snapshots_; ++k) {
+    if (snapshots_.contains(*k)) continue;
+    // Cut at the keyframe (a run does not depend on where it is cut) and copy the world there.
+    server_->run_until(*k);
+    snapshots_.emplace(*k, server_->snapshot());
+  }
+  server_->run_until(t);
+}
+
+bool WorldHost::restore_snapshot(double t) {
+  auto it = snapshots_.upper_bound(t);
+  if (it == snapshots_.begin()) return false;
+  --it;
+  if (!(t < server_->time()) && !(it->first > server_->time())) return false;
+  server_->restore(*it->second);
+  return true;
 }
 
 std::string WorldHost::state_text() const {

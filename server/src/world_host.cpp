@@ -89,6 +89,7 @@ WorldHost::WorldHost(HostOptions options, const turtle::Registry& registry, worl
   }
   build_world(std::move(scene));
   start_recording();
+  plan_snapshots();
 }
 
 WorldHost::~WorldHost() = default;
@@ -988,8 +989,10 @@ bool WorldHost::replay_target(double& target) {
 }
 
 void WorldHost::seek(double t) {
-  const bool rebuild = t < server_->time();
+  const bool back = t < server_->time();
   fan_out_events();
+  const bool restored = restore_snapshot(t);
+  const bool rebuild = back && !restored;
   if (rebuild) {
     world::Scene scene = world::parse_scene(world_text(), options_.world_file, registry_);
     scene.def.dt = options_.replay->dt;
@@ -997,7 +1000,7 @@ void WorldHost::seek(double t) {
   }
   in_step_ = true;
   try {
-    server_->run_until(t);
+    replay_run_until(t);
   } catch (const std::exception& e) {
     in_step_ = false;
     events_.clear();
@@ -1005,10 +1008,10 @@ void WorldHost::seek(double t) {
     return;
   }
   in_step_ = false;
-  if (rebuild) reopen_client_views();
+  if (rebuild || restored) reopen_client_views();
   events_.clear();  // what happened on the way is not shown: the viewer jumps
   reanchor();
-  if (!rebuild) return;
+  if (!rebuild && !restored) return;
   std::map<std::string, FrameStream> fresh;
   for (auto& [key, s] : streams_) fresh.try_emplace(key, s.kind(), *server_).first->second.next_due = now();
   streams_ = std::move(fresh);

@@ -210,11 +210,22 @@ class WorldHost {
   void reopen_client_views();
   void note_client_view(const char* op, const turtle::View& view);
   std::string state_text() const;
+  /// A replay: how many snapshots it may keep (0: none: a world with turtles or a game, whose
+  /// programs cannot be copied, or a served run's recording, whose inputs are read as it goes).
+  void plan_snapshots();
+  /// A replay: run_until(t), stopping on the way at the recording's keyframe times to snapshot
+  /// the world (WorldServer::snapshot) while the budget lasts.
+  void replay_run_until(double t);
+  /// A replay: the world put back to the latest snapshot at or before t when t is behind the
+  /// world or that snapshot is ahead of it; whether it was.
+  bool restore_snapshot(double t);
 
   std::optional<std::ofstream> record_file_;
   std::optional<formats::RecordingWriter> recorder_;
   double next_key_ = 0.0;
   std::vector<turtle::View> client_views_;  ///< a replay's clients' views
+  std::map<double, std::shared_ptr<const turtle::WorldServer::Snapshot>> snapshots_;  ///< a replay's, by time
+  std::size_t max_snapshots_ = 0;
 
   HostOptions options_;
   const turtle::Registry& registry_;
