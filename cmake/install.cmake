@@ -33,6 +33,8 @@ install(FILES ${PROJECT_BINARY_DIR}/turtlegas.pc DESTINATION ${CMAKE_INSTALL_LIB
 install(DIRECTORY worlds/ DESTINATION ${CMAKE_INSTALL_DATADIR}/turtlegas/worlds)
 install(FILES controllers/examples/feeler.cpp controllers/examples/feeler.json controllers/examples/CMakeLists.txt
         DESTINATION ${CMAKE_INSTALL_DATADIR}/turtlegas/examples/feeler)
+# The viewer's page: `serve` finds it at ../share/turtlegas/web from its own binary (server/CMakeLists.txt).
+install(DIRECTORY server/web/ DESTINATION ${CMAKE_INSTALL_DATADIR}/turtlegas/web)
 install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR} PATTERN "bench" EXCLUDE)
 install(FILES README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
 

@@ -2,7 +2,9 @@
 #include "serve_command.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
@@ -30,8 +32,17 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommandOptions& opt) {
   s->add_option("--until", opt.until, "Stop at this simulated time, as on SIGINT");
   s->add_option("--events", opt.events, "Write the event log here (JSON lines, as `run --events`)");
   s->add_option("--inputs-out", opt.inputs_out, "Write the input log here (replay with `run --inputs`)");
+  s->add_option("--record", opt.record,
+                "Write a recording of the served run here, inputs and views included (docs/recording.md; play it "
+                "with `turtlegas replay`)");
+  s->add_option("--keyframe-seconds", opt.keyframe_seconds, "A recording's keyframe every this many simulated seconds (0: none)")
+      ->capture_default_str()
+      ->check(real_in(0, 1e9, "seconds"));
+  s->add_option("--keyframe-events", opt.keyframe_events, "A recording's keyframe after this many engine events (0: none)")
+      ->capture_default_str()
+      ->check(integer_in(0, std::numeric_limits<std::int64_t>::max(), "events"));
   s->add_option("--save-dir", opt.save_dir, "The only directory save and load may touch");
-  s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the source tree's server/web)");
+  s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the installed share/turtlegas/web beside the program, else the source tree's server/web)");
   s->add_option("--max-clients", opt.max_clients, "Connections at most (WebSocket and TCP lines)")->capture_default_str();
   s->add_option("--max-claims", opt.max_claims, "Claimed turtles per connection at most")->capture_default_str();
   s->add_option("--max-message", opt.max_message, "Bytes per message at most")->capture_default_str();
@@ -60,7 +71,7 @@ CLI::App* add_replay_command(CLI::App& app, ServeCommandOptions& opt) {
   s->add_option("--speed", opt.speed, "Simulated seconds per wall second, 0.01 to 1000, or max")->capture_default_str();
   s->add_flag("--paused", opt.paused, "Start paused");
   s->add_option("--token", opt.token, "Token that control messages need");
-  s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the source tree's server/web)");
+  s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the installed share/turtlegas/web beside the program, else the source tree's server/web)");
   s->add_option("--max-clients", opt.max_clients, "Connections at most (WebSocket and TCP lines)")->capture_default_str();
   s->add_option("--stack-kib", opt.stack_kib, "Each turtle program's stack, KiB")->capture_default_str();
   return s;
@@ -107,6 +118,14 @@ int serve_command(const ServeCommandOptions& opt, const turtle::Registry& regist
   h.until = opt.until;
   h.events_path = opt.events;
   h.inputs_path = opt.inputs_out;
+  if (!opt.record.empty()) {
+    if (opt.record == "-") throw BadInput("--record needs a file name, not standard output (replay seeks in it)");
+    for (const std::string* other : {&opt.events, &opt.inputs_out})
+      if (!other->empty() && std::filesystem::path(*other) == std::filesystem::path(opt.record))
+        throw BadInput("--record: '" + opt.record + "' is also another output; give each its own file");
+    h.record_path = opt.record;
+    h.keyframes = {opt.keyframe_seconds, opt.keyframe_events};
+  }
   if (!opt.save_dir.empty()) {
     std::error_code fe;
     if (!std::filesystem::is_directory(opt.save_dir, fe))
@@ -152,6 +171,9 @@ int serve_command(const ServeCommandOptions& opt, const turtle::Registry& regist
     r.dt = rec.header.dt;
     r.complete = rec.complete;
     for (const formats::Keyframe& k : rec.keyframes) r.keyframes.push_back(k.t);
+    if (rec.header.command == "serve")  // its inputs, up to where the recording is whole
+      r.inputs = formats::recording_inputs(opt.replay, rec.complete ? rec.bytes : rec.keyframes.back().offset,
+                                           scene.def.name, rec.header.dt);
     h.replay = std::move(r);
     h.until.reset();
   } else {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +31,9 @@ struct ServeCommandOptions {
   bool realtime = false;
   std::size_t stack_kib = 32;
   double program_budget = 2.0;
+  std::string record;  ///< `serve --record R.tgrec` (docs/recording.md)
+  double keyframe_seconds = 1.0;
+  std::uint64_t keyframe_events = 100000;
   std::string replay;  ///< `turtlegas replay R.tgrec`: the recording served (docs/recording.md)
 };
 

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "turtlegas/formats/json_text.hpp"
+#include "turtlegas/turtle/view.hpp"
 
 namespace turtlegas::formats {
 namespace {
@@ -84,6 +85,17 @@ std::string input_spawn_line(std::uint64_t step, std::string_view kind, const nl
   append_json_string(out, kind);
   out += ": ";
   out += entry.dump();  // numbers as the shortest text that reads back to the same double
+  out += "}}\n";
+  return out;
+}
+
+std::string input_view_line(std::uint64_t step, std::string_view op, const nlohmann::json& view) {
+  std::string out;
+  append_step(out, step);
+  out += ", \"view\": {\"op\": ";
+  append_json_string(out, op);
+  out += ", \"view\": ";
+  out += view.dump();
   out += "}}\n";
   return out;
 }
@@ -212,14 +224,37 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
         c.wall.from = {w.at("from").at(0).get<double>(), w.at("from").at(1).get<double>()};
         c.wall.to = {w.at("to").at(0).get<double>(), w.at("to").at(1).get<double>()};
         changes_.push_back(std::move(c));
+      } else if (j.contains("view")) {
+        const nlohmann::json& v = j.at("view");
+        const std::string op = v.at("op").get<std::string>();
+        if (op != "open" && op != "change" && op != "close") fail("/view/op: must be \"open\", \"change\" or \"close\"");
+        if (op == "close" ? !v.at("view").is_string() : !v.at("view").is_object())
+          fail("/view/view: a view object to open or change, a view's id to close");
+        Change c;
+        c.kind = Change::Kind::view;
+        c.step = step;
+        c.spawn = v;
+        changes_.push_back(std::move(c));
       } else {
-        fail("a line needs \"turtle\" (a command), \"takeover\", \"add_wall\", \"spawn\", \"remove\" or \"teleport\"");
+        fail("a line needs \"turtle\" (a command), \"takeover\", \"add_wall\", \"spawn\", \"remove\", \"teleport\" or \"view\"");
       }
     } catch (const nlohmann::json::exception& e) {
       fail(std::string("a field is missing or has the wrong type: ") + e.what());
     }
   }
   if (!header) throw std::invalid_argument(file_ + ": empty; an input log starts with {\"format\": \"turtlegas-inputs/1\", ...}");
+}
+
+void ReplayInput::apply_view(turtle::WorldServer& server, const nlohmann::json& v, std::uint64_t step) const {
+  const std::string op = v.at("op").get<std::string>();
+  try {
+    if (op == "close") server.close_view(v.at("view").get<std::string>());
+    else if (op == "open") server.open_view(turtle::parse_view(v.at("view")));
+    else server.change_view(turtle::parse_view(v.at("view")));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(file_ + ": the view change recorded at step " + std::to_string(step) + " was refused (" +
+                             e.what() + "); is this the log of this world?");
+  }
 }
 
 void ReplayInput::at_boundary(turtle::WorldServer& server, std::uint64_t step) {
@@ -238,6 +273,7 @@ void ReplayInput::at_boundary(turtle::WorldServer& server, std::uint64_t step) {
         if (c.vel) server.teleport_ball(c.id, c.pos, *c.vel);
         else server.teleport_turtle(c.id, c.pos, *c.heading);
         break;
+      case Change::Kind::view: apply_view(server, c.spawn, c.step); break;
     }
   }
 }

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/json_text.hpp"
 #include "turtlegas/formats/state_file.hpp"
 
@@ -29,7 +30,7 @@ RecordingWriter::RecordingWriter(std::ostream& out, const RecordingHeader& h) : 
       {"world_file", h.world_file},
       {"mode", h.mode},
       {"dt", h.dt},
-      {"until", h.until},
+      {"until", h.until ? nlohmann::ordered_json(*h.until) : nlohmann::ordered_json(nullptr)},
       {"keyframes", {{"every_seconds", h.keyframes.seconds}, {"every_events", h.keyframes.events}}},
       {"world", h.world},
   };
@@ -42,6 +43,11 @@ void RecordingWriter::events(std::span<const turtle::LogEvent> events) {
   buf_.clear();
   for (const turtle::LogEvent& e : events) append_event(buf_, event_line(e));
   lines_ += events.size();
+  put();
+}
+
+void RecordingWriter::input(std::string_view line) {
+  buf_.assign(line);
   put();
 }
 
@@ -119,7 +125,7 @@ RecordingHeader parse_header(const std::string& line, const std::string& path) {
     r.world = h.at("world");
     r.mode = h.at("mode").get<std::string>();
     r.dt = h.at("dt").get<double>();
-    r.until = h.at("until").get<double>();
+    if (!h.at("until").is_null()) r.until = h.at("until").get<double>();
     r.command = h.value("command", std::string("run"));
     r.keyframes.seconds = h.at("keyframes").at("every_seconds").get<double>();
     r.keyframes.events = h.at("keyframes").at("every_events").get<std::uint64_t>();
@@ -217,6 +223,8 @@ Recording read_recording(const std::string& path) {
       }
     } else if (starts_with(line, "{\"t\":")) {
       ++lines;
+    } else if (starts_with(line, "{\"step\":")) {
+      // a served run's input
     } else if (starts_with(line, "{\"index\":") || starts_with(line, "{\"end_of_recording\":")) {
       // A finished recording whose end line is damaged: what precedes is whole.
     } else {
@@ -258,6 +266,21 @@ Keyframe read_keyframe(const std::string& path, const Keyframe& at) {
     throw std::invalid_argument(path + ": the keyframe at byte " + std::to_string(at.offset) + " is damaged (" + e.what() +
                                 ")");
   }
+}
+
+std::string recording_inputs(const std::string& path, std::uint64_t offset, std::string_view world_name, double dt) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::invalid_argument(path + ": cannot be read");
+  std::string line, out = input_header_line(world_name, dt);
+  std::getline(in, line);  // the header
+  std::uint64_t at = line.size() + 1;
+  while (at < offset && std::getline(in, line)) {
+    at += line.size() + 1;
+    if (!starts_with(line, "{\"step\":")) continue;
+    out += line;
+    out += '\n';
+  }
+  return out;
 }
 
 std::string recording_events(const std::string& path, std::uint64_t lines) {

@@ -3,6 +3,7 @@
 
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <thread>
@@ -24,7 +25,16 @@ namespace turtlegas::server {
 
 namespace asio = boost::asio;
 
-std::filesystem::path default_web_root() { return TURTLEGAS_DEFAULT_WEB_ROOT; }
+std::filesystem::path default_web_root() {
+  // The installed page beside the program (BINDIR/../share/turtlegas/web), else the source tree's.
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path installed = (exe.parent_path() / TURTLEGAS_WEB_FROM_BIN).lexically_normal();
+    if (std::filesystem::is_regular_file(installed / "index.html", ec)) return installed;
+  }
+  return TURTLEGAS_DEFAULT_WEB_ROOT;
+}
 
 int serve(ServeOptions options, const turtle::Registry& registry, world::Scene scene) {
   boost::system::error_code ec;

@@ -51,6 +51,10 @@ void WorldHost::handle_view_message(ClientState& c, const json& m, const std::st
       throw RequestError("unknown_view", "/view: no view \"" + id.substr(0, 64) + "\" is open" + open_views_list(), "/view");
     server_->close_view(id);
     r["view"] = id;
+    record_view("close", id);
+    turtle::View closed;
+    closed.id = id;
+    note_client_view("close", closed);
   } else {
     if (!v->is_object()) throw RequestError("wrong_type", "/view must be a view object; send e.g. " + std::string(open_example), "/view");
     turtle::View view;
@@ -84,6 +88,9 @@ void WorldHost::handle_view_message(ClientState& c, const json& m, const std::st
     if (type == "view_open") server_->open_view(view);
     else server_->change_view(view);
     r["view"] = turtle::view_to_json(view);
+    const char* op = type == "view_open" ? "open" : "change";
+    record_view(op, r["view"]);
+    note_client_view(op, view);
   }
   reply(c, r);
   // Between steps the event goes out now; during one (a lockstep wait) with the step's events.

@@ -88,6 +88,8 @@ WorldHost::WorldHost(HostOptions options, const turtle::Registry& registry, worl
     *inputs_file_ << formats::input_header_line(scene.def.name, scene.def.dt);
   }
   build_world(std::move(scene));
+  start_recording();
+  plan_snapshots();
 }
 
 WorldHost::~WorldHost() = default;
@@ -99,7 +101,8 @@ void WorldHost::build_world(world::Scene scene) {
   o.mode = options_.mode;
   o.stack_bytes = options_.stack_bytes;
   o.program_budget = options_.program_budget;
-  o.input = input_;
+  o.input = world_input();
+  if (!o.input) o.input = input_;
   o.remote_reports = [this](const turtle::RemoteReport& r) { on_report(r); };
   server_.reset();
   server_ = world::make_server(scene_, registry_, o);
@@ -240,6 +243,7 @@ int WorldHost::run() {
   fan_out_events();
   if (events_file_) events_file_->flush();
   if (inputs_file_) inputs_file_->flush();
+  if (recorder_) finish_recording(stop_reason_ == "until" ? "" : stop_reason_);
   const std::string bye = dump({{"type", "bye"}, {"reason", stop_reason_}, {"t", server_->time()}});
   for (auto& [id, c] : clients_) {
     c.client->send(std::make_shared<const std::string>(bye));
@@ -253,7 +257,7 @@ int WorldHost::run() {
 void WorldHost::step_world(double target) {
   in_step_ = true;
   try {
-    server_->run_until(target);
+    advance(target);
   } catch (const std::exception& e) {
     in_step_ = false;
     fan_out_events();
@@ -267,6 +271,7 @@ void WorldHost::step_world(double target) {
 void WorldHost::fan_out_events() {
   if (events_.empty()) return;
   if (events_writer_) events_writer_->write(events_);
+  if (recorder_) recorder_->events(events_);
   bool wanted = false;
   for (const auto& [key, s] : streams_) wanted = wanted || s.kind().all_events || !s.kind().events.empty();
   if (wanted) {
@@ -283,6 +288,7 @@ void WorldHost::fan_out_events() {
 
 void WorldHost::end_world(const std::string& reason) {
   ended_ = reason;
+  if (recorder_) finish_recording("ended: " + reason, false);
   spdlog::error("the world ended at t={}: {}", fmt(server_->time()), reason);
   // Changes waiting for a boundary that will not come are answered now.
   auto refuse = [&](std::uint64_t client, const json& id, const char* request) {
@@ -416,6 +422,7 @@ void WorldHost::require_live() const {
 
 void WorldHost::write_input(const std::string& line) {
   if (inputs_file_) *inputs_file_ << line;
+  if (recorder_) recorder_->input(line);
 }
 
 void WorldHost::handle(Inbound& in) {
@@ -435,9 +442,7 @@ void WorldHost::handle(Inbound& in) {
       return;
     }
     case Inbound::Kind::state: {
-      std::ostringstream out;
-      formats::write_state(out, server_->world(), formats::RunNames{ball_ids_, scene_.def, server_->world()});
-      in.state_done(out.str());
+      in.state_done(state_text());
       return;
     }
     case Inbound::Kind::stop:
@@ -956,6 +961,7 @@ void WorldHost::do_file_requests() {
     events_writer_.reset();
     events_file_.reset();
     inputs_file_.reset();
+    if (recorder_) finish_recording("load");
     build_world(std::move(scene));
     {
       std::lock_guard lock(text_mutex_);
@@ -993,8 +999,10 @@ bool WorldHost::replay_target(double& target) {
 }
 
 void WorldHost::seek(double t) {
-  const bool rebuild = t < server_->time();
+  const bool back = t < server_->time();
   fan_out_events();
+  const bool restored = restore_snapshot(t);
+  const bool rebuild = back && !restored;
   if (rebuild) {
     world::Scene scene = world::parse_scene(world_text(), options_.world_file, registry_);
     scene.def.dt = options_.replay->dt;
@@ -1002,7 +1010,7 @@ void WorldHost::seek(double t) {
   }
   in_step_ = true;
   try {
-    server_->run_until(t);
+    replay_run_until(t);
   } catch (const std::exception& e) {
     in_step_ = false;
     events_.clear();
@@ -1010,9 +1018,10 @@ void WorldHost::seek(double t) {
     return;
   }
   in_step_ = false;
+  if (rebuild || restored) reopen_client_views();
   events_.clear();  // what happened on the way is not shown: the viewer jumps
   reanchor();
-  if (!rebuild) return;
+  if (!rebuild && !restored) return;
   std::map<std::string, FrameStream> fresh;
   for (auto& [key, s] : streams_) fresh.try_emplace(key, s.kind(), *server_).first->second.next_due = now();
   streams_ = std::move(fresh);

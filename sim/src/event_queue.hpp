@@ -34,6 +34,9 @@ class EventQueue {
   /// Starts empty over `ids` nodes (default-constructed by the caller) at `first`, `stride` bytes
   /// apart; they must stay put while the queue is used.
   void reset(Node* first, std::size_t stride, std::size_t ids);
+  /// The same nodes, moved to `first` by a copy of their records (World::copy): the queue's
+  /// links are ids, so only where the nodes are changes.
+  void rebind(Node* first) { nodes_ = first; }
   /// Inserts id or moves it to its new key (which may be infinite).
   void set(std::uint32_t id, double key);
   void remove(std::uint32_t id);

@@ -18,6 +18,12 @@ World::World(const WorldDef& def, Mode mode) : impl_(std::make_unique<Impl>()) {
 World::World(WorldDef&& def, Mode mode) : impl_(std::make_unique<Impl>()) {
   impl_->engine = detail::make_engine(std::move(def), mode);
 }
+World::World(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+World World::copy() const {
+  auto impl = std::make_unique<Impl>();
+  impl->engine = impl_->engine->clone();
+  return World(std::move(impl));
+}
 World::~World() = default;
 World::World(World&&) noexcept = default;
 World& World::operator=(World&&) noexcept = default;

@@ -17,6 +17,9 @@ import sys
 import tempfile
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from viewer_page import check_installed_viewer  # noqa: E402
+
 
 def fail(msg):
     print("deb_test: FAIL: " + msg, file=sys.stderr)
@@ -94,6 +97,8 @@ def main():
                     "usr/share/turtlegas/examples/feeler/CMakeLists.txt"]:
             if not (root / rel).exists():
                 fail("the package does not hold /" + rel)
+        check_installed_viewer(turtlegas, root / "usr/share/turtlegas/web", worlds / "tag.json", fail)
+
         if not list(root.glob("usr/lib*/**/cmake/turtlegas/turtlegasConfig.cmake")):
             fail("the package does not hold the CMake package (usr/lib/.../cmake/turtlegas)")
 

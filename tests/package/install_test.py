@@ -20,6 +20,9 @@ import sys
 import tempfile
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from viewer_page import check_installed_viewer  # noqa: E402
+
 
 def fail(msg):
     print("install_test: FAIL: " + msg, file=sys.stderr)
@@ -70,6 +73,8 @@ def main():
         first = version.splitlines()[0] if version else ""
         if not first.startswith("turtlegas ") or "commit " not in version or "build " not in version:
             fail("turtlegas --version printed " + repr(version))
+
+        check_installed_viewer(turtlegas, prefix / "share/turtlegas/web", prefix / "share/turtlegas/worlds/tag.json", fail)
 
         # Every installed header on its own: a missing include shows here, not in a user's build.
         headers = sorted((prefix / "include").rglob("*.hpp"))

@@ -58,6 +58,21 @@ BodyStore::BodyStore(const WorldDef& def, std::vector<BallDef>* release, bool wi
   }
 }
 
+BodyStore::BodyStore(const BodyStore& o)
+    : layers(o.layers), held(o.held), layered(o.layered), head(o.head), turtle_head(o.turtle_head), nb_(o.nb_) {
+  const std::size_t n = o.size();
+  if (n > 0) {
+    records_.reset(static_cast<Record*>(::operator new(n * sizeof(Record), std::align_val_t{alignof(Record)})));
+    static_assert(std::is_trivially_copyable_v<Record>);
+    std::memcpy(static_cast<void*>(records_.get()), o.records_.get(), n * sizeof(Record));
+  }
+  body = {records_.get(), n};
+  mass = {records_.get(), nb_};
+  end = {records_.get(), n};
+  last = {records_.get(), n};
+  pending = {records_.get(), n};
+}
+
 void BodyStore::insert(std::uint32_t at, bool ball) {
   const std::size_t n = size();
   auto up = [at](std::uint32_t id) { return id != kNone && id >= at ? id + 1 : id; };

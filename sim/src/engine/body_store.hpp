@@ -21,6 +21,12 @@ class BodyStore {
   /// never take memory at the same time (see the constructor). `with_layers`: keep the bodies'
   /// collision layers (scenes with extras).
   BodyStore(const WorldDef& def, std::vector<BallDef>* release, bool with_layers);
+  /// A copy with records of its own (World::copy): the records' bytes, the columns pointed at
+  /// them. The event queue that links the records must be rebound (EventQueue::rebind).
+  BodyStore(const BodyStore& other);
+  BodyStore& operator=(const BodyStore&) = delete;
+  BodyStore(BodyStore&&) noexcept = default;  // the records stay where they are: the columns hold
+  BodyStore& operator=(BodyStore&&) noexcept = default;
 
   std::uint32_t balls() const { return nb_; }
   /// Makes room for one body with id `at`: a ball at balls() (after the balls, before the

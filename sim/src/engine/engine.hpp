@@ -98,6 +98,16 @@ class Engine final : public EngineBase {
 
   void advance_to(double t) override;
   void set_event_log(std::vector<Event>* log) override { record_.log = log; }
+  std::unique_ptr<EngineBase> clone() const override {
+    // Every room is a value (vectors, the cell lists, the clocks and counters) but for the
+    // records, which BodyStore's copy gives a place of their own, and the queue, whose nodes
+    // live in the records: it is rebound to the copy's. The log pointers are the caller's.
+    auto copy = std::make_unique<Engine>(*this);
+    copy->heap_.rebind(copy->bodies_.nodes());
+    copy->record_.log = nullptr;
+    copy->record_.impulses = nullptr;
+    return copy;
+  }
   void set_impulse_log(std::vector<Impulse>* log) override { record_.impulses = log; }
   void set_event_limit(std::uint64_t limit) override { event_limit_ = limit; }
   double time() const override { return t_base_ + now_; }

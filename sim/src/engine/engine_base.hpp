@@ -13,6 +13,8 @@ class EngineBase {
  public:
   virtual ~EngineBase() = default;
   virtual void advance_to(double t) = 0;
+  /// An exact copy of the whole engine (World::copy), logging nowhere.
+  virtual std::unique_ptr<EngineBase> clone() const = 0;
   virtual void set_event_log(std::vector<Event>* log) = 0;
   virtual void set_impulse_log(std::vector<Impulse>* log) = 0;
   virtual void set_event_limit(std::uint64_t limit) = 0;

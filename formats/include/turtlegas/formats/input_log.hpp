@@ -10,6 +10,10 @@
 //   {"step": 61, "spawn": {"turtle": {"id": "t9", "pos": [80, 80], "heading": 90}}}
 //   {"step": 70, "remove": "b9"}
 //   {"step": 80, "teleport": {"id": "t9", "pos": [120, 80], "heading": 180}}
+//   {"step": 90, "view": {"op": "open", "view": {"id": "v1", "center": [250, 200], ...}}}
+// View lines are display data a client sent (view_open/change/close); `serve --inputs-out` leaves
+// them out (they change no physics), a recording of a served run (`serve --record`) keeps them so
+// that its replay shows the client's views; ReplayInput applies them when it finds them.
 // A spawn's entry is the world file's (world/entries.hpp), as the host accepted it.
 // `turtlegas serve --inputs-out` writes it; ReplayInput feeds it back to a WorldServer headless
 // (`turtlegas run --inputs`), which then gives the same event log bit for bit.
@@ -43,6 +47,9 @@ std::string input_wall_line(std::uint64_t step, const sim::WallDef& wall);
 /// kind: "ball" or "turtle"; entry: the world-file entry that was spawned.
 std::string input_spawn_line(std::uint64_t step, std::string_view kind, const nlohmann::json& entry);
 std::string input_remove_line(std::uint64_t step, std::string_view id);
+/// A client's view change: op "open" or "change" with the whole view (view_to_json), or "close"
+/// with the view's id only.
+std::string input_view_line(std::uint64_t step, std::string_view op, const nlohmann::json& view);
 /// A ball's teleport (vel) or a turtle's (heading, degrees).
 std::string input_teleport_line(std::uint64_t step, std::string_view id, sim::Vec2 pos, std::optional<sim::Vec2> vel,
                                 std::optional<double> heading);
@@ -64,16 +71,17 @@ class ReplayInput : public turtle::InputSource {
 
  private:
   struct Change {
-    enum class Kind { takeover, add_wall, spawn, remove, teleport } kind = Kind::add_wall;
+    enum class Kind { takeover, add_wall, spawn, remove, teleport, view } kind = Kind::add_wall;
     std::uint64_t step = 0;
     std::size_t turtle = 0;  ///< takeover
     sim::WallDef wall;       ///< add_wall
-    nlohmann::json spawn;    ///< spawn: {"ball": {...}} or {"turtle": {...}}
+    nlohmann::json spawn;    ///< spawn: {"ball": {...}} or {"turtle": {...}}; view: {"op", "view"}
     std::string id;          ///< remove, teleport
     sim::Vec2 pos;           ///< teleport
     std::optional<sim::Vec2> vel;
     std::optional<double> heading;
   };
+  void apply_view(turtle::WorldServer& server, const nlohmann::json& v, std::uint64_t step) const;
   SpawnApplier spawn_;
   struct Command {
     std::uint64_t step = 0;

@@ -5,6 +5,9 @@
 //              a keyframe line every N events or S simulated seconds ({"keyframe": k, ...}, the
 //              full state there, as the state file writes it: numbers shortest round-trip, so the
 //              doubles are bit-exact), after the events up to its time;
+//   in a served run's recording (`serve --record`), also the inputs the world took from outside
+//              as the input log writes them ({"step": ...}: remote turtles' commands, takeovers,
+//              walls, spawns, removals, teleports, and clients' views), at the step they were taken;
 //   at a clean end  {"index": [...], ...} (each keyframe's time and byte offset) and, last,
 //              {"end_of_recording": OFFSET_OF_THE_INDEX_LINE}.
 // Written as the run goes and flushed at every keyframe, so a run killed in the middle leaves a
@@ -17,6 +20,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -44,7 +48,7 @@ struct RecordingHeader {
   nlohmann::ordered_json world;  ///< the world file as loaded (its keys in the file's order)
   std::string mode;              ///< "exact" or "step"
   double dt = 0.0;               ///< the run's (after --dt)
-  double until = 0.0;            ///< the time the run was asked to reach
+  std::optional<double> until;   ///< the time the run was asked to reach (none: a served run without --until)
   std::string command;           ///< "run" or "serve"
   KeyframePolicy keyframes;
 };
@@ -64,11 +68,15 @@ class RecordingWriter {
   }
   /// The world server's events.
   void events(std::span<const turtle::LogEvent> events);
+  /// An input line of a served run (input_log.hpp's, newline-terminated), as it is taken.
+  void input(std::string_view line);
 
   /// Whether a keyframe is due by the events policy, with `engine_events` events taken.
   bool keyframe_due(std::uint64_t engine_events) const;
   /// A keyframe of `world` at its current time; flushes the stream.
   void keyframe(const sim::World& world, const RunNames& names);
+  /// The last keyframe's time (one is written by the constructor's caller first).
+  double last_keyframe_time() const { return index_.empty() ? 0.0 : index_.back().t; }
   /// The index and the end line; flushes. `stopped`: why the run ended early, empty when it did not.
   void finish(double t, const std::string& stopped);
 
@@ -121,6 +129,10 @@ Recording read_recording(const std::string& path);
 
 /// The keyframe at `k.offset`, whole (state and walls filled in).
 Keyframe read_keyframe(const std::string& path, const Keyframe& k);
+
+/// The input lines ({"step": ...}) of a served run's recording that precede byte `offset` (a
+/// keyframe's), as an input log (its header line first) for formats::ReplayInput.
+std::string recording_inputs(const std::string& path, std::uint64_t offset, std::string_view world_name, double dt);
 
 /// The event lines of a recording with `lines` at most (a keyframe's `lines`), as `--events` wrote
 /// them, newline-terminated.

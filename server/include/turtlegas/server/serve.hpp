@@ -17,11 +17,12 @@ struct ServeOptions {
   std::string bind = "127.0.0.1";
   unsigned short port = 8080;           ///< 0: any free port
   std::optional<unsigned short> line_port;  ///< default: port + 1, or any free port when port is 0
-  std::filesystem::path web_root;       ///< empty: the source tree's server/web
+  std::filesystem::path web_root;       ///< empty: default_web_root()
   HostOptions host;
 };
 
-/// The default web root (the source tree's server/web/).
+/// The default web root: the installed page beside the program (BINDIR/../share/turtlegas/web,
+/// cmake --install and the .deb put it there) when it is there, else the source tree's server/web/.
 std::filesystem::path default_web_root();
 
 /// Serves the scene until a signal or --until; prints the two "listening" lines on stdout first.

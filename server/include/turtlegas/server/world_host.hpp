@@ -26,6 +26,7 @@
 
 #include "turtlegas/formats/event_log.hpp"
 #include "turtlegas/formats/names.hpp"
+#include "turtlegas/formats/recording.hpp"
 #include "turtlegas/server/client.hpp"
 #include "turtlegas/server/frames.hpp"
 #include "turtlegas/server/limits.hpp"
@@ -50,6 +51,7 @@ struct ReplaySource {
   double dt = 0.0;            ///< the recorded run's (after its --dt), for the rebuilt worlds
   bool complete = true;       ///< false: it was cut, and `end` is its last keyframe's time
   std::vector<double> keyframes;  ///< their times
+  std::string inputs;  ///< a served run's recording: its inputs as an input log (formats::ReplayInput); else empty
 };
 
 struct HostOptions {
@@ -69,6 +71,8 @@ struct HostOptions {
   double program_budget = 2.0;
   Limits limits;
   std::optional<ReplaySource> replay;  ///< set: a replay (ReplaySource)
+  std::string record_path;             ///< `serve --record`: the recording (docs/recording.md); empty: none
+  formats::KeyframePolicy keyframes;   ///< its keyframes
 };
 
 class WorldHost {
@@ -192,6 +196,36 @@ class WorldHost {
   void seek(double t);
   /// A replay's next target when it plays, forward or in reverse, and whether it has one.
   bool replay_target(double& target);
+
+  // `serve --record` and a replay's own inputs and views (host_recording.cpp).
+  void start_recording();
+  /// run_until(target), cut at the recording's keyframe times, a keyframe written at each.
+  void advance(double target);
+  /// The last keyframe (when `keyframe`), the index and the end line; closes the recording.
+  void finish_recording(const std::string& stopped, bool keyframe = true);
+  void record_view(const char* op, const nlohmann::json& view);
+  /// A served run's recording replayed: its inputs, read afresh; nullptr otherwise (the host's own).
+  std::shared_ptr<turtle::InputSource> world_input();
+  /// A replay: the views its clients opened, opened again after a seek rebuilt the world.
+  void reopen_client_views();
+  void note_client_view(const char* op, const turtle::View& view);
+  std::string state_text() const;
+  /// A replay: how many snapshots it may keep (0: none: a world with turtles or a game, whose
+  /// programs cannot be copied, or a served run's recording, whose inputs are read as it goes).
+  void plan_snapshots();
+  /// A replay: run_until(t), stopping on the way at the recording's keyframe times to snapshot
+  /// the world (WorldServer::snapshot) while the budget lasts.
+  void replay_run_until(double t);
+  /// A replay: the world put back to the latest snapshot at or before t when t is behind the
+  /// world or that snapshot is ahead of it; whether it was.
+  bool restore_snapshot(double t);
+
+  std::optional<std::ofstream> record_file_;
+  std::optional<formats::RecordingWriter> recorder_;
+  double next_key_ = 0.0;
+  std::vector<turtle::View> client_views_;  ///< a replay's clients' views
+  std::map<double, std::shared_ptr<const turtle::WorldServer::Snapshot>> snapshots_;  ///< a replay's, by time
+  std::size_t max_snapshots_ = 0;
 
   HostOptions options_;
   const turtle::Registry& registry_;

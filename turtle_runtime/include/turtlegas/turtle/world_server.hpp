@@ -153,6 +153,16 @@ class WorldServer {
   /// The game, or nullptr.
   const Game* game() const;
 
+  /// An exact copy of the world at a control boundary (snapshot.cpp): the engine
+  /// (sim::World::copy), the scene, the step counter and the views, so that restore() then
+  /// run_until(t) gives what run_until(t) would have from the snapshot's time, bit for bit. Only
+  /// for worlds without turtles and games (a turtle's program is a coroutine, whose stack cannot
+  /// be copied): nullptr otherwise.
+  struct Snapshot;
+  std::shared_ptr<const Snapshot> snapshot() const;
+  /// Puts this server back to a snapshot it took; the event log (set_event_log) stays as it is.
+  void restore(const Snapshot& s);
+
   struct TurtleInfo {
     std::string id;
     sim::TurtleState state;

@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: MIT
+// `turtlegas serve --record` (docs/recording.md, "Recording a served run"): the host writes the
+// recording as `run --record` does, plus the inputs the world took from outside (the input log's
+// lines, and the clients' views), so that `turtlegas replay` re-simulates the served run exactly.
+// And a replay's own side: the inputs of a served run's recording fed back to its world, the
+// views its clients opened kept across a seek that rebuilds the world.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "turtlegas/formats/input_log.hpp"
+#include "turtlegas/formats/state_file.hpp"
+#include "turtlegas/server/world_host.hpp"
+#include "turtlegas/sim/mode_names.hpp"
+#include "turtlegas/world/entries.hpp"
+
+namespace turtlegas::server {
+
+namespace {
+
+double next_multiple(double t, double every) {
+  return every > 0.0 ? (std::floor(t / every) + 1.0) * every : INFINITY;
+}
+
+}  // namespace
+
+void WorldHost::start_recording() {
+  if (options_.record_path.empty()) return;
+  record_file_.emplace(options_.record_path, std::ios::binary | std::ios::trunc);
+  if (!*record_file_) throw std::runtime_error("--record: cannot write '" + options_.record_path + "'");
+  formats::RecordingHeader h;
+  h.command = "serve";
+  h.world_file = options_.world_file;
+  try {
+    h.world = nlohmann::ordered_json::parse(world_text());
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error("--record: the world file is not JSON (" + std::string(e.what()) + ")");
+  }
+  h.mode = sim::to_string(options_.mode);
+  h.dt = scene_.def.dt;
+  h.until = options_.until;
+  h.keyframes = options_.keyframes;
+  recorder_.emplace(*record_file_, h);
+  recorder_->keyframe(server_->world(), formats::RunNames{ball_ids_, scene_.def, server_->world()});
+  next_key_ = next_multiple(server_->time(), options_.keyframes.seconds);
+}
+
+void WorldHost::advance(double target) {
+  if (!recorder_) {
+    if (options_.replay) replay_run_until(target);
+    else server_->run_until(target);
+    return;
+  }
+  // Cut at every multiple of the keyframe period, as `run --record` cuts its chunks there (a run
+  // does not depend on where it is cut: docs/recording.md).
+  auto keyframe = [&] {
+    fan_out_events();  // the events up to the keyframe's time come before it
+    recorder_->keyframe(server_->world(), formats::RunNames{ball_ids_, scene_.def, server_->world()});
+  };
+  while (next_key_ < target && recorder_) {
+    server_->run_until(next_key_);
+    keyframe();
+    next_key_ = next_multiple(next_key_, options_.keyframes.seconds);
+  }
+  server_->run_until(target);
+  if (!recorder_) return;
+  const bool at_key = server_->time() >= next_key_;
+  if (at_key) next_key_ = next_multiple(server_->time(), options_.keyframes.seconds);
+  if (at_key || recorder_->keyframe_due(server_->world().stats().events)) keyframe();
+}
+
+void WorldHost::finish_recording(const std::string& stopped, bool keyframe) {
+  if (!recorder_) return;
+  fan_out_events();
+  if (keyframe) recorder_->keyframe(server_->world(), formats::RunNames{ball_ids_, scene_.def, server_->world()});
+  recorder_->finish(keyframe ? server_->time() : recorder_->last_keyframe_time(), stopped);
+  recorder_.reset();
+  record_file_->close();
+  if (!*record_file_) spdlog::error("--record: writing '{}' failed (disk full?)", options_.record_path);
+  record_file_.reset();
+  spdlog::info("recording '{}' closed at t={}{}", options_.record_path, server_->time(),
+               stopped.empty() ? std::string() : " (" + stopped + ")");
+}
+
+void WorldHost::record_view(const char* op, const nlohmann::json& view) {
+  if (recorder_) recorder_->input(formats::input_view_line(server_->step(), op, view));
+}
+
+std::shared_ptr<turtle::InputSource> WorldHost::world_input() {
+  if (!options_.replay || options_.replay->inputs.empty()) return nullptr;
+  // A fresh reader for every build: a seek backwards replays the inputs from the start. A spawn
+  // grows the host's scene as a live spawn does (body_changes.cpp), so that ids and frames name it.
+  formats::SpawnApplier spawn = [this](turtle::WorldServer& server, const nlohmann::json& entry) {
+    const bool ball = entry.contains("ball");
+    const std::size_t index = world::spawn_entry(server, entry, options_.replay->path, registry_);
+    const sim::WorldDef& now = server.scene();
+    if (ball) {
+      scene_.def.balls.push_back(now.balls[index]);
+      ball_ids_.push_back(now.balls[index].id);
+    } else {
+      scene_.def.turtles.push_back(now.turtles[index]);
+      scene_.programs.push_back(world::read_turtle_entry(entry.at("turtle"), "spawn", registry_).program);
+      slots_.push_back(Slot{});
+    }
+  };
+  std::istringstream in(options_.replay->inputs);
+  return std::make_shared<formats::ReplayInput>(in, scene_.def, options_.replay->path, std::move(spawn));
+}
+
+void WorldHost::note_client_view(const char* op, const turtle::View& view) {
+  if (!options_.replay) return;
+  const auto it = std::find_if(client_views_.begin(), client_views_.end(), [&](const turtle::View& v) { return v.id == view.id; });
+  const std::string o = op;
+  if (o == "open") client_views_.push_back(view);
+  else if (it != client_views_.end() && o == "change") *it = view;
+  else if (it != client_views_.end()) client_views_.erase(it);
+}
+
+void WorldHost::reopen_client_views() {
+  for (const turtle::View& v : client_views_) {
+    try {
+      if (server_->find_view(v.id)) server_->change_view(v);
+      else server_->open_view(v);
+    } catch (const std::invalid_argument& e) {
+      // A view following a turtle that is not there at this time (spawned later): shown again
+      // after a seek to a time it exists at.
+      spdlog::info("replay: view '{}' is not shown at t={}: {}", v.id, server_->time(), e.what());
+    }
+  }
+}
+
+void WorldHost::plan_snapshots() {
+  max_snapshots_ = 0;
+  if (!options_.replay || !options_.replay->inputs.empty() || !server_->snapshot()) return;
+  // About 400 bytes a ball in the engine and the scene; at most 512 MiB of snapshots.
+  const double bytes = 400.0 * static_cast<double>(server_->world().ball_count() + 16);
+  max_snapshots_ = static_cast<std::size_t>(std::clamp(512.0 * 1024 * 1024 / bytes, 1.0, 4096.0));
+}
+
+void WorldHost::replay_run_until(double t) {
+  const std::vector<double>& keys = options_.replay->keyframes;
+  for (auto k = std::upper_bound(keys.begin(), keys.end(), server_->time());
+       k != keys.end() && *k <= t && snapshots_.size() < max_snapshots_; ++k) {
+    if (snapshots_.contains(*k)) continue;
+    // Cut at the keyframe (a run does not depend on where it is cut) and copy the world there.
+    server_->run_until(*k);
+    snapshots_.emplace(*k, server_->snapshot());
+  }
+  server_->run_until(t);
+}
+
+bool WorldHost::restore_snapshot(double t) {
+  auto it = snapshots_.upper_bound(t);
+  if (it == snapshots_.begin()) return false;
+  --it;
+  if (!(t < server_->time()) && !(it->first > server_->time())) return false;
+  server_->restore(*it->second);
+  return true;
+}
+
+std::string WorldHost::state_text() const {
+  std::ostringstream out;
+  formats::write_state(out, server_->world(), formats::RunNames{ball_ids_, scene_.def, server_->world()});
+  return out.str();
+}
+
+}  // namespace turtlegas::server
