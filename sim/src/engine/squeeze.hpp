@@ -242,5 +242,53 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
   return Squeeze::wedged;
 }
 
+/// Discs squeezed by discs: a ball held by the rule between two obstacles (its course unchanged
+/// since, still touching both) that another ball pushes into both of them at once cannot move
+/// that way: it is as heavy as they are. The pusher bounces off it as off an obstacle of infinite
+/// mass moving at its velocity (with the rest threshold, so a pile rests on a wedged disc as on a
+/// wall); the held ball keeps its course and its mark. Returns false (nothing done) when neither
+/// ball is so held, or the push has a component that one obstacle alone would let it take.
+/// (Without it, a disc pressed onto a disc wedged in a V exchanged round-off velocities of 1e-19
+/// with it and the walls for ever at one instant, in step mode.)
+template <Flight Fl, bool kStep, bool kExtras>
+bool push_held(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t j) {
+  const BodyStore& bs = p.bodies;
+  auto holds = [&](std::uint32_t k, std::uint32_t other) {
+    const BodyStore::Held& h = bs.held[k];
+    if (h.a.is_none() || h.b.is_none() || h.count != bs.body[k].count) return false;
+    // (A turtle obstacle that has changed course since may have let go.)
+    for (const LastPartner who : {h.a, h.b})
+      if (who.kind() == Partner::body && bs.body[who.index()].count != (who == h.a ? h.count_a : h.count_b)) return false;
+    p.sync(k);
+    p.sync(other);
+    const Side A = side_of(p, k, h.a), B = side_of(p, k, h.b);
+    const Body& bk = bs.body[k];
+    if (!A.ok || !B.ok || A.gap > held_gap(bk) || B.gap > held_gap(bk)) return false;
+    const Vec2 d = p.arena.min_image(bk.x - bs.body[other].x);  // the way `other` pushes k
+    return dot(d, A.n) < 0.0 && dot(d, B.n) < 0.0;
+  };
+  std::uint32_t k = j, other = i;
+  if (!holds(j, i)) {
+    if (!holds(i, j)) return false;
+    k = i;
+    other = j;
+  }
+  Body& o = p.bodies.body[other];
+  const Body& bk = p.bodies.body[k];
+  const Vec2 F = p.arena.min_image(o.x - bk.x);
+  const double dist = norm(F);
+  p.record.note_contact(o.r + bk.r - dist, std::min(o.r, bk.r));
+  const Vec2 n = F / dist;
+  const Vec2 va = o.v;
+  o.v = bk.v + p.bounce(other, o.v - bk.v, n);  // as off a wall: the plain restitution
+  if (p.record.impulses) [[unlikely]]
+    p.impulse(EventKind::ball_ball, other, k, p.bodies.mass[other] * (o.v - va), -F);
+  ++p.record.stats.ball_ball;
+  p.note(EventKind::ball_ball, i, j);
+  p.changed(other);
+  p.bodies.last[other] = LastPartner::of(Partner::body, k);
+  return true;
+}
+
 }  // namespace
 }  // namespace turtlegas::sim::detail
