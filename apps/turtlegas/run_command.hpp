@@ -46,6 +46,9 @@ struct RunOptions {
   int observe_samples = 20, observe_bins = 20, observe_speed_bins = 40;
   std::string observe_axis = "y";
   double svg_trails = 0.0;  ///< seconds of each ball's path the SVG draws (0: none)
+  /// How many evenly spaced instants --stats measures the deepest overlap at (0: only at
+  /// contacts and the end); unset: the default of overlap_samples() in run_command.cpp.
+  std::optional<std::uint64_t> overlap_samples;
 };
 
 /// The `run` subcommand's command line, parsed into a RunOptions by options() once CLI11 has run.

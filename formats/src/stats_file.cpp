@@ -44,6 +44,7 @@ nlohmann::json stats_json(const RunFigures& run, const sim::World& world) {
       {"energy_end", run.energy_end},
       {"max_overlap", run.max_overlap},
       {"max_overlap_relative", run.max_overlap_relative},
+      {"overlap_samples", run.overlap_samples},
   };
   if (!run.stopped.empty()) j["stopped"] = run.stopped;
   return j;

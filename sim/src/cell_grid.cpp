@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "turtlegas/sim/format.hpp"
 
@@ -49,6 +50,25 @@ int cells_along(double extent, double min_cell) {
   return k > 1e9 ? 1000000000 : static_cast<int>(k);
 }
 
+// The part of segment p->q inside the box [x0, x1] x [y0, y1] (Liang-Barsky), as parameters
+// [t0, t1] along it; t0 > t1 when it misses the box.
+std::pair<double, double> clip_to_box(Vec2 p, Vec2 q, double x0, double y0, double x1, double y1) {
+  double t0 = 0.0, t1 = 1.0;
+  const Vec2 d = q - p;
+  const double pk[4] = {-d.x, d.x, -d.y, d.y};
+  const double qk[4] = {p.x - x0, x1 - p.x, p.y - y0, y1 - p.y};
+  for (int k = 0; k < 4; ++k) {
+    if (pk[k] == 0.0) {
+      if (qk[k] < 0.0) return {1.0, 0.0};
+    } else {
+      const double r = qk[k] / pk[k];
+      if (pk[k] < 0.0) t0 = std::max(t0, r);
+      else t1 = std::min(t1, r);
+    }
+  }
+  return {t0, t1};
+}
+
 }  // namespace
 
 CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
@@ -77,7 +97,10 @@ CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
     double entries = 0.0, longest = 0.0;
     for (std::uint32_t w = 0; w < walls.size(); ++w) {
       if (w < skip.size() && skip[w]) continue;
-      const Vec2 d = walls[w].len * walls[w].u;
+      const Vec2 p = walls[w].p1, q = walls[w].p1 + walls[w].len * walls[w].u;
+      const auto [t0, t1] = clip_to_box(p, q, -cw_, -ch_, width_ + cw_, height_ + ch_);
+      if (!(t0 <= t1)) continue;
+      const Vec2 d = (t1 - t0) * (q - p);
       const double crossed = std::min(std::abs(d.x) / cw_ + 2.0, nx_ + 2.0) + std::min(std::abs(d.y) / ch_ + 2.0, ny_ + 2.0);
       entries += 10.0 * crossed;
       longest = std::max(longest, walls[w].len);
@@ -100,8 +123,15 @@ CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
   for (std::uint32_t w = 0; w < walls.size(); ++w) {
     if (w < skip.size() && skip[w]) continue;
     const Vec2 p = walls[w].p1, q = walls[w].p1 + walls[w].len * walls[w].u;
-    const int ix0 = col(std::min(p.x, q.x) - sx), ix1 = col(std::max(p.x, q.x) + sx);
-    const int iy0 = row(std::min(p.y, q.y) - sy), iy1 = row(std::max(p.y, q.y) + sy);
+    // Only the part of a wall within one cell of the arena can be reached: bodies are inside the
+    // arena (they exit an open one, walls stay in a periodic one) and no wider than a cell. The
+    // rest is not listed (a wall 1e15 long rising slowly above a long thin arena was listed in
+    // every cell of the ring above it, 3.7e6 of them: `check` took 60 s and 1.4 GB).
+    const auto [t0, t1] = clip_to_box(p, q, -cw_, -ch_, width_ + cw_, height_ + ch_);
+    if (!(t0 <= t1)) continue;
+    const Vec2 cp = t0 > 0.0 ? p + t0 * (q - p) : p, cq = t1 < 1.0 ? p + t1 * (q - p) : q;
+    const int ix0 = col(std::min(cp.x, cq.x) - sx), ix1 = col(std::max(cp.x, cq.x) + sx);
+    const int iy0 = row(std::min(cp.y, cq.y) - sy), iy1 = row(std::max(cp.y, cq.y) + sy);
     for (int iy = iy0; iy <= iy1; ++iy)
       for (int ix = ix0; ix <= ix1; ++ix) {
         // Ring cells extend to infinity outward so that walls beyond the grid are still listed.
@@ -149,12 +179,34 @@ CellGrid::CellGrid(double width, double height, double min_cell, bool periodic,
   };
   spread(wl, nw);
   spread(el, ne);
+  // Periodic arenas: the ring cells' items again, folded into the arena cells across the seam
+  // with their shift, for step mode's scans (which wrap onto arena cells only and so never read a
+  // ring cell: a wall end on x = W was invisible to them).
+  std::vector<std::pair<std::uint32_t, Near>> sw, se;
+  auto fold = [&](const std::vector<std::pair<std::uint32_t, std::uint32_t>>& src,
+                  std::vector<std::pair<std::uint32_t, Near>>& out) {
+    if (!periodic_) return;
+    for (const auto& [cell, item] : src) {
+      int ix = ix_of(static_cast<int>(cell)), iy = iy_of(static_cast<int>(cell));
+      if (ix >= 1 && ix <= nx_ && iy >= 1 && iy <= ny_) continue;
+      Vec2 base{};
+      if (ix < 1) { ix += nx_; base.x = width_; }
+      else if (ix > nx_) { ix -= nx_; base.x = -width_; }
+      if (iy < 1) { iy += ny_; base.y = height_; }
+      else if (iy > ny_) { iy -= ny_; base.y = -height_; }
+      out.emplace_back(index(ix, iy), Near{item, shift_index(base)});
+    }
+  };
+  fold(wl, sw);
+  fold(el, se);
   slot_.assign(n, 0);
   records_.assign(1, Ranges{});
   store(wl, wall_items_, &Ranges::walls);
   store(el, end_items_, &Ranges::ends);
   store(nw, near_walls_, &Ranges::near_walls);
   store(ne, near_ends_, &Ranges::near_ends);
+  store(sw, seam_walls_, &Ranges::seam_walls);
+  store(se, seam_ends_, &Ranges::seam_ends);
 }
 
 CellGrid::Ranges& CellGrid::record_for(std::uint32_t cell) {
@@ -200,7 +252,7 @@ std::uint32_t CellGrid::shift_index(Vec2 s) const {
 std::size_t CellGrid::memory_bytes() const {
   return sizeof(double) * (x_lines_.capacity() + y_lines_.capacity()) +
          sizeof(std::uint32_t) * (slot_.capacity() + wall_items_.capacity() + end_items_.capacity()) +
-         sizeof(Ranges) * records_.capacity() + sizeof(Near) * (near_walls_.capacity() + near_ends_.capacity());
+         sizeof(Ranges) * records_.capacity() + sizeof(Near) * (near_walls_.capacity() + near_ends_.capacity() + seam_walls_.capacity() + seam_ends_.capacity());
 }
 
 }  // namespace turtlegas::sim::detail

@@ -97,6 +97,14 @@ class CellGrid {
   const Near* near_walls_end(int cell) const { return near_walls_.data() + ranges(cell).near_walls[1]; }
   const Near* near_ends_begin(int cell) const { return near_ends_.data() + ranges(cell).near_ends[0]; }
   const Near* near_ends_end(int cell) const { return near_ends_.data() + ranges(cell).near_ends[1]; }
+  /// Periodic arenas: what the ring cells list (walls and ends on the seam x = W or y = H, or
+  /// reaching below x = 0 or y = 0), folded into the arena cell across the seam, each with the
+  /// shift (index into shifts()) that brings it to the arena cell's side. Step mode's ring scans
+  /// read these beside walls_begin/ends_begin, which never reach a ring cell in a periodic arena.
+  const Near* seam_walls_begin(int cell) const { return seam_walls_.data() + ranges(cell).seam_walls[0]; }
+  const Near* seam_walls_end(int cell) const { return seam_walls_.data() + ranges(cell).seam_walls[1]; }
+  const Near* seam_ends_begin(int cell) const { return seam_ends_.data() + ranges(cell).seam_ends[0]; }
+  const Near* seam_ends_end(int cell) const { return seam_ends_.data() + ranges(cell).seam_ends[1]; }
   Vec2 shift(std::uint32_t k) const { return shifts_[k]; }
   std::uint32_t shift_index(Vec2 s) const;
 
@@ -114,6 +122,8 @@ class CellGrid {
     std::uint32_t ends[2] = {0, 0};
     std::uint32_t near_walls[2] = {0, 0};
     std::uint32_t near_ends[2] = {0, 0};
+    std::uint32_t seam_walls[2] = {0, 0};
+    std::uint32_t seam_ends[2] = {0, 0};
   };
   const Ranges& ranges(int cell) const { return records_[slot_[static_cast<std::size_t>(cell)]]; }
   Ranges& record_for(std::uint32_t cell);
@@ -124,7 +134,7 @@ class CellGrid {
   std::vector<std::uint32_t> slot_;
   std::vector<Ranges> records_;
   std::vector<std::uint32_t> wall_items_, end_items_;
-  std::vector<Near> near_walls_, near_ends_;
+  std::vector<Near> near_walls_, near_ends_, seam_walls_, seam_ends_;
   Vec2 shifts_[9];
 };
 

@@ -23,7 +23,8 @@ struct DiscView {
 };
 
 /// Deepest overlap among discs (ball-ball) and between discs and segments, found with a grid of
-/// sorted cell keys built from scratch (independent of the engine's grid; 4 bytes per disc).
+/// sorted cell keys built from scratch (independent of the engine's grid; 24 bytes per disc while it
+/// runs).
 /// Periodic arenas use the minimum image when width/height are > 0. ball_pairs false checks discs
 /// against walls only. With layers given, pairs whose collision layers do not meet are skipped
 /// (they may overlap).

@@ -68,17 +68,38 @@ struct DeformingContact {
     const double f1 = cross(d0, v) + cross(w, rel);
     return (f1 - f0 * dot(d0, w) / l2) / std::sqrt(l2);
   }
+  // Whether the disc overlaps the segment on `side` at t: inside the line's strip, foot on it.
+  bool overlaps(double t, double side) const { return side * distance(t) - radius < 0.0 && foot_on_segment(t); }
 };
 
 }  // namespace
+
+double deforming_line_accel(Vec2 rel, Vec2 v, Vec2 a, Vec2 d0, Vec2 w) {
+  // sigma = f / L with f = cross(D, Y) = f0 + f1 t + f2 t^2 + ... and L = |D| = sqrt(Q),
+  // Q = l0 + l1 t + l2 t^2: sigma'' = f''/L - 2 f' L'/L^2 - f L''/L^2 + 2 f L'^2/L^3 at t = 0,
+  // with L' = Q'/(2L) and L'' = Q''/(2L) - Q'^2/(4 L^3).
+  const double l0 = norm2(d0), l1 = 2.0 * dot(d0, w), l2 = norm2(w);
+  const double f0 = cross(d0, rel), f1 = cross(d0, v) + cross(w, rel), f2 = 0.5 * cross(d0, a) + cross(w, v);
+  const double L = std::sqrt(l0);
+  const double Lp = l1 / (2.0 * L);
+  const double Lpp = l2 / L - l1 * l1 / (4.0 * l0 * L);
+  return (2.0 * f2 - 2.0 * f1 * Lp / L - f0 * Lpp / L + 2.0 * f0 * Lp * Lp / l0) / L;
+}
 
 double toi_disc_deforming_segment(Vec2 rel, Vec2 v, Vec2 a, Vec2 d0, Vec2 w, double radius, double t_max) {
   const double f0 = cross(d0, rel);
   if (f0 == 0.0 || !(t_max >= 0.0)) return kNever;  // on the line: overlapping, or beyond an end
   const DeformingContact c{rel, v, a, d0, w, radius};
   // Touching and approaching collides now; touching and receding looks for the next contact.
+  // Touching at rate 0 with the line closing at second order (a disc touching the pivot of a
+  // turning arm, whose point there does not move) collides now too, as a disc at rest on a fixed
+  // wall under gravity does (first_approach_quadratic); the bounce then leaves it at the rest
+  // threshold's speed (Restitution::bounce, with the press of the turning line).
   const double side0 = f0 > 0.0 ? 1.0 : -1.0;
-  if (side0 * c.distance(0.0) - radius <= 0.0 && c.foot_on_segment(0.0) && side0 * c.distance_rate0() < 0.0) return 0.0;
+  if (side0 * c.distance(0.0) - radius <= 0.0 && c.foot_on_segment(0.0)) {
+    const double rate = side0 * c.distance_rate0();
+    if (rate < 0.0 || (rate == 0.0 && side0 * deforming_line_accel(rel, v, a, d0, w) < 0.0)) return 0.0;
+  }
   // f(t) = cross(D, Y) = f0 + f1 t + f2 t^2 + f3 t^3 and |D|^2 = l0 + l1 t + l2 t^2; the distance is
   // +-radius only where h = f^2 - radius^2 |D|^2 is zero.
   const Vec2 ah = 0.5 * a;
@@ -88,21 +109,35 @@ double toi_disc_deforming_segment(Vec2 rel, Vec2 v, Vec2 a, Vec2 d0, Vec2 w, dou
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) h[i + j] += f[i] * f[j];
   for (int i = 0; i < 3; ++i) h[i] -= radius * radius * l[i];
-  double roots[6];
-  const int n = real_roots_in(h, 6, 0.0, t_max, roots);
+  double roots[16];  // 6 + 3 + 3 at most (16: std::sort's insertion threshold, for -Warray-bounds)
+  int n = real_roots_in(h, 6, 0.0, t_max, roots);
   // Between consecutive roots of h neither side's gap (side * distance - radius) changes sign: read
   // the distance at the midpoints and take the first fall of either gap from outside to inside with
   // the foot on the segment. Both sides count: the disc may pass the line beyond an end and meet
   // the other face later, the wall turning back onto it.
-  double knots[8];
-  int nk = 0;
-  knots[nk++] = 0.0;
-  for (int k = 0; k < n; ++k)
-    if (roots[k] > knots[nk - 1] && roots[k] < t_max) knots[nk++] = roots[k];
-  knots[nk++] = t_max;
+  // Touching and receding: until the gap has grown past the round-off of the distance (some ulps
+  // of the positions), a "fall" read there is noise (a disc bounced off an arm it rides with got
+  // one at 1e-19 s, for ever); roots of h before then are no knots.
+  double t_skip = 0.0;
+  {
+    const double noise = 0x1p-46 * (norm(rel) + norm(d0) + radius);
+    const double rate = side0 * c.distance_rate0();
+    if (side0 * c.distance(0.0) - radius <= noise && rate > 0.0) t_skip = noise / rate;
+  }
+  double knots[18];
+  auto make_knots = [&] {
+    int nk = 0;
+    knots[nk++] = 0.0;
+    for (int k = 0; k < n; ++k)
+      if (roots[k] > knots[nk - 1] && roots[k] > t_skip && roots[k] < t_max) knots[nk++] = roots[k];
+    knots[nk++] = t_max;
+    return nk;
+  };
+  int nk = make_knots();
+  double found = kNever;
   double prev_mid = 0.0;
   double prev_dist = c.distance(0.0);
-  for (int k = 0; k + 1 < nk; ++k) {
+  for (int k = 0; k + 1 < nk && found == kNever; ++k) {
     const double mid = knots[k] + 0.5 * (knots[k + 1] - knots[k]);
     const double dist = c.distance(mid);
     for (double side : {1.0, -1.0}) {
@@ -114,13 +149,47 @@ double toi_disc_deforming_segment(Vec2 rel, Vec2 v, Vec2 a, Vec2 d0, Vec2 w, dou
         if (m <= lo || m >= hi) break;
         (side * c.distance(m) - radius >= 0.0 ? lo : hi) = m;
       }
-      if (c.foot_on_segment(lo)) return lo;
+      if (c.foot_on_segment(lo)) {
+        found = lo;
+        break;
+      }
     }
     prev_mid = mid;
     prev_dist = dist;
   }
-  // A fall at t_max itself (the last root at the horizon) is left to the next prediction.
-  return kNever;
+  // (A fall at t_max itself, the last root at the horizon, is left to the next prediction.)
+  // The other way into an overlap: the foot comes onto the segment over an end while the gap is
+  // <= 0. Anywhere but at a pivot the disc would overlap that end, which is met first; at the
+  // pivot of a turning arm a disc touching the end stays touching it while the line sweeps round
+  // onto it, and its gap is exactly 0 there (a double root of h). Those instants are roots of h or
+  // of the foot's q = dot(Y, D) = 0 or |D|^2 (cubics at most): with them as knots, whether the disc
+  // overlaps the segment is the same over each interval between knots.
+  const double q0[4] = {dot(rel, d0), dot(v, d0) + dot(rel, w), dot(ah, d0) + dot(v, w), dot(ah, w)};
+  const double q1[4] = {q0[0] - l[0], q0[1] - l[1], q0[2] - l[2], q0[3]};
+  n += real_roots_in(q0, 3, 0.0, t_max, roots + n);
+  n += real_roots_in(q1, 3, 0.0, t_max, roots + n);
+  std::sort(roots, roots + n);
+  nk = make_knots();
+  prev_mid = 0.0;
+  for (int k = 0; k + 1 < nk && knots[k] < found; ++k) {
+    const double mid = knots[k] + 0.5 * (knots[k + 1] - knots[k]);
+    for (double side : {1.0, -1.0}) {
+      // Not overlapping before, and not outside the line's strip either (that is a fall, above).
+      if (!c.overlaps(mid, side) || c.overlaps(prev_mid, side) || side * c.distance(prev_mid) - radius > 0.0) continue;
+      double lo = prev_mid, hi = mid;
+      for (int it = 0; it < 200; ++it) {
+        const double m = lo + 0.5 * (hi - lo);
+        if (m <= lo || m >= hi) break;
+        (c.overlaps(m, side) ? hi : lo) = m;
+      }
+      // Only at the contact distance (the pivot's case, within the overlap budget): a disc passing
+      // an end deeper than that meets the end, which is the end's contact, not this one's.
+      if (side * c.distance(lo) - radius < -1e-9 * radius) continue;
+      return std::min(lo, found);
+    }
+    prev_mid = mid;
+  }
+  return found;
 }
 
 double toi_disc_point_accel(Vec2 rel, Vec2 v, Vec2 a, double radius, double t_max) {

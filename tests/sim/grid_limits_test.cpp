@@ -8,8 +8,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "scenes.hpp"
+#include "cell_grid.hpp"
 #include "overlap.hpp"
+#include "scenes.hpp"
 #include "turtlegas/sim/format.hpp"
 #include "turtlegas/sim/world.hpp"
 
@@ -47,6 +48,27 @@ TEST_CASE("a wall reaching y = 1e30 is listed in the grid, and a ball bounces of
     CHECK(w.ball(0).pos.x < 49.0);
     CHECK(w.measure_overlap().relative <= 1e-9);
   }
+}
+
+TEST_CASE("only the part of a wall within a cell of the arena is listed", "[grid]") {
+  // slow-check-long-walls.json: over an arena 7e13 x 400 (cells 400 high, 3.7e6 across), a wall
+  // from (299, 0) to (1e15, 1e6) leaves the arena at x = 4e11 but ran on through the ring row
+  // above it to x = 7e13: it was listed in all 3.7e6 ring cells and their neighbourhoods (`check`:
+  // 60 s, 1.4 GB). Beyond one cell outside the arena no body can reach it.
+  const double width = 7e13, height = 400, cell = 7e13 / 3741657;
+  const std::vector<Segment> walls{make_segment({299, 0}, {1e15, 1e6})};
+  const detail::CellGrid grid(width, height, cell, false, walls, {});
+  CHECK(grid.memory_bytes() < 100e6);  // the table: 45 MB (3.7e6 x 3 cells of 4 bytes), its lines 30 MB
+  auto lists = [&](double x, int iy) {
+    const int c = grid.index(static_cast<int>(std::floor(x / grid.cell_w())) + 1, iy);
+    return grid.walls_begin(c) != grid.walls_end(c);
+  };
+  // Still listed where a body can meet it: in the arena's row under it (y = 390 at x = 3.9e11) and
+  // in the ring cell above the arena within a cell of it (y = 500 at x = 5e11) ...
+  CHECK(lists(3.9e11, 1));
+  CHECK(lists(5e11, 2));
+  // ... but not further out (y = 1000 at x = 1e12, more than a cell above the arena).
+  CHECK_FALSE(lists(1e12, 2));
 }
 
 TEST_CASE("an arena of absurd aspect is refused with the key to change, not an overflow or a hang", "[grid]") {
@@ -144,6 +166,71 @@ TEST_CASE("walls and wall ends on a periodic arena's seam are seen from both sid
     w.advance_to(5.0);
     CHECK(count(log, EventKind::ball_wall) == 2);  // the other at x = 99, t = 4
     CHECK(w.measure_overlap().relative <= 1e-9);
+  }
+}
+
+TEST_CASE("step mode sees walls and wall ends on a periodic arena's seam too", "[grid][periodic][step]") {
+  // Its ring scans wrap onto arena cells only, and the seam x = W lists its walls and ends in the
+  // ring column col(W) = nx + 1, which they never read: the end at (100, 50) was invisible and a
+  // disc ran half a radius into it and on through the wall (docs/physics.md, "The grid").
+  for (double y : {50.0, 50.5, 49.2}) {
+    INFO("the disc at y = " << y);
+    WorldDef d = box(100, 100, Boundary::periodic);
+    d.walls.push_back({"w", {60, 50}, {100, 50}});
+    d.balls.push_back(ball("b", {10, y}, {-1, 0}, 1));
+    World w(d, Mode::step);
+    std::vector<Event> log;
+    w.set_event_log(&log);
+    w.set_event_limit(100000);
+    double worst = 0.0;
+    for (int k = 1; k <= 120; ++k) {
+      w.advance_to(k * 0.1);
+      worst = std::max(worst, w.measure_overlap().relative);
+    }
+    REQUIRE(!log.empty());
+    CHECK(log[0].kind == EventKind::ball_wall_end);
+    // It meets the end's image (0, 50) when its centre is one radius from it.
+    CHECK(log[0].t == Approx(9.0 + (1.0 - std::sqrt(1.0 - (y - 50) * (y - 50)))).epsilon(1e-12));
+    CHECK(worst <= 1e-9);
+  }
+  {
+    // A wall lying along x = W: discs from both sides meet it (at x = 1 and x = 99).
+    WorldDef d = box(100, 100, Boundary::periodic);
+    d.walls.push_back({"w", {100, 20}, {100, 80}});
+    d.balls.push_back(ball("b", {3, 50}, {-1, 0}, 1));
+    d.balls.push_back(ball("c", {95, 30}, {1, 0}, 1));
+    World w(d, Mode::step);
+    std::vector<Event> log;
+    w.set_event_log(&log);
+    w.set_event_limit(100000);
+    double worst = 0.0;
+    for (int k = 1; k <= 50; ++k) {
+      w.advance_to(k * 0.1);
+      worst = std::max(worst, w.measure_overlap().relative);
+    }
+    REQUIRE(count(log, EventKind::ball_wall) == 2);
+    CHECK(log[0].t == Approx(2.0).epsilon(1e-12));
+    CHECK(log[1].t == Approx(4.0).epsilon(1e-12));
+    CHECK(worst <= 1e-9);
+  }
+  {
+    // A wall ending on the seam y = H, met from y = 5 going down: its image ends at (50, 0).
+    WorldDef d = box(100, 100, Boundary::periodic);
+    d.walls.push_back({"w", {50, 60}, {50, 100}});
+    d.balls.push_back(ball("b", {50, 5}, {0, -1}, 1));
+    World w(d, Mode::step);
+    std::vector<Event> log;
+    w.set_event_log(&log);
+    w.set_event_limit(100000);
+    double worst = 0.0;
+    for (int k = 1; k <= 60; ++k) {
+      w.advance_to(k * 0.1);
+      worst = std::max(worst, w.measure_overlap().relative);
+    }
+    REQUIRE(!log.empty());
+    CHECK(log[0].kind == EventKind::ball_wall_end);
+    CHECK(log[0].t == Approx(4.0).epsilon(1e-12));
+    CHECK(worst <= 1e-9);
   }
 }
 

@@ -452,6 +452,13 @@ void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
         if (keep_first) repredict(c.first);
         if (keep_second) repredict(c.second);
       } else {
+        // A ball the squeeze rule holds, pushed into its holders, is as heavy as they are.
+        if (!bodies_.held.empty()) [[unlikely]] {
+          if (push_held(parts(), i, p.partner)) {
+            served({i, p.partner});
+            return;
+          }
+        }
         served(apply_ball_ball(parts(), i, p.partner));
       }
       return;

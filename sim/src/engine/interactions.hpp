@@ -176,29 +176,50 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
   // The velocity of the wall's material point at the contact: the ends' velocities interpolated
   // at the foot (the same for every point of a translating wall).
   Vec2 u{};
+  bool turning = false;
+  double press = 0.0;  // the body's acceleration along n relative to a turning wall's line (< 0: pressed)
+  const double d = dot(p.arena.rel_to_segment(a.x, s), s.n);
   if (mi != kNone) {
     const Mover& m = p.schedule.movers[mi];
     u = m.u;
-    if (!m.rigid()) u += std::clamp(dot(a.x - s.p1, s.u) / s.len, 0.0, 1.0) * m.w;
+    if (!m.rigid()) {
+      turning = true;
+      u += std::clamp(dot(a.x - s.p1, s.u) / s.len, 0.0, 1.0) * m.w;
+      // Its line accelerates relative to the body even where its material point does not move
+      // (a pivot): the rest threshold counts that press as it counts a field's.
+      const Vec2 vb = p.is_turtle(i) ? Vec2{} : a.v;
+      press = (d >= 0.0 ? 1.0 : -1.0) * deforming_line_accel(a.x - s.p1, vb - m.u, Vec2{}, m.d_at(p.now), m.w);
+    }
   }
-  const double d = dot(p.arena.rel_to_segment(a.x, s), s.n);
   const Vec2 n = d >= 0.0 ? s.n : -s.n;
   p.record.note_contact(a.r - std::abs(d), a.r);
   if (p.is_turtle(i)) {
     ++p.record.stats.turtle_wall;
     p.note(EventKind::turtle_wall, i - p.bodies.balls(), w);
     p.touch(i, EventKind::turtle_wall, w, n);
-    if (dot(u, n) > 0.0) {
-      // A moving wall pushing a turtle carries it along at its normal speed (both have
-      // infinite mass), until the wall's next keyframe. A turning or stretching wall's push
-      // changes along the way, so it knocks the turtle off instead, at twice its normal speed
-      // (an elastic bounce off the wall), which the wall can only catch up with by speeding up.
-      a.v = (p.schedule.movers[mi].rigid() ? 1.0 : 2.0) * dot(u, n) * n;
+    // A moving wall pushing a turtle carries it along at its normal speed (both have infinite
+    // mass), until the wall's next keyframe. A turning or stretching wall's push changes along the
+    // way, so it knocks the turtle off instead, at twice its normal speed (an elastic bounce off
+    // the wall), which the wall can only catch up with by speeding up; at least at the rest
+    // threshold's speed for its press (at a pivot the normal speed is 0).
+    const double un = dot(u, n);
+    double knock = !turning ? un : std::max(2.0 * un, -press * p.restitution.tc / 2.0);
+    if (turning && knock > 0.0) knock = std::max(knock, 0x1p-40 * norm(u));  // (round-off: as for a ball, below)
+    if (knock > 0.0) {
+      a.v = knock * n;
       p.turtles.pushed_by[i - p.bodies.balls()] = mi;
     }
   } else {
     const Vec2 va = a.v;
-    a.v = u + p.bounce(i, a.v - u, n);
+    a.v = u + p.bounce(i, a.v - u, n, press);
+    if (turning) {
+      // A turning line's approach rate (the solver's) and the normal speed of its point at the foot
+      // (this response's) agree only to round-off: a ball left at a rate within it (riding the arm
+      // at its speed) could be "touching and approaching" again at once, for ever. It leaves at
+      // 2^-40 of its speed at least (1e-12: far below any physics, far above the round-off).
+      const double floor = 0x1p-40 * (norm(a.v) + norm(u)), rn = dot(a.v - u, n);
+      if (rn < floor) a.v += (floor - rn) * n;
+    }
     if (p.record.impulses) [[unlikely]]
       p.impulse(EventKind::ball_wall, i, w, p.bodies.mass[i] * (a.v - va), std::abs(d) * n);
     ++p.record.stats.ball_wall;

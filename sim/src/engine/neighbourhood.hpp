@@ -145,6 +145,22 @@ template <bool kBallBall, Flight F, bool kExtras>
         st = step.scan;
         predict_end(l, i, bi, *it, nb.shift, p);
       }
+      if (!periodic) continue;
+      // What the ring cells list, folded across the seam (CellGrid::seam_walls_begin).
+      for (auto it = grid.seam_walls_begin(nb.cell); it != grid.seam_walls_end(nb.cell); ++it) {
+        const Vec2 shift = nb.shift + grid.shift(it->shift);
+        std::uint32_t& st = step.stamp[it->item * 9 + grid.shift_index(shift)];
+        if (st == step.scan) continue;
+        st = step.scan;
+        predict_wall(l, i, bi, it->item, shift, p);
+      }
+      for (auto it = grid.seam_ends_begin(nb.cell); it != grid.seam_ends_end(nb.cell); ++it) {
+        const Vec2 shift = nb.shift + grid.shift(it->shift);
+        std::uint32_t& st = step.stamp[walls * 9 + it->item * 9 + grid.shift_index(shift)];
+        if (st == step.scan) continue;
+        st = step.scan;
+        predict_end(l, i, bi, it->item, shift, p);
+      }
     }
   if constexpr (kExtras)
     for (std::uint32_t m = 0; m < l.schedule.movers.size(); ++m) predict_mover(l, i, bi, m, p);

@@ -157,9 +157,11 @@ struct Parts {
     turtles.touch(id - bodies.balls(), bodies.body[id], bodies.end[id], now, t_base, dt, kind, other, normal);
   }
   /// The bounce of ball i (at the contact, its velocity not yet changed) off an obstacle, v its
-  /// velocity relative to the obstacle (Restitution::bounce, under the ball's field).
-  Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n) const {
-    return restitution.bounce(v, n, motion.flight().normal_accel(i, bodies.body[i].v, n));
+  /// velocity relative to the obstacle (Restitution::bounce, under the ball's field, plus `press`:
+  /// the ball's acceleration along n relative to the obstacle that the obstacle's own motion adds,
+  /// a turning wall's; negative presses).
+  Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n, double press = 0.0) const {
+    return restitution.bounce(v, n, motion.flight().normal_accel(i, bodies.body[i].v, n) + press);
   }
 };
 

@@ -6,7 +6,8 @@
 //   1. held: if its free room towards A is within kHeldGap of a radius, it touches both. Its
 //      velocity becomes the nearest one that leaves both (the velocity of a perfectly inelastic
 //      contact with both at once); if none exists (A and B parallel and closing), it is crushed.
-//   2. certain crush: if A and B are parallel wall interiors closing at rate c > 0, nothing
+//   2. certain crush: if A and B are parallel wall interiors (or a wall's interior and a wall end
+//      the body is exactly in line with) closing at rate c > 0, nothing
 //      changes their motion before the room g closes (the next keyframe is after now + g/c) and
 //      the body stays between them until then (flying straight), no sequence of bounces can save
 //      it: it stops bouncing and rides on B (its velocity along the normal becomes B's), meets A
@@ -39,6 +40,8 @@ inline constexpr double kParallel = 1e-9;
 struct Side {
   bool ok = false;       ///< an obstacle of infinite mass that is still there
   bool interior = false; ///< a wall's interior, the contact foot strictly inside it
+  bool point = false;    ///< a wall end (fixed, or a moving wall's, moving in a straight line), or a turtle's centre
+  Vec2 at;               ///< a point's position now
   Vec2 n;                ///< unit normal from the obstacle to the body
   Vec2 u;                ///< velocity of the obstacle's surface at the contact
   double gap = 0.0;      ///< distance from the obstacle minus the contact distance
@@ -67,6 +70,8 @@ Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner wh
       s.gap = dist - a.r - t.r;
       s.name = k - p.bodies.balls();
       s.turtle = true;
+      s.point = true;
+      s.at = a.x - F;
       break;
     }
     case Partner::wall: {
@@ -98,6 +103,8 @@ Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner wh
       s.n = F / dist;
       s.gap = dist - a.r;
       s.name = end.wall;
+      s.point = true;
+      s.at = a.x - F;
       break;
     }
     case Partner::moving_end: {
@@ -111,6 +118,8 @@ Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner wh
       s.gap = dist - a.r;
       s.name = m.wall;
       s.mover = k / 2;
+      s.point = true;
+      s.at = a.x - F;
       break;
     }
   }
@@ -126,6 +135,14 @@ inline bool stays_over(Vec2 x, Vec2 v, const Side& s, double tau) {
   const Vec2 rel_then = (x + tau * v) - (s.seg.p1 + tau * s.u);
   const double foot = dot(rel_then, s.seg.u);
   return s.interior && foot > 0.0 && foot < s.seg.len;
+}
+
+/// Whether the body's centre, flying straight at v, stays on the squeeze's axis through point
+/// obstacle s (moving at s.u) from now to now + tau: the axis is the other obstacle's normal n,
+/// and off it by more than kParallel of the distance the two normals would no longer be parallel.
+inline bool stays_on_axis(Vec2 x, Vec2 v, const Side& s, Vec2 n, double tau) {
+  const Vec2 rel_then = (x + tau * v) - (s.at + tau * s.u);
+  return std::abs(cross(rel_then, n)) <= kParallel * norm(rel_then);
 }
 
 /// The squeeze rule for body i, which has just been answered at a contact with `b` (its velocity
@@ -170,8 +187,9 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
       // Under a field that presses the body into A or B, leaving it at rate 0 would let it sink
       // at once: the rest threshold (Restitution::bounce) for both contacts, each pressed one left
       // at least at -a_n tc / 2. Parallel obstacles cannot both be left: the pressed one wins,
-      // and the body, kept in the room by the field, sinks into the other by at most
-      // a_n tc^2 / 8 before it falls back (docs/physics.md).
+      // and the body, with no room to hop in, rises into the other by w^2 / (2 |a_n|) before the
+      // field brings it back; so the hop there is capped at sqrt(|a_n| r 1e-9), which keeps that
+      // within half the overlap budget (docs/physics.md; it hops faster than t_c then).
       const auto threshold = [&](const Side& s) {
         const double an = p.motion.flight().normal_accel(i, v, s.n);
         return an < 0.0 ? -an * p.restitution.tc / 2.0 : 0.0;
@@ -180,20 +198,38 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
       if (wa > 0.0 || wb > 0.0) {
         const double ca = dot(A.u, A.n) + wa, cb = dot(B.u, B.n) + wb;
         if (parallel) {
-          const Side& pressed = wa >= wb ? A : B;
-          v += ((wa >= wb ? ca : cb) - dot(v, pressed.n)) * pressed.n;
+          const bool on_a = wa >= wb;
+          const Side& pressed = on_a ? A : B;
+          const double hop = on_a ? wa : wb;  // = |a_n| tc / 2
+          const double capped = std::min(hop, std::sqrt(2.0 * hop / p.restitution.tc * body.r * 1e-9));
+          v += (dot(pressed.u, pressed.n) + capped - dot(v, pressed.n)) * pressed.n;
         } else {
           v = {(ca * B.n.y - cb * A.n.y) / det, (cb * A.n.x - ca * B.n.x) / det};
         }
       }
     }
   } else {
-    // 2. A certain crush: ride on B until the room closes.
-    if (!parallel || !closes || !A.interior || !B.interior || !p.motion.straight(i)) return Squeeze::none;
+    // 2. A certain crush: ride on B until the room closes. Between two wall interiors, or a wall's
+    // interior and a wall end or turtle the body is exactly in line with (head on: a piston
+    // driving it onto the end of a wall), which it cannot slide off when it does not move across
+    // the axis.
+    if (!parallel || !closes || !p.motion.straight(i)) return Squeeze::none;
+    if (!(A.interior || A.point) || !(B.interior || B.point) || (A.point && B.point)) return Squeeze::none;
     const double tau = A.gap / closing;
     if (!(p.now + tau < p.schedule.next_key)) return Squeeze::none;
+    // A turtle keeps its velocity while its command runs, and its program can change it only at a
+    // control boundary (a touch is delivered there): certain until the earlier of the two.
+    auto turtle_keeps = [&](const Side& s) {
+      if (!s.turtle) return true;
+      const double boundary = (std::floor((p.t_base + p.now) / p.dt) + 1.0) * p.dt - p.t_base;
+      return p.now + tau <= boundary && p.now + tau <= p.bodies.end[p.bodies.balls() + s.name];
+    };
+    if (!turtle_keeps(A) || !turtle_keeps(B)) return Squeeze::none;
     v = v0 + (dot(B.u, B.n) - dot(v0, B.n)) * B.n;
-    if (!stays_over(body.x, v, A, tau) || !stays_over(body.x, v, B, tau)) return Squeeze::none;
+    auto keeps = [&](const Side& s, const Side& other) {
+      return s.point ? stays_on_axis(body.x, v, s, other.n, tau) : stays_over(body.x, v, s, tau);
+    };
+    if (!keeps(A, B) || !keeps(B, A)) return Squeeze::none;
     held = false;  // it must meet A at t*: no mark
   }
   body.v = v;
@@ -204,6 +240,54 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
   ++p.record.stats.wedged;
   if (held) p.bodies.hold(i, a, b, p.now, p.motion.straight(i));
   return Squeeze::wedged;
+}
+
+/// Discs squeezed by discs: a ball held by the rule between two obstacles (its course unchanged
+/// since, still touching both) that another ball pushes into both of them at once cannot move
+/// that way: it is as heavy as they are. The pusher bounces off it as off an obstacle of infinite
+/// mass moving at its velocity (with the rest threshold, so a pile rests on a wedged disc as on a
+/// wall); the held ball keeps its course and its mark. Returns false (nothing done) when neither
+/// ball is so held, or the push has a component that one obstacle alone would let it take.
+/// (Without it, a disc pressed onto a disc wedged in a V exchanged round-off velocities of 1e-19
+/// with it and the walls for ever at one instant, in step mode.)
+template <Flight Fl, bool kStep, bool kExtras>
+bool push_held(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t j) {
+  const BodyStore& bs = p.bodies;
+  auto holds = [&](std::uint32_t k, std::uint32_t other) {
+    const BodyStore::Held& h = bs.held[k];
+    if (h.a.is_none() || h.b.is_none() || h.count != bs.body[k].count) return false;
+    // (A turtle obstacle that has changed course since may have let go.)
+    for (const LastPartner who : {h.a, h.b})
+      if (who.kind() == Partner::body && bs.body[who.index()].count != (who == h.a ? h.count_a : h.count_b)) return false;
+    p.sync(k);
+    p.sync(other);
+    const Side A = side_of(p, k, h.a), B = side_of(p, k, h.b);
+    const Body& bk = bs.body[k];
+    if (!A.ok || !B.ok || A.gap > held_gap(bk) || B.gap > held_gap(bk)) return false;
+    const Vec2 d = p.arena.min_image(bk.x - bs.body[other].x);  // the way `other` pushes k
+    return dot(d, A.n) < 0.0 && dot(d, B.n) < 0.0;
+  };
+  std::uint32_t k = j, other = i;
+  if (!holds(j, i)) {
+    if (!holds(i, j)) return false;
+    k = i;
+    other = j;
+  }
+  Body& o = p.bodies.body[other];
+  const Body& bk = p.bodies.body[k];
+  const Vec2 F = p.arena.min_image(o.x - bk.x);
+  const double dist = norm(F);
+  p.record.note_contact(o.r + bk.r - dist, std::min(o.r, bk.r));
+  const Vec2 n = F / dist;
+  const Vec2 va = o.v;
+  o.v = bk.v + p.bounce(other, o.v - bk.v, n);  // as off a wall: the plain restitution
+  if (p.record.impulses) [[unlikely]]
+    p.impulse(EventKind::ball_ball, other, k, p.bodies.mass[other] * (o.v - va), -F);
+  ++p.record.stats.ball_ball;
+  p.note(EventKind::ball_ball, i, j);
+  p.changed(other);
+  p.bodies.last[other] = LastPartner::of(Partner::body, k);
+  return true;
 }
 
 }  // namespace

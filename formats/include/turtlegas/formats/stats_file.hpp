@@ -38,6 +38,8 @@ struct RunFigures {
   double energy_end = 0.0;
   double max_overlap = 0.0;           ///< world units
   double max_overlap_relative = 0.0;  ///< of the smaller radius
+  /// Instants of the run (besides every contact and the end) the overlap was measured at.
+  std::uint64_t overlap_samples = 0;
   /// Collisions per wall-clock second (0 for a run that took no measurable time).
   double collisions_per_second(const sim::Stats& st) const {
     return wall_seconds > 0.0 ? static_cast<double>(st.collisions()) / wall_seconds : 0.0;

@@ -58,7 +58,17 @@ double toi_disc_segment(Vec2 rel, Vec2 v, Vec2 a, const Segment& s, double radiu
 /// doubles, and the end where the disc has not yet reached the wall is returned. Touching and
 /// approaching at t = 0 returns 0; a graze is not a contact. w == 0 gives the same times as
 /// toi_disc_segment to round-off (the engine uses that closed form for pure translation).
+/// Also a contact: touching at rate 0 while the line closes at second order, and the foot coming
+/// onto the segment over an end at the contact distance (a disc touching the pivot of a turning
+/// arm: there the wall's point does not move, so the contact has neither an approach speed nor a
+/// gap to close; docs/physics.md, "Walls that move in time").
 double toi_disc_deforming_segment(Vec2 rel, Vec2 v, Vec2 a, Vec2 d0, Vec2 w, double radius, double t_max);
+
+/// The second derivative at t = 0 of the signed distance cross(D, Y) / |D| from the centre
+/// Y = rel + v t + a t^2/2 to the line of D = d0 + w t (both in the frame of the first end): how
+/// hard a turning or stretching wall presses a disc touching it, field included (positive along
+/// perp(d0)).
+double deforming_line_accel(Vec2 rel, Vec2 v, Vec2 a, Vec2 d0, Vec2 w);
 
 /// A disc under constant acceleration a reaching a point: the quartic |rel + v t + a t^2/2| = radius,
 /// searched on [0, t_max] (a == 0 falls back to the closed form).
