@@ -457,10 +457,13 @@ TEST_CASE("no NaN and no overlap over q/m 1e-6..1e6 and Bz 1e-8..1e6", "[fields]
         for (double t = 0.5; t <= 40.0 && w.stats().collisions() < 100 && w.stats().events < 200; t += 0.5) w.advance_to(t);
         CHECK(w.max_contact_overlap().relative <= 1e-9);
         CHECK(w.measure_overlap().relative <= 1e-9);
-        // Energy only up to q/m = 1: at 1e6 the field's pull into a wall (|a| ~ 2e5) makes the rest
-        // threshold (a ball pressed onto a wall leaves it at least at |a_n| tc / 2, here 10 units/s;
-        // physics.md) inject energy at every skipping bounce, by design of that rule.
-        if (qm <= 1.0) CHECK(w.energy() == Approx(e0).epsilon(1e-12));
+        // At q/m = 1e6 the field's pull into a wall (|a| ~ 2e5) asks the rest threshold for a
+        // normal speed of |a_n| tc / 2 ~ 11 at skipping bounces; with restitution 1 it is taken
+        // from the tangential speed, not added (Restitution::bounce), so one species keeps its
+        // energy at every q/m. Known gap: the mixed gas at q/m = 1e6 (species 1e6, 0, -2e6) still
+        // drifts (6e-5 at Bz = 0.01), not yet diagnosed; balls slower than the threshold, which
+        // it lifts with energy, are the likely source (docs/physics.md, "Known limits").
+        if (qm <= 1.0 || !mixed) CHECK(w.energy() == Approx(e0).epsilon(1e-12));
         for (std::size_t i = 0; i < w.ball_count(); ++i) {
           REQUIRE(std::isfinite(w.ball(i).pos.x));
           REQUIRE(std::isfinite(w.ball(i).pos.y));
@@ -468,6 +471,31 @@ TEST_CASE("no NaN and no overlap over q/m 1e-6..1e6 and Bz 1e-8..1e6", "[fields]
           REQUIRE(std::isfinite(w.ball(i).vel.y));
         }
       }
+}
+
+TEST_CASE("an elastic bounce pressed by a strong field keeps the ball's energy (the rest threshold turns, not adds)",
+          "[fields][engine][stability]") {
+  // q/m = 1e6 in E = (0, -0.2): a = 2e5 into the floor, so the rest threshold asks for a normal
+  // speed of a tc / 2 = 10 after each bounce. A ball skimming along the floor at 30 units/s with
+  // a normal speed of 1e-3 would gain 50 units of energy per unit mass at every bounce if the
+  // threshold were added; restitution 1 takes it from the tangential speed instead.
+  WorldDef d = box(200, 20);
+  d.effects.electric = {0.0, -0.2};
+  d.balls.push_back(charged("p", {10.0, 0.5 + 1e-9}, {30.0, -1e-3}, 0.5, 1.0, 1e6));
+  World w(d, Mode::exact);
+  const double e0 = w.energy();
+  w.advance_to(5.0);
+  CHECK(w.stats().collisions() > 100);
+  CHECK(w.energy() == Approx(e0).epsilon(1e-12));
+  CHECK(norm(w.ball(0).vel) <= std::sqrt(30.0 * 30.0 + 1e-6) * (1.0 + 1e-12) + 2e5 * 1e-4);
+  CHECK(w.max_contact_overlap().relative <= 1e-9);
+  // Nearly at rest (slower than the threshold), it is lifted as before: it must not hang.
+  d.balls[0].vel = {1e-3, 0.0};
+  World rest(d, Mode::exact);
+  rest.advance_to(1.0);
+  CHECK(rest.time() == 1.0);
+  CHECK(rest.stats().events < 4.0 / 1e-4);
+  CHECK(rest.ball(0).pos.y >= 0.5 - 1e-9);
 }
 
 // Long (hidden from the default run; `fields_engine_test "[long]"`): 10^6 collisions of a mixed
