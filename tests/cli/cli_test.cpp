@@ -471,6 +471,14 @@ TEST_CASE("cli: --observe writes the gas observables and --svg-trails the balls'
     b = run(dir, {"run", std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/wander.json", "--until", "1", "--observe", P("o.json")});
     CHECK(b.code == 2);
     CHECK(contains(b.err, "has turtles"));
+    // Runs with turtles go through the runtime, whose impulses the trails and the observer do not
+    // see: both are refused, naming the reason, and nothing is written.
+    b = run(dir, {"run", std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/wander.json", "--until", "1", "--svg",
+                  P("t.svg"), "--svg-trails", "1"});
+    CHECK(b.code == 2);
+    CHECK(contains(b.err, "has turtles"));
+    CHECK(contains(b.err, "--svg-trails"));
+    CHECK_FALSE(std::filesystem::exists(dir.path / "t.svg"));
     b = run(dir, {"run", gas, "--until", "1", "--mode", "step", "--svg", P("s.svg"), "--svg-trails", "1"});
     CHECK(b.code == 2);
     CHECK(contains(b.err, "step mode"));

@@ -457,10 +457,13 @@ TEST_CASE("no NaN and no overlap over q/m 1e-6..1e6 and Bz 1e-8..1e6", "[fields]
         for (double t = 0.5; t <= 40.0 && w.stats().collisions() < 100 && w.stats().events < 200; t += 0.5) w.advance_to(t);
         CHECK(w.max_contact_overlap().relative <= 1e-9);
         CHECK(w.measure_overlap().relative <= 1e-9);
-        // Energy only up to q/m = 1: at 1e6 the field's pull into a wall (|a| ~ 2e5) makes the rest
-        // threshold (a ball pressed onto a wall leaves it at least at |a_n| tc / 2, here 10 units/s;
-        // physics.md) inject energy at every skipping bounce, by design of that rule.
-        if (qm <= 1.0) CHECK(w.energy() == Approx(e0).epsilon(1e-12));
+        // At q/m = 1e6 the field's pull into a wall (|a| ~ 2e5) asks the rest threshold for a
+        // normal speed of |a_n| tc / 2 ~ 11 at skipping bounces; with restitution 1 it is taken
+        // from the tangential speed, not added (Restitution::bounce), so one species keeps its
+        // energy at every q/m. Known gap: the mixed gas at q/m = 1e6 (species 1e6, 0, -2e6) still
+        // drifts (6e-5 at Bz = 0.01), not yet diagnosed; balls slower than the threshold, which
+        // it lifts with energy, are the likely source (docs/physics.md, "Known limits").
+        if (qm <= 1.0 || !mixed) CHECK(w.energy() == Approx(e0).epsilon(1e-12));
         for (std::size_t i = 0; i < w.ball_count(); ++i) {
           REQUIRE(std::isfinite(w.ball(i).pos.x));
           REQUIRE(std::isfinite(w.ball(i).pos.y));
@@ -468,6 +471,31 @@ TEST_CASE("no NaN and no overlap over q/m 1e-6..1e6 and Bz 1e-8..1e6", "[fields]
           REQUIRE(std::isfinite(w.ball(i).vel.y));
         }
       }
+}
+
+TEST_CASE("an elastic bounce pressed by a strong field keeps the ball's energy (the rest threshold turns, not adds)",
+          "[fields][engine][stability]") {
+  // q/m = 1e6 in E = (0, -0.2): a = 2e5 into the floor, so the rest threshold asks for a normal
+  // speed of a tc / 2 = 10 after each bounce. A ball skimming along the floor at 30 units/s with
+  // a normal speed of 1e-3 would gain 50 units of energy per unit mass at every bounce if the
+  // threshold were added; restitution 1 takes it from the tangential speed instead.
+  WorldDef d = box(200, 20);
+  d.effects.electric = {0.0, -0.2};
+  d.balls.push_back(charged("p", {10.0, 0.5 + 1e-9}, {30.0, -1e-3}, 0.5, 1.0, 1e6));
+  World w(d, Mode::exact);
+  const double e0 = w.energy();
+  w.advance_to(5.0);
+  CHECK(w.stats().collisions() > 100);
+  CHECK(w.energy() == Approx(e0).epsilon(1e-12));
+  CHECK(norm(w.ball(0).vel) <= std::sqrt(30.0 * 30.0 + 1e-6) * (1.0 + 1e-12) + 2e5 * 1e-4);
+  CHECK(w.max_contact_overlap().relative <= 1e-9);
+  // Nearly at rest (slower than the threshold), it is lifted as before: it must not hang.
+  d.balls[0].vel = {1e-3, 0.0};
+  World rest(d, Mode::exact);
+  rest.advance_to(1.0);
+  CHECK(rest.time() == 1.0);
+  CHECK(rest.stats().events < 4.0 / 1e-4);
+  CHECK(rest.ball(0).pos.y >= 0.5 - 1e-9);
 }
 
 // Long (hidden from the default run; `fields_engine_test "[long]"`): 10^6 collisions of a mixed
@@ -670,4 +698,272 @@ TEST_CASE("held-out-oracle scenes: the engine agrees with the brute-force refere
     d.walls.push_back({"baffle", {d.arena.width * 0.3, d.arena.height * 0.6}, {d.arena.width * 0.5, d.arena.height * 0.5}});
     compare_with_reference(d, 10.0, 30);
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The same scenes against an independent event-driven oracle in long double (64-bit mantissa):
+// none of the engine's time-of-impact functions, flights or responses. Each ball flies the
+// textbook guiding-centre form (field_oracle.hpp's arrangement, Taylor series where |w t| <= 1/2);
+// every pair's gap |x_j - x_i| - sigma and every ball's distance to every wall segment (face and
+// ends in one function) minus its radius are sampled on a grid of steps much finer than a period
+// and than a radius' travel; a sign change is bisected, a dip between samples is minimised by
+// golden section and bisected when it goes below zero. Responses are the memo's, written out here.
+
+namespace {
+
+using L = long double;
+using LV = field_oracle::V2<L>;
+
+struct OracleBall {
+  LV x, v, a;
+  L w = 0, r = 0, m = 1;
+};
+
+// Position and velocity t after (x, v) under (a, w).
+field_oracle::State<L> oracle_fly(const OracleBall& b, L t) {
+  using field_oracle::jcw;
+  if (b.w == 0) return {b.x + t * b.v + (t * t / 2) * b.a, b.v + t * b.a};
+  if (std::fabs(b.w * t) <= 0.5L) {
+    LV x = b.x + t * b.v, v = b.v;
+    LV d = b.a + b.w * jcw(b.v);
+    L p = t;
+    for (int n = 2; n <= 42; ++n) {
+      const L q = p * t / L(n);
+      x = x + q * d;
+      v = v + p * d;
+      p = q;
+      d = b.w * jcw(d);
+    }
+    return {x, v};
+  }
+  const LV ud = (L(1) / b.w) * jcw(b.a), rot = b.v - ud;
+  const L th = b.w * t, s = std::sin(th), c = std::cos(th);
+  return {b.x + t * ud + (s / b.w) * rot + ((1 - c) / b.w) * jcw(rot), ud + c * rot + s * jcw(rot)};
+}
+
+L lnorm(LV v) { return std::sqrt(v.x * v.x + v.y * v.y); }
+
+struct OracleWall {
+  LV p1, p2;
+  std::uint32_t id;
+};
+
+// Distance from x to the segment, and where its foot is: 0 interior, 1 first end, 2 second end.
+std::pair<L, int> segment_distance(LV x, const OracleWall& s) {
+  const LV d = s.p2 - s.p1;
+  const L len2 = field_oracle::dot2(d, d);
+  const L u = field_oracle::dot2(x - s.p1, d) / len2;
+  if (u <= 0) return {lnorm(x - s.p1), 1};
+  if (u >= 1) return {lnorm(x - s.p2), 2};
+  return {lnorm(x - (s.p1 + u * d)), 0};
+}
+
+RefRun long_double_oracle(const WorldDef& def, double t_end) {
+  std::vector<WallDef> wall_defs = def.walls;
+  if (def.arena.boundary == Boundary::walls)
+    for (auto& w : arena_walls(def.arena)) wall_defs.push_back(w);
+  std::vector<OracleWall> walls;
+  for (std::uint32_t k = 0; k < wall_defs.size(); ++k)
+    walls.push_back({field_oracle::lift<L>(wall_defs[k].from), field_oracle::lift<L>(wall_defs[k].to), k});
+  auto end_owner = [&](LV p) {  // the first wall that ends at p (the engine's id for the end)
+    for (const OracleWall& s : walls)
+      if ((s.p1.x == p.x && s.p1.y == p.y) || (s.p2.x == p.x && s.p2.y == p.y)) return s.id;
+    return std::uint32_t{0};
+  };
+  const EffectsDef& fx = def.effects;
+  std::vector<OracleBall> balls;
+  L vmax = 0, amax = 0, rmin = 1e300L, wmax = 0;
+  for (const BallDef& b : def.balls) {
+    const double qm = b.charge / b.mass;
+    OracleBall o;
+    o.x = field_oracle::lift<L>(b.pos);
+    o.v = field_oracle::lift<L>(b.vel);
+    o.a = LV{L(fx.gravity.x) + L(qm) * L(fx.electric.x), L(fx.gravity.y) + L(qm) * L(fx.electric.y)};
+    o.w = L(qm) * L(fx.magnetic);
+    o.r = b.radius;
+    o.m = b.mass;
+    balls.push_back(o);
+    rmin = std::min(rmin, o.r);
+    wmax = std::max(wmax, std::fabs(o.w));
+  }
+  const std::size_t n = balls.size(), nw = walls.size();
+  // Candidates: pairs (i < j), then (ball, wall).
+  struct Cand {
+    int kind;  // 1 pair, 2 wall
+    std::size_t i, j;
+  };
+  std::vector<Cand> cands;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) cands.push_back({1, i, j});
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < nw; ++k) cands.push_back({2, i, k});
+  auto gap = [&](const Cand& c, L t) -> L {
+    const LV xi = oracle_fly(balls[c.i], t).x;
+    if (c.kind == 1) return lnorm(oracle_fly(balls[c.j], t).x - xi) - (balls[c.i].r + balls[c.j].r);
+    return segment_distance(xi, walls[c.j]).first - balls[c.i].r;
+  };
+  RefRun out;
+  L now = 0;
+  const L T = t_end;
+  for (;;) {
+    // A bound on every ball's speed until T: |v - u_d| is constant on a circle, so |v| <= |v0| +
+    // 2 |u_d|; on a parabola |v0| + |a| t.
+    vmax = 0;
+    for (const OracleBall& b : balls)
+      vmax = std::max(vmax, lnorm(b.v) + (b.w != 0 ? 2 * lnorm(b.a) / std::fabs(b.w) : lnorm(b.a) * (T - now)));
+    (void)amax;
+    const L speed = 2 * vmax + 1e-30L;
+    L h = rmin / (8 * speed);
+    if (wmax > 0) h = std::min(h, L(6.283185307179586) / wmax / 64);
+    // Per candidate: the last two samples.
+    const std::size_t nc = cands.size();
+    std::vector<L> g1(nc), g2(nc);
+    for (std::size_t c = 0; c < nc; ++c) g1[c] = g2[c] = std::max(gap(cands[c], 0), L(0)) + 1e-300L;
+    L best = T - now;
+    std::size_t who = nc;
+    L t_prev = 0;
+    std::vector<LV> at(n);
+    for (L t = h; t_prev < best; t += h) {
+      const L tt = std::min(t, T - now);
+      for (std::size_t i = 0; i < n; ++i) at[i] = oracle_fly(balls[i], tt).x;
+      for (std::size_t c = 0; c < nc; ++c) {
+        const Cand& cc = cands[c];
+        const L g = cc.kind == 1 ? lnorm(at[cc.j] - at[cc.i]) - (balls[cc.i].r + balls[cc.j].r)
+                                 : segment_distance(at[cc.i], walls[cc.j]).first - balls[cc.i].r;
+        L lo = -1, hi = -1;
+        if (g <= 0) {
+          lo = t_prev;
+          hi = tt;
+        } else if (g1[c] < g2[c] && g1[c] < g) {
+          // A dip between the samples at t_prev - h and tt: is its bottom below zero?
+          L a = std::max(L(0), t_prev - h), b = tt;
+          for (int k = 0; k < 200 && b - a > 1e-22L; ++k) {
+            const L m1 = a + (b - a) * 0.381966L, m2 = a + (b - a) * 0.618034L;
+            if (gap(cands[c], m1) < gap(cands[c], m2)) b = m2;
+            else a = m1;
+          }
+          const L m = (a + b) / 2;
+          if (gap(cands[c], m) <= 0) {
+            lo = std::max(L(0), t_prev - h);
+            hi = m;
+            if (gap(cands[c], lo) <= 0) lo = -1;  // (the contact just resolved)
+          }
+        }
+        if (lo >= 0) {
+          for (int k = 0; k < 200 && hi - lo > 1e-22L; ++k) {
+            const L m = (lo + hi) / 2;
+            (gap(cands[c], m) > 0 ? lo : hi) = m;
+          }
+          if (hi < best) {
+            best = hi;
+            who = c;
+          }
+        }
+        g2[c] = g1[c];
+        g1[c] = g;
+      }
+      t_prev = tt;
+      if (tt >= T - now) break;
+    }
+    for (OracleBall& b : balls) {
+      const auto s = oracle_fly(b, best);
+      b.x = s.x;
+      b.v = s.v;
+    }
+    now += best;
+    if (who == nc) break;
+    const Cand& c = cands[who];
+    OracleBall& bi = balls[c.i];
+    if (c.kind == 1) {
+      OracleBall& bj = balls[c.j];
+      const LV F = bj.x - bi.x;
+      const L k = 2 * field_oracle::dot2(bj.v - bi.v, F) / (field_oracle::dot2(F, F) * (bi.m + bj.m));
+      bi.v = bi.v + (k * bj.m) * F;
+      bj.v = bj.v - (k * bi.m) * F;
+      out.events.push_back({static_cast<double>(now), EventKind::ball_ball, static_cast<std::uint32_t>(c.i),
+                            static_cast<std::uint32_t>(c.j)});
+    } else {
+      const OracleWall& s = walls[c.j];
+      const auto [dist, foot] = segment_distance(bi.x, s);
+      LV from;
+      if (foot == 0) {
+        const LV d = s.p2 - s.p1;
+        from = s.p1 + (field_oracle::dot2(bi.x - s.p1, d) / field_oracle::dot2(d, d)) * d;
+      } else {
+        from = foot == 1 ? s.p1 : s.p2;
+      }
+      const LV nrm = (L(1) / dist) * (bi.x - from);
+      bi.v = bi.v - (2 * field_oracle::dot2(bi.v, nrm)) * nrm;
+      out.events.push_back({static_cast<double>(now), foot == 0 ? EventKind::ball_wall : EventKind::ball_wall_end,
+                            static_cast<std::uint32_t>(c.i), foot == 0 ? s.id : end_owner(from)});
+    }
+  }
+  for (const OracleBall& b : balls)
+    out.final.push_back({{static_cast<double>(b.x.x), static_cast<double>(b.x.y)},
+                         {static_cast<double>(b.v.x), static_cast<double>(b.v.y)}, true});
+  return out;
+}
+
+void compare_with_oracle(const WorldDef& d, double T, std::size_t min_events) {
+  World w(d, Mode::exact);
+  std::vector<Event> log;
+  w.set_event_log(&log);
+  w.advance_to(T);
+  const RefRun ref = long_double_oracle(d, T);
+  INFO("engine " << log.size() << " events, oracle " << ref.events.size());
+  CHECK(log.size() >= min_events);
+  REQUIRE(log.size() == ref.events.size());
+  for (std::size_t k = 0; k < log.size(); ++k) {
+    Event a = log[k], b = ref.events[k];
+    if (a.kind == EventKind::ball_ball && a.a > a.b) std::swap(a.a, a.b);
+    INFO("event " << k << " at " << b.t);
+    REQUIRE(a.kind == b.kind);
+    REQUIRE(a.a == b.a);
+    REQUIRE(a.b == b.b);
+    REQUIRE(a.t == Approx(b.t).margin(1e-9));
+  }
+  for (std::size_t i = 0; i < d.balls.size(); ++i) {
+    INFO("ball " << i);
+    CHECK(norm(w.ball(i).pos - ref.final[i].pos) <= 1e-9);
+    CHECK(norm(w.ball(i).vel - ref.final[i].vel) <= 1e-9);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("held-out-oracle scenes against an independent long-double event-driven oracle: events and final state to 1e-9",
+          "[fields][engine][oracle]") {
+  SECTION("cyclotron in a box") {
+    WorldDef d = box(60, 60);
+    d.effects.magnetic = 0.5;
+    d.arena.cell = 4.0;
+    d.balls.push_back(charged("a", {30, 40}, {6, 0}, 1.0, 1.0, 1.0));
+    d.balls.push_back(charged("b", {30, 20}, {6, 1}, 1.0, 1.0, -1.0));
+    d.balls.push_back(charged("c", {12, 12}, {0, 5}, 1.5, 2.0, 1.0));
+    compare_with_oracle(d, 40.0, 10);
+  }
+  SECTION("grazing circles near walls and ends") {
+    WorldDef d = box(40, 40);
+    d.effects.magnetic = 1.0;
+    d.walls.push_back({"shelf", {9.9, 7.5 + 1e-7}, {10.1, 7.5 + 1e-7}});
+    d.walls.push_back({"pin", {25.0, 8.5 + 1e-7}, {25.0, 9.0}});
+    d.walls.push_back({"ledge", {29.0, 25.5 - 1e-7}, {31.0, 25.5 - 1e-7}});
+    d.balls.push_back(charged("p", {10.0, 10.0}, {1.0, 0.0}, 0.5, 1.0, 1.0));
+    d.balls.push_back(charged("q", {25.0, 10.0}, {1.0, 0.0}, 0.5, 1.0, 1.0));
+    d.balls.push_back(charged("s", {30.0, 30.0}, {2.0, 0.0}, 0.5, 1.0, 1.0));
+    compare_with_oracle(d, 60.0, 1);
+  }
+  SECTION("E x B drift against a wall end") {
+    WorldDef d = box(100, 40);
+    d.effects.electric = {0.0, -2.0};
+    d.effects.magnetic = 1.0;
+    d.walls.push_back({"post", {40.0, 0.0}, {40.0, 15.0}});
+    d.walls.push_back({"hook", {30.0, 30.0}, {30.0, 40.0}});
+    d.balls.push_back(charged("p", {80.0, 14.0}, {0.5, 1.0}, 1.0, 1.0, 1.0));
+    d.balls.push_back(charged("q", {70.0, 27.0}, {0.0, 1.5}, 1.0, 1.0, 1.0));
+    compare_with_oracle(d, 40.0, 3);
+  }
+  // Not yet here: the equal/unequal q/m pairs and the memo gas with all three fields, the
+  // brute-force reference's other two scenes: this oracle's sampling did not finish them in
+  // minutes (to be found: a loop that does not advance, or a step far too fine).
 }

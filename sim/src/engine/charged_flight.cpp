@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // ChargedFlight's species table and its cell exits (flights.hpp).
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -29,7 +30,8 @@ ChargedFlight::ChargedFlight(const WorldDef& def) {
     if (b.charge == 0.0) continue;
     charged = true;
     const double qm = b.charge / b.mass;
-    const Species s{fx.gravity + qm * fx.electric, qm * fx.magnetic};
+    Species s{fx.gravity + qm * fx.electric, qm * fx.magnetic};
+    s.circle = s.w != 0.0 && s.a == Vec2{};
     const auto [it, added] = index.try_emplace({s.a.x, s.a.y, s.w}, static_cast<std::uint32_t>(species_.size()));
     if (added) species_.push_back(s);
     of_[i] = it->second;
@@ -65,8 +67,15 @@ CellExit ChargedFlight::cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const Cell
   // While the circle's envelope (guiding centre +- gyration radius, moving at the drift) is
   // provably inside the cell, nothing needs computing: re-plan when that stops holding (never for a
   // drift-free circle inside its cell).
-  const Envelope env = flight_envelope(x, f, 0.0);
-  const double quiet = env.bounded ? quiet_time_box(env, {b.x_lo, b.y_lo}, {b.x_hi, b.y_hi}) : 0.0;
+  // A circle wider than its cell (gyration radius, as flight_envelope forms it, at least 3/4 of the
+  // cell's side, well clear of round-off) is never inside it: skip forming the envelope.
+  const double rho = norm(field_acceleration(f)) / (f.w * f.w);
+  const bool wider = rho > 0.75 * std::min(b.x_hi - b.x_lo, b.y_hi - b.y_lo);
+  double quiet = 0.0;
+  if (!wider) {
+    const Envelope env = flight_envelope(x, f, 0.0);
+    quiet = env.bounded ? quiet_time_box(env, {b.x_lo, b.y_lo}, {b.x_hi, b.y_hi}) : 0.0;
+  }
   CellExit e;
   if (quiet > 0.0) {
     e = {quiet, kReplan};

@@ -196,6 +196,7 @@ class ChargedFlight {
   struct Species {
     Vec2 a;          ///< g + (q/m) E
     double w = 0.0;  ///< q Bz / m
+    bool circle = false;  ///< w != 0 and a == 0: a drift-free circle (circle_advance)
   };
   const Species& species(std::uint32_t ball) const { return species_[of_[ball]]; }
   std::size_t species_count() const { return species_.size(); }
@@ -207,11 +208,13 @@ class ChargedFlight {
   Vec2 pos(std::uint32_t ball, Vec2 x, Vec2 v, double dt) const {
     const Species& s = species(ball);
     if (s.w == 0.0) return x + dt * v + (0.5 * dt * dt) * s.a;
+    if (s.circle) return circle_advance(x, v, s.w, dt).x;
     return x + field_displacement({v, s.a, s.w}, dt);
   }
   Vec2 vel(std::uint32_t ball, Vec2 v, double dt) const {
     const Species& s = species(ball);
     if (s.w == 0.0) return v + dt * s.a;
+    if (s.circle) return circle_advance({}, v, s.w, dt).v;
     return field_velocity({v, s.a, s.w}, dt);
   }
   /// pos and vel together, from one set of coefficients (one sine and cosine instead of two): the
@@ -219,6 +222,7 @@ class ChargedFlight {
   FieldState state(std::uint32_t ball, Vec2 x, Vec2 v, double dt) const {
     const Species& s = species(ball);
     if (s.w == 0.0) return {x + dt * v + (0.5 * dt * dt) * s.a, v + dt * s.a};
+    if (s.circle) return circle_advance(x, v, s.w, dt);
     return field_advance(x, {v, s.a, s.w}, dt);
   }
   CellExit cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const CellBox& b) const;

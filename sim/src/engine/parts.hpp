@@ -7,6 +7,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -49,7 +50,22 @@ struct Restitution {
     // The rest threshold: a ball pressed onto the obstacle by the field leaves it at least fast
     // enough to stay away for tc. Without it an inelastic ball would bounce infinitely often before
     // coming to rest, and a ball at rest would sink.
-    if (a_n < 0.0) w_out = std::max(w_out, -a_n * tc / 2.0);
+    if (a_n < 0.0) {
+      const double floor = -a_n * tc / 2.0;
+      if (w_out < floor) {
+        // An elastic bounce keeps the ball's energy: the normal speed the threshold asks for is
+        // taken from the tangential speed (v turned, |v| kept) whenever |v| has that much. Only a
+        // ball slower than the threshold is lifted with energy (a ball at rest would sink). Under
+        // a strong field (q/m = 1e6 in E: floor ~ 10) adding it at every skipping bounce made
+        // energy grow without bound.
+        if (e == 1.0) {
+          const Vec2 vt = v + w * n;  // the tangential part
+          const double speed2 = dot(v, v), floor2 = floor * floor, vt2 = dot(vt, vt);
+          if (speed2 > floor2 && vt2 > 0.0) return floor * n + std::sqrt((speed2 - floor2) / vt2) * vt;
+        }
+        w_out = floor;
+      }
+    }
     return v + (w + w_out) * n;
   }
 };
