@@ -203,6 +203,17 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
           const double hop = on_a ? wa : wb;  // = |a_n| tc / 2
           const double capped = std::min(hop, std::sqrt(2.0 * hop / p.restitution.tc * body.r * 1e-9));
           v += (dot(pressed.u, pressed.n) + capped - dot(v, pressed.n)) * pressed.n;
+          if (p.restitution.e == 1.0) {
+            // Elastic: keep the speed relative to the pressed obstacle, as Restitution::bounce does
+            // at e = 1 (it turned v to leave at the threshold, taking that from the tangential
+            // part); the cap above would otherwise drain the slide a little at every hop. The
+            // hop comes back at the speed it left with, so this adds no energy over a hop.
+            const Vec2 rel = v - pressed.u, rel0 = v0 - pressed.u;
+            const double wn = dot(rel, pressed.n);
+            const Vec2 t = rel - wn * pressed.n;
+            const double want = dot(rel0, rel0) - wn * wn, t2 = dot(t, t);
+            if (want > 0.0 && t2 > 0.0) v = pressed.u + wn * pressed.n + std::sqrt(want / t2) * t;
+          }
         } else {
           v = {(ca * B.n.y - cb * A.n.y) / det, (cb * A.n.x - ca * B.n.x) / det};
         }
