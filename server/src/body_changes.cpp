@@ -102,6 +102,21 @@ void WorldHost::queue_body_change(ClientState& c, const json& m, const std::stri
   body_changes_.push_back(std::move(change));
 }
 
+std::size_t WorldHost::spawn_into_scene(turtle::WorldServer& server, const nlohmann::json& entry, const std::string& source) {
+  // The world grows by the body, and so do the host's scene, ids and slots, so that frames name it.
+  const std::size_t index = world::spawn_entry(server, entry, source, registry_);
+  const sim::WorldDef& now = server.scene();
+  if (entry.contains("ball")) {
+    scene_.def.balls.push_back(now.balls[index]);
+    ball_ids_.push_back(now.balls[index].id);
+  } else {
+    scene_.def.turtles.push_back(now.turtles[index]);
+    scene_.programs.push_back(world::read_turtle_entry(entry.at("turtle"), source, registry_).program);
+    slots_.push_back(Slot{});
+  }
+  return index;
+}
+
 void WorldHost::apply_body_changes(turtle::WorldServer& server, std::uint64_t step) {
   while (!body_changes_.empty()) {
     BodyChange b = std::move(body_changes_.front());
@@ -112,16 +127,7 @@ void WorldHost::apply_body_changes(turtle::WorldServer& server, std::uint64_t st
     try {
       if (b.type == "spawn") {
         const bool ball = b.spawn.contains("ball");
-        const std::size_t index = world::spawn_entry(server, b.spawn, "spawn", registry_);
-        const sim::WorldDef& now = server.scene();
-        if (ball) {
-          scene_.def.balls.push_back(now.balls[index]);
-          ball_ids_.push_back(now.balls[index].id);
-        } else {
-          scene_.def.turtles.push_back(now.turtles[index]);
-          scene_.programs.push_back(world::read_turtle_entry(b.spawn.at("turtle"), "spawn", registry_).program);
-          slots_.push_back(Slot{});
-        }
+        const std::size_t index = spawn_into_scene(server, b.spawn, "spawn");
         write_input(formats::input_spawn_line(step, ball ? "ball" : "turtle", b.spawn.at(ball ? "ball" : "turtle")));
         reply_msg = ok(m, "spawn");
         reply_msg.update({{"body", b.body}, {"kind", ball ? "ball" : "turtle"}, {"index", index}});

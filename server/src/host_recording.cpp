@@ -94,17 +94,7 @@ std::shared_ptr<turtle::InputSource> WorldHost::world_input() {
   // A fresh reader for every build: a seek backwards replays the inputs from the start. A spawn
   // grows the host's scene as a live spawn does (body_changes.cpp), so that ids and frames name it.
   formats::SpawnApplier spawn = [this](turtle::WorldServer& server, const nlohmann::json& entry) {
-    const bool ball = entry.contains("ball");
-    const std::size_t index = world::spawn_entry(server, entry, options_.replay->path, registry_);
-    const sim::WorldDef& now = server.scene();
-    if (ball) {
-      scene_.def.balls.push_back(now.balls[index]);
-      ball_ids_.push_back(now.balls[index].id);
-    } else {
-      scene_.def.turtles.push_back(now.turtles[index]);
-      scene_.programs.push_back(world::read_turtle_entry(entry.at("turtle"), "spawn", registry_).program);
-      slots_.push_back(Slot{});
-    }
+    spawn_into_scene(server, entry, options_.replay->path);
   };
   std::istringstream in(options_.replay->inputs);
   return std::make_shared<formats::ReplayInput>(in, scene_.def, options_.replay->path, std::move(spawn));

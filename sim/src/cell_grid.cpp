@@ -12,25 +12,6 @@
 namespace turtlegas::sim::detail {
 namespace {
 
-// Liang-Barsky: does segment p->q meet the closed box [x0,x1] x [y0,y1]?
-bool segment_meets_box(Vec2 p, Vec2 q, double x0, double y0, double x1, double y1) {
-  double t0 = 0.0, t1 = 1.0;
-  const Vec2 d = q - p;
-  const double pk[4] = {-d.x, d.x, -d.y, d.y};
-  const double qk[4] = {p.x - x0, x1 - p.x, p.y - y0, y1 - p.y};
-  for (int k = 0; k < 4; ++k) {
-    if (pk[k] == 0.0) {
-      if (qk[k] < 0.0) return false;
-    } else {
-      const double r = qk[k] / pk[k];
-      if (pk[k] < 0.0) t0 = std::max(t0, r);
-      else t1 = std::min(t1, r);
-      if (t0 > t1) return false;
-    }
-  }
-  return true;
-}
-
 // floor(x / cell) + 1 clamped to [lo, hi], decided in double: a coordinate of 1e30 (or a NaN)
 // must not reach an int conversion, which would be undefined (a wall ending at y = 1e30 once
 // landed in no cell at all and balls passed through it).
@@ -67,6 +48,12 @@ std::pair<double, double> clip_to_box(Vec2 p, Vec2 q, double x0, double y0, doub
     }
   }
   return {t0, t1};
+}
+
+// Does segment p->q meet the closed box [x0, x1] x [y0, y1]?
+bool segment_meets_box(Vec2 p, Vec2 q, double x0, double y0, double x1, double y1) {
+  const auto [t0, t1] = clip_to_box(p, q, x0, y0, x1, y1);
+  return t0 <= t1;
 }
 
 }  // namespace

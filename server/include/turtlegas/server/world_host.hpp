@@ -206,6 +206,9 @@ class WorldHost {
   void record_view(const char* op, const nlohmann::json& view);
   /// A served run's recording replayed: its inputs, read afresh; nullptr otherwise (the host's own).
   std::shared_ptr<turtle::InputSource> world_input();
+  /// Spawns `entry` (a protocol or input-log spawn) into `server` and grows the host's scene, ids
+  /// and slots with it; returns the new body's index among its kind. `source` names it in errors.
+  std::size_t spawn_into_scene(turtle::WorldServer& server, const nlohmann::json& entry, const std::string& source);
   /// A replay: the views its clients opened, opened again after a seek rebuilt the world.
   void reopen_client_views();
   void note_client_view(const char* op, const turtle::View& view);
