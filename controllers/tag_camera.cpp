@@ -6,6 +6,7 @@
 // view is display data only: the run's physics are those of the same program without it.
 //   params: declared in tag_camera_info() below (`turtlegas controllers` lists them)
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "tag_common.hpp"
@@ -16,13 +17,17 @@ namespace turtlegas::controllers {
 
 namespace {
 
-/// Opens the view on t while it is "it", closes it otherwise; at most one change per call.
+/// Keeps the view on t while it is "it" and closes it otherwise; at most one change per call.
+/// Turtles given one shared view id hand it over: the new "it" turns the view onto itself (it may
+/// run before the old "it" has closed it), and a turtle closes only a view that follows itself.
 void sync_view(turtle::Turtle& t, const turtle::View& view, bool camera) {
   if (!camera) return;
   turtle::Display d = t.display();
-  const bool open = d.find(view.id).has_value();
-  if (t.it() && !open) d.open(view);
-  else if (!t.it() && open) d.close(view.id);
+  const std::optional<turtle::View> now = d.find(view.id);
+  const bool mine = now && now->follow == view.follow;
+  if (t.it() && !now) d.open(view);
+  else if (t.it() && !mine) d.change(view);
+  else if (!t.it() && mine) d.close(view.id);
 }
 
 }  // namespace

@@ -169,6 +169,11 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
   std::string text = title;
   if (!snap.turtles.empty())
     text += ", " + std::to_string(snap.turtles.size()) + (snap.turtles.size() == 1 ? " turtle" : " turtles");
+  // A title wider than the picture is set smaller until it fits (it was cut at the right edge).
+  cairo_text_extents_t ext;
+  cairo_text_extents(cr, text.c_str(), &ext);
+  const double room = l.width - 2 * l.margin;
+  if (ext.x_advance > room && ext.x_advance > 0.0) cairo_set_font_size(cr, std::max(6.0, 16.0 * room / ext.x_advance));
   cairo_move_to(cr, l.margin, l.margin + 14);
   cairo_show_text(cr, text.c_str());
 

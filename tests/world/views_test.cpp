@@ -273,3 +273,52 @@ TEST_CASE("the Display handle refuses what the world server refuses") {
     }
   CHECK(ops == std::vector<std::string>{"mine:open", "mine:change", "mine:close"});
 }
+
+TEST_CASE("tag_camera turtles sharing one view id keep it on whoever is it") {
+  // worlds/tag_follow_it.json: five tag_camera turtles share the view "it". In its first 120 s t1
+  // tags t4 (the tagger comes first in world order: it closes, t4 opens) and t4 tags t3 (t3 comes
+  // first: it turns the view onto itself before t4 runs, and t4 leaves it alone). At the end of
+  // every instant with a tag or a view change, the view must be open and follow the one who is it.
+  const std::vector<std::string> log = run_log(read_file(std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/tag_follow_it.json"), 120.0);
+  std::string it = "t1", follow;
+  bool open = false;
+  int tags = 0, changes = 0, closes = 0;
+  std::vector<json> group;
+  const auto check_group = [&] {
+    if (group.empty()) return;
+    INFO("t = " << group.front()["t"].dump());
+    CHECK(open);
+    CHECK(follow == it);
+    group.clear();
+  };
+  for (const std::string& line : log) {
+    const json e = json::parse(line);
+    const std::string kind = e["kind"];
+    if (kind != "tag" && kind != "view") continue;
+    if (!group.empty() && group.front()["t"] != e["t"]) check_group();
+    group.push_back(e);
+    if (kind == "tag") {
+      it = e["b"];
+      ++tags;
+      continue;
+    }
+    REQUIRE(e["a"] == "it");
+    const std::string op = e["op"];
+    if (op == "open" || op == "change") {
+      CHECK((op == "open") != open);
+      open = true;
+      follow = e["view"]["follow"];
+      CHECK(e["by"] == follow);  // a turtle turns the view onto itself only
+      changes += op == "change";
+    } else {
+      CHECK(op == "close");
+      CHECK(e["by"] == follow);  // and closes only a view on itself
+      open = false;
+      ++closes;
+    }
+  }
+  check_group();
+  CHECK(tags >= 2);
+  CHECK(changes >= 1);
+  CHECK(closes >= 1);
+}
