@@ -265,6 +265,7 @@ class WorldHost {
   std::mutex mutex_;
   std::condition_variable cv_;
   std::deque<Inbound> inbox_;
+  std::atomic<bool> inbox_ready_{false};  ///< inbox_ is not empty (read without the lock, to spin on)
   std::atomic<std::size_t> clients_open_{0};
   std::atomic<std::uint64_t> last_client_id_{0};
 };
