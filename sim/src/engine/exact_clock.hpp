@@ -9,7 +9,7 @@ namespace turtlegas::sim::detail {
 namespace {
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
-void Engine<F, kBallBall, kStep, kExtras>::cross(std::uint32_t i) {
+inline void Engine<F, kBallBall, kStep, kExtras>::cross(std::uint32_t i) {
   const int dir = bodies_.pending[i].cross_dir;
   if constexpr (F::kBoundedHorizon) {
     if (dir == kReplan) {
