@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cli_common.hpp"
+#include "output_file.hpp"
 #include "turtlegas/formats/recording.hpp"
 #include "turtlegas/world/file_error.hpp"
 #include "turtlegas/world/world_file.hpp"
@@ -118,11 +119,17 @@ int serve_command(const ServeCommandOptions& opt, const turtle::Registry& regist
   h.until = opt.until;
   h.events_path = opt.events;
   h.inputs_path = opt.inputs_out;
+  // As `run` checks its outputs: none may be the world file (by any name) or another output, and a
+  // directory is no file to write (serve --events worlds/tag.json overwrote the world before).
+  check_outputs({{opt.events, "--events"}, {opt.inputs_out, "--inputs-out"}, {opt.record, "--record"}},
+                {{opt.world, "the world file"}});
+  for (const auto& [path, option] : {std::pair{&opt.events, "--events"}, {&opt.inputs_out, "--inputs-out"}, {&opt.record, "--record"}}) {
+    std::error_code de;
+    if (!path->empty() && *path != "-" && std::filesystem::is_directory(*path, de))
+      throw BadInput(std::string(option) + " " + *path + ": that is a directory; give a file name");
+  }
   if (!opt.record.empty()) {
     if (opt.record == "-") throw BadInput("--record needs a file name, not standard output (replay seeks in it)");
-    for (const std::string* other : {&opt.events, &opt.inputs_out})
-      if (!other->empty() && std::filesystem::path(*other) == std::filesystem::path(opt.record))
-        throw BadInput("--record: '" + opt.record + "' is also another output; give each its own file");
     h.record_path = opt.record;
     h.keyframes = {opt.keyframe_seconds, opt.keyframe_events};
   }

@@ -617,3 +617,26 @@ TEST_CASE("robust: --stats measures the overlap over the run, not only at contac
   REQUIRE(none.code == 0);
   CHECK(json::parse(read(out)).at("max_overlap_relative").get<double>() == 0.0);
 }
+
+TEST_CASE("robust: serve refuses an output that is its world file, or a directory, with exit 2") {
+  // serve --events / --inputs-out / --record checked only against each other: `serve w.json --record
+  // w.json` overwrote the world file with a recording. Refused before anything is served.
+  TempDir dir;
+  const fs::path w = dir.write("w.json", read(worlds + "tag.json"));
+  const std::string before = read(w);
+  for (const std::string option : {"--events", "--inputs-out", "--record"}) {
+    const Result r = run(dir, {"serve", w.string(), "--port", "0", "--until", "0.1", option, w.string()});
+    INFO(option << ": " << r.err);
+    CHECK(r.code == 2);
+    CHECK(contains(r.err, "the world file"));
+    CHECK(read(w) == before);
+    const Result d = run(dir, {"serve", w.string(), "--port", "0", "--until", "0.1", option, dir.path.string()});
+    INFO(option << " DIR: " << d.err);
+    CHECK(d.code == 2);
+    CHECK(contains(d.err, "directory"));
+  }
+  const Result twice = run(dir, {"serve", w.string(), "--port", "0", "--until", "0.1", "--events",
+                                 (dir.path / "o.txt").string(), "--record", (dir.path / "." / "o.txt").string()});
+  CHECK(twice.code == 2);
+  CHECK(contains(twice.err, "both write"));
+}
