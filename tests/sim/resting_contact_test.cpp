@@ -12,20 +12,6 @@
 using namespace turtlegas::sim;
 using namespace turtlegas::test;
 
-namespace {
-
-/// Advances w to `until` in `samples` slices; the deepest overlap seen at any slice's end.
-double deepest_over_run(World& w, double until, int samples) {
-  double worst = 0.0;
-  for (int k = 1; k <= samples; ++k) {
-    w.advance_to(until * k / samples);
-    worst = std::max(worst, w.measure_overlap().relative);
-  }
-  return worst;
-}
-
-}  // namespace
-
 TEST_CASE("a disc resting on one straight 10-degree slope under gravity does not sink into it", "[rest]") {
   // It once got "never" from the first-approach root when a few ulps inside and receding slowly
   // with gravity pulling it back, and sank 0.54 of a radius within 2 s.

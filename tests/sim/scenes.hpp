@@ -75,4 +75,15 @@ inline double momentum_x(const sim::World& w) {
   return p;
 }
 
+/// Advances w to `until` in `samples` equal slices; the deepest overlap (relative to a radius)
+/// seen at any slice's end.
+inline double deepest_over_run(sim::World& w, double until, int samples) {
+  double worst = 0.0;
+  for (int k = 1; k <= samples; ++k) {
+    w.advance_to(until * k / samples);
+    worst = std::max(worst, w.measure_overlap().relative);
+  }
+  return worst;
+}
+
 }  // namespace turtlegas::test

@@ -250,12 +250,7 @@ namespace {
 double deepest_over_run(World& w, Run& run, double until, int samples, std::uint64_t limit = kLimit) {
   w.set_event_log(&run.log);
   w.set_event_limit(limit);
-  double worst = 0.0;
-  for (int k = 1; k <= samples; ++k) {
-    w.advance_to(until * k / samples);
-    worst = std::max(worst, w.measure_overlap().relative);
-  }
-  return worst;
+  return turtlegas::test::deepest_over_run(w, until, samples);
 }
 
 }  // namespace

@@ -35,16 +35,6 @@ WorldDef windmill(double restitution, Vec2 gravity = {}) {
   return d;
 }
 
-/// The deepest overlap seen at `samples` instants of a run to `until`.
-double deepest_over_run(World& w, double until, int samples) {
-  double worst = 0.0;
-  for (int k = 1; k <= samples; ++k) {
-    w.advance_to(until * k / samples);
-    worst = std::max(worst, w.measure_overlap().relative);
-  }
-  return worst;
-}
-
 }  // namespace
 
 TEST_CASE("a disc touching the pivot of a turning arm is pushed off, never overlapped", "[pivot]") {
