@@ -611,13 +611,14 @@ RefRun field_reference(const WorldDef& def, double t_end) {
   return out;
 }
 
-void compare_with_reference(const WorldDef& d, double T, std::size_t min_events) {
+/// The engine's exact-mode run of d to T against `ref` (a reference or the oracle, named `what`):
+/// the same events in order, times to 1e-9, and final positions and velocities to 1e-9.
+void compare_runs(const WorldDef& d, double T, std::size_t min_events, const RefRun& ref, const char* what) {
   World w(d, Mode::exact);
   std::vector<Event> log;
   w.set_event_log(&log);
   w.advance_to(T);
-  const RefRun ref = field_reference(d, T);
-  INFO("engine " << log.size() << " events, reference " << ref.events.size());
+  INFO("engine " << log.size() << " events, " << what << " " << ref.events.size());
   CHECK(log.size() >= min_events);
   REQUIRE(log.size() == ref.events.size());
   for (std::size_t k = 0; k < log.size(); ++k) {
@@ -635,6 +636,10 @@ void compare_with_reference(const WorldDef& d, double T, std::size_t min_events)
     CHECK(norm(w.ball(i).vel - ref.final[i].vel) <= 1e-9);
   }
   CHECK(w.max_contact_overlap().relative <= 1e-9);
+}
+
+void compare_with_reference(const WorldDef& d, double T, std::size_t min_events) {
+  compare_runs(d, T, min_events, field_reference(d, T), "reference");
 }
 
 }  // namespace
@@ -905,28 +910,7 @@ RefRun long_double_oracle(const WorldDef& def, double t_end) {
 }
 
 void compare_with_oracle(const WorldDef& d, double T, std::size_t min_events) {
-  World w(d, Mode::exact);
-  std::vector<Event> log;
-  w.set_event_log(&log);
-  w.advance_to(T);
-  const RefRun ref = long_double_oracle(d, T);
-  INFO("engine " << log.size() << " events, oracle " << ref.events.size());
-  CHECK(log.size() >= min_events);
-  REQUIRE(log.size() == ref.events.size());
-  for (std::size_t k = 0; k < log.size(); ++k) {
-    Event a = log[k], b = ref.events[k];
-    if (a.kind == EventKind::ball_ball && a.a > a.b) std::swap(a.a, a.b);
-    INFO("event " << k << " at " << b.t);
-    REQUIRE(a.kind == b.kind);
-    REQUIRE(a.a == b.a);
-    REQUIRE(a.b == b.b);
-    REQUIRE(a.t == Approx(b.t).margin(1e-9));
-  }
-  for (std::size_t i = 0; i < d.balls.size(); ++i) {
-    INFO("ball " << i);
-    CHECK(norm(w.ball(i).pos - ref.final[i].pos) <= 1e-9);
-    CHECK(norm(w.ball(i).vel - ref.final[i].vel) <= 1e-9);
-  }
+  compare_runs(d, T, min_events, long_double_oracle(d, T), "oracle");
 }
 
 }  // namespace
