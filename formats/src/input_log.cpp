@@ -195,7 +195,7 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
         Change c;
         c.kind = Change::Kind::spawn;
         c.step = step;
-        c.spawn = sp;
+        c.body = sp;
         changes_.push_back(std::move(c));
       } else if (j.contains("remove")) {
         Change c;
@@ -233,7 +233,7 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
         Change c;
         c.kind = Change::Kind::view;
         c.step = step;
-        c.spawn = v;
+        c.body = v;
         changes_.push_back(std::move(c));
       } else {
         fail("a line needs \"turtle\" (a command), \"takeover\", \"add_wall\", \"spawn\", \"remove\", \"teleport\" or \"view\"");
@@ -267,13 +267,13 @@ void ReplayInput::at_boundary(turtle::WorldServer& server, std::uint64_t step) {
     switch (c.kind) {
       case Change::Kind::takeover: server.make_remote(c.turtle); break;
       case Change::Kind::add_wall: server.add_wall(c.wall); break;
-      case Change::Kind::spawn: spawn_(server, c.spawn); break;
+      case Change::Kind::spawn: spawn_(server, c.body); break;
       case Change::Kind::remove: server.remove_body(c.id); break;
       case Change::Kind::teleport:
         if (c.vel) server.teleport_ball(c.id, c.pos, *c.vel);
         else server.teleport_turtle(c.id, c.pos, *c.heading);
         break;
-      case Change::Kind::view: apply_view(server, c.spawn, c.step); break;
+      case Change::Kind::view: apply_view(server, c.body, c.step); break;
     }
   }
 }

@@ -75,7 +75,7 @@ class ReplayInput : public turtle::InputSource {
     std::uint64_t step = 0;
     std::size_t turtle = 0;  ///< takeover
     sim::WallDef wall;       ///< add_wall
-    nlohmann::json spawn;    ///< spawn: {"ball": {...}} or {"turtle": {...}}; view: {"op", "view"}
+    nlohmann::json body;     ///< spawn: {"ball": {...}} or {"turtle": {...}}; view: {"op", "view"}
     std::string id;          ///< remove, teleport
     sim::Vec2 pos;           ///< teleport
     std::optional<sim::Vec2> vel;
