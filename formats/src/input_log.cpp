@@ -162,6 +162,13 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
     const std::uint64_t step = s->get<std::uint64_t>();
     if (step < last_step) fail("/step: steps must not decrease (" + std::to_string(step) + " after " + std::to_string(last_step) + ")");
     last_step = step;
+    auto point = [](const nlohmann::json& p) { return sim::Vec2{p.at(0).get<double>(), p.at(1).get<double>()}; };
+    auto change = [&](Change::Kind kind) {
+      Change c;
+      c.kind = kind;
+      c.step = step;
+      return c;
+    };
     try {
       if (j.contains("turtle")) {
         const std::size_t i = index_of(j.at("turtle").get<std::string>(), line, "turtle");
@@ -177,9 +184,7 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
           c.pen = j.value("mode", std::string("line")) == "wall" ? turtle::PenMode::wall : turtle::PenMode::line;
         commands_[i].push_back({step, c});
       } else if (j.contains("takeover")) {
-        Change c;
-        c.kind = Change::Kind::takeover;
-        c.step = step;
+        Change c = change(Change::Kind::takeover);
         c.turtle = index_of(j.at("takeover").get<std::string>(), line, "takeover");
         changes_.push_back(std::move(c));
       } else if (j.contains("spawn")) {
@@ -192,37 +197,29 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
           turtle_ids_.push_back(sp.at("turtle").at("id").get<std::string>());
           commands_.resize(turtle_ids_.size());
         }
-        Change c;
-        c.kind = Change::Kind::spawn;
-        c.step = step;
+        Change c = change(Change::Kind::spawn);
         c.body = sp;
         changes_.push_back(std::move(c));
       } else if (j.contains("remove")) {
-        Change c;
-        c.kind = Change::Kind::remove;
-        c.step = step;
+        Change c = change(Change::Kind::remove);
         c.id = j.at("remove").get<std::string>();
         changes_.push_back(std::move(c));
       } else if (j.contains("teleport")) {
         const nlohmann::json& tp = j.at("teleport");
-        Change c;
-        c.kind = Change::Kind::teleport;
-        c.step = step;
+        Change c = change(Change::Kind::teleport);
         c.id = tp.at("id").get<std::string>();
-        c.pos = {tp.at("pos").at(0).get<double>(), tp.at("pos").at(1).get<double>()};
-        if (tp.contains("vel")) c.vel = sim::Vec2{tp.at("vel").at(0).get<double>(), tp.at("vel").at(1).get<double>()};
+        c.pos = point(tp.at("pos"));
+        if (tp.contains("vel")) c.vel = point(tp.at("vel"));
         if (tp.contains("heading")) c.heading = tp.at("heading").get<double>();
         if (c.vel.has_value() == c.heading.has_value())
           fail("/teleport: a ball's teleport has \"vel\", a turtle's \"heading\" (one of them)");
         changes_.push_back(std::move(c));
       } else if (j.contains("add_wall")) {
         const nlohmann::json& w = j.at("add_wall");
-        Change c;
-        c.kind = Change::Kind::add_wall;
-        c.step = step;
+        Change c = change(Change::Kind::add_wall);
         c.wall.id = w.at("id").get<std::string>();
-        c.wall.from = {w.at("from").at(0).get<double>(), w.at("from").at(1).get<double>()};
-        c.wall.to = {w.at("to").at(0).get<double>(), w.at("to").at(1).get<double>()};
+        c.wall.from = point(w.at("from"));
+        c.wall.to = point(w.at("to"));
         changes_.push_back(std::move(c));
       } else if (j.contains("view")) {
         const nlohmann::json& v = j.at("view");
@@ -230,9 +227,7 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
         if (op != "open" && op != "change" && op != "close") fail("/view/op: must be \"open\", \"change\" or \"close\"");
         if (op == "close" ? !v.at("view").is_string() : !v.at("view").is_object())
           fail("/view/view: a view object to open or change, a view's id to close");
-        Change c;
-        c.kind = Change::Kind::view;
-        c.step = step;
+        Change c = change(Change::Kind::view);
         c.body = v;
         changes_.push_back(std::move(c));
       } else {
