@@ -87,6 +87,11 @@ TEST_CASE("a copied world runs on exactly as the original and as a fresh run", "
   SECTION("exact mode, periodic arena") {
     check_copy(random_gas(300, 0.2, 2.0, 30.0, 7, sim::Boundary::periodic), sim::Mode::exact, 1.01, 3.5);
   }
+  SECTION("exact mode, a gas whose records lie on huge pages") {
+    // 70,000 balls: 8.96 MB of records, allocated on 2 MiB boundaries (big_memory.hpp); the copy
+    // allocates its own.
+    check_copy(random_gas(70'000, 0.2, 2.0, 30.0, 13, sim::Boundary::periodic), sim::Mode::exact, 0.011, 0.03);
+  }
   SECTION("step mode") {
     sim::WorldDef d = random_gas(300, 0.2, 2.0, 30.0, 9);
     d.dt = 1.0 / 30;

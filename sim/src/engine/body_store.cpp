@@ -1,12 +1,20 @@
 // SPDX-License-Identifier: MIT
 #include "body_store.hpp"
 
+#include "big_memory.hpp"
+
 #include <algorithm>
 #include <cstring>
 #include <new>
 #include <type_traits>
 
 namespace turtlegas::sim::detail {
+
+Record* allocate_records(std::size_t n) {
+  return static_cast<Record*>(allocate_big(std::max<std::size_t>(n, 1) * sizeof(Record), alignof(Record)));
+}
+
+void FreeRecords::operator()(Record* p) const { free_big(p); }
 
 BodyStore::BodyStore(const WorldDef& def, std::vector<BallDef>* release, bool with_layers) {
   nb_ = static_cast<std::uint32_t>(def.balls.size());
@@ -21,7 +29,7 @@ BodyStore::BodyStore(const WorldDef& def, std::vector<BallDef>* release, bool wi
     double r, mass;
   };
   static_assert(sizeof(Record) >= sizeof(Packed) && sizeof(Record) % alignof(Packed) == 0);
-  records_.reset(static_cast<Record*>(::operator new(n * sizeof(Record), std::align_val_t{alignof(Record)})));
+  records_.reset(allocate_records(n));
   char* const raw = reinterpret_cast<char*>(records_.get());
   char* const packed = raw + n * (sizeof(Record) - sizeof(Packed));
   if (with_layers) {
@@ -62,7 +70,7 @@ BodyStore::BodyStore(const BodyStore& o)
     : layers(o.layers), held(o.held), layered(o.layered), head(o.head), turtle_head(o.turtle_head), nb_(o.nb_) {
   const std::size_t n = o.size();
   if (n > 0) {
-    records_.reset(static_cast<Record*>(::operator new(n * sizeof(Record), std::align_val_t{alignof(Record)})));
+    records_.reset(allocate_records(n));
     static_assert(std::is_trivially_copyable_v<Record>);
     std::memcpy(static_cast<void*>(records_.get()), o.records_.get(), n * sizeof(Record));
   }
@@ -80,7 +88,7 @@ void BodyStore::insert(std::uint32_t at, bool ball) {
     return !p.is_none() && p.kind() == Partner::body ? LastPartner::of(Partner::body, up(p.index())) : p;
   };
   std::unique_ptr<Record[], FreeRecords> grown(
-      static_cast<Record*>(::operator new((n + 1) * sizeof(Record), std::align_val_t{alignof(Record)})));
+      allocate_records(n + 1));
   Record* const to = grown.get();
   // Record is trivially copyable: its bytes move, then the ids inside follow.
   static_assert(std::is_trivially_copyable_v<Record>);

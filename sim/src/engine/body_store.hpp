@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "big_memory.hpp"
 #include "records.hpp"
 #include "turtlegas/sim/world_def.hpp"
 
@@ -110,7 +111,7 @@ class BodyStore {
     if (b.next != kNone) body[b.next].prev = b.prev;
     b.next = b.prev = kNone;
   }
-  std::vector<std::uint32_t> head;         ///< balls by cell
+  std::vector<std::uint32_t, BigAllocator<std::uint32_t>> head;  ///< balls by cell (huge pages when large)
   std::vector<std::uint32_t> turtle_head;  ///< turtles by cell (only with extras)
 
  private:

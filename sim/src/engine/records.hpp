@@ -128,8 +128,11 @@ inline double& mass_of(Record& r) { return r.mass_or_end; }
 inline double& command_end_of(Record& r) { return r.mass_or_end; }
 inline LastPartner& last_of(Record& r) { return r.pending.last; }
 
+/// The records' memory: n records, aligned to their cache lines, on huge pages when large
+/// (big_memory.hpp). Freed by FreeRecords.
+Record* allocate_records(std::size_t n);
 struct FreeRecords {
-  void operator()(Record* p) const { ::operator delete(p, std::align_val_t{alignof(Record)}); }
+  void operator()(Record* p) const;
 };
 
 }  // namespace turtlegas::sim::detail
