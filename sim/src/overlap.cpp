@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 
 namespace turtlegas::sim::detail {
 namespace {
@@ -83,60 +84,76 @@ Overlap deepest_overlap(const DiscView& discs, const std::vector<Segment>& walls
   if (!ball_pairs) return worst;
 
   // Sort by cell of side 2 rmax and compare with the 3x3 neighbouring cells: an independent grid.
-  // Each disc's position and cell are read once (24 bytes a disc while measuring): the sampled
-  // self-check of a run measures often, and reading them through the views at every comparison
-  // cost ten times more.
+  // Each disc's position and cell are read once: the sampled self-check of a run measures often,
+  // and reading them through the views at every comparison cost ten times more. The cells are
+  // kept in 32-bit indices when every one fits (12 bytes a disc, with the 16 of its position:
+  // the measure's peak stays under the engine's own 128 + bytes a ball at N = 10^6); a gas spread
+  // past them (a fuzzed scene) takes 64-bit ones.
   const double cell = 2.0 * rmax;
-  struct Cell {
-    std::int64_t cx, cy;
-    auto operator<=>(const Cell&) const = default;
-  };
-  struct Item {
-    Cell c;
-    std::uint32_t i;
-  };
   auto cell_of = [&](Vec2 p) {
     if (periodic_width > 0.0) p = {p.x - periodic_width * std::floor(p.x / periodic_width),
                                    p.y - periodic_height * std::floor(p.y / periodic_height)};
-    return Cell{cell_index(p.x, cell), cell_index(p.y, cell)};
+    return std::pair{cell_index(p.x, cell), cell_index(p.y, cell)};
   };
-  std::vector<Item> order;
   std::vector<Vec2> at(n);
-  order.reserve(live);
+  constexpr std::int64_t kNarrow = std::int64_t{1} << 30;
+  bool narrow = true;
   for (std::size_t i = 0; i < n; ++i)
     if (discs.alive(i)) {
       at[i] = discs.pos(i);
-      order.push_back({cell_of(at[i]), static_cast<std::uint32_t>(i)});
+      const auto [cx, cy] = cell_of(at[i]);
+      narrow = narrow && cx > -kNarrow && cx < kNarrow && cy > -kNarrow && cy < kNarrow;
     }
-  std::sort(order.begin(), order.end(), [](const Item& a, const Item& b) { return a.c != b.c ? a.c < b.c : a.i < b.i; });
+  const std::int64_t ncx = periodic_width > 0.0 ? cell_index(periodic_width, cell) : 0;
+  const std::int64_t ncy = periodic_height > 0.0 ? cell_index(periodic_height, cell) : 0;
   auto check_pair = [&](std::size_t i, std::size_t j) {
     if (!meet(i, j)) return;
     const Vec2 d = min_image(at[j] - at[i], periodic_width, periodic_height);
     const double ri = discs.radius(i), rj = discs.radius(j);
     note(ri + rj - norm(d), std::min(ri, rj));
   };
-  const std::int64_t ncx = periodic_width > 0.0 ? cell_index(periodic_width, cell) : 0;
-  const std::int64_t ncy = periodic_height > 0.0 ? cell_index(periodic_height, cell) : 0;
-  const bool brute = periodic_width > 0.0 && (ncx < 3 || ncy < 3);
-  if (brute || order.size() < 64) {
-    for (std::size_t a = 0; a < order.size(); ++a)
-      for (std::size_t b = a + 1; b < order.size(); ++b) check_pair(order[a].i, order[b].i);
-    return worst;
-  }
-  for (const Item& home : order) {
-    for (std::int64_t dy = -1; dy <= 1; ++dy)
-      for (std::int64_t dx = -1; dx <= 1; ++dx) {
-        Cell c{home.c.cx + dx, home.c.cy + dy};
-        if (periodic_width > 0.0) {
-          // Cells past the last whole one belong to the last; wrap the rest.
-          c.cx = ((c.cx % (ncx + 1)) + (ncx + 1)) % (ncx + 1);
-          c.cy = ((c.cy % (ncy + 1)) + (ncy + 1)) % (ncy + 1);
-        }
-        auto it = std::partition_point(order.begin(), order.end(), [&](const Item& k) { return k.c < c; });
-        for (; it != order.end() && it->c == c; ++it)
-          if (it->i > home.i) check_pair(home.i, it->i);
+  auto pairs = [&](auto index) {
+    using Index = decltype(index);
+    struct Cell {
+      Index cx, cy;
+      auto operator<=>(const Cell&) const = default;
+    };
+    struct Item {
+      Cell c;
+      std::uint32_t i;
+    };
+    std::vector<Item> order;
+    order.reserve(live);
+    for (std::size_t i = 0; i < n; ++i)
+      if (discs.alive(i)) {
+        const auto [cx, cy] = cell_of(at[i]);
+        order.push_back({{static_cast<Index>(cx), static_cast<Index>(cy)}, static_cast<std::uint32_t>(i)});
       }
-  }
+    std::sort(order.begin(), order.end(), [](const Item& a, const Item& b) { return a.c != b.c ? a.c < b.c : a.i < b.i; });
+    const bool brute = periodic_width > 0.0 && (ncx < 3 || ncy < 3);
+    if (brute || order.size() < 64) {
+      for (std::size_t a = 0; a < order.size(); ++a)
+        for (std::size_t b = a + 1; b < order.size(); ++b) check_pair(order[a].i, order[b].i);
+      return;
+    }
+    for (const Item& home : order) {
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        for (std::int64_t dx = -1; dx <= 1; ++dx) {
+          std::int64_t cx = home.c.cx + dx, cy = home.c.cy + dy;
+          if (periodic_width > 0.0) {
+            // Cells past the last whole one belong to the last; wrap the rest.
+            cx = ((cx % (ncx + 1)) + (ncx + 1)) % (ncx + 1);
+            cy = ((cy % (ncy + 1)) + (ncy + 1)) % (ncy + 1);
+          }
+          const Cell c{static_cast<Index>(cx), static_cast<Index>(cy)};
+          auto it = std::partition_point(order.begin(), order.end(), [&](const Item& k) { return k.c < c; });
+          for (; it != order.end() && it->c == c; ++it)
+            if (it->i > home.i) check_pair(home.i, it->i);
+        }
+    }
+  };
+  if (narrow && ncx < kNarrow && ncy < kNarrow) pairs(std::int32_t{});
+  else pairs(std::int64_t{});
   return worst;
 }
 

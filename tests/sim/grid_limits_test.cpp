@@ -252,3 +252,21 @@ TEST_CASE("the overlap measure of a gas of tiny discs has its cell indices in ra
   World w(d, Mode::exact);
   CHECK(w.measure_overlap().depth == 0.0);
 }
+
+TEST_CASE("the overlap measure finds the same pairs with narrow and wide cell indices", "[overlap]") {
+  // The measure keeps cells in 32-bit indices when every one fits (|index| < 2^30) and in 64-bit
+  // ones otherwise. A lattice of 200 discs (the grid path) with one pair overlapping by 0.25 r,
+  // placed where the cells are small numbers, just below 2^30 cells from the origin (narrow), and
+  // past it (wide); every placement must report that pair and nothing deeper. The lattice's pairs
+  // straddle cell edges and rows, so a wrong neighbour cell would miss the overlapping one.
+  for (double origin : {0.0, 2.0 * 0x1p30 - 600.0, 2.0 * 0x1p30 + 600.0, 1e12}) {
+    INFO("origin " << origin);
+    std::vector<Vec2> pos;
+    for (int k = 0; k < 200; ++k) pos.push_back({origin + 3.0 * (k % 20), 3.0 * (k / 20)});
+    pos[137] = pos[136] + Vec2{1.75, 0.0};  // radius 1: overlap 0.25, moved left onto its neighbour
+    detail::DiscView discs{pos.size(), [&](std::size_t i) { return pos[i]; }, [](std::size_t) { return 1.0; },
+                           [](std::size_t) { return true; }};
+    const Overlap o = detail::deepest_overlap(discs, {});
+    CHECK(o.relative == Approx(0.25).epsilon(1e-6));
+  }
+}
