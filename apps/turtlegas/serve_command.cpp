@@ -78,8 +78,9 @@ CLI::App* add_replay_command(CLI::App& app, ServeCommandOptions& opt) {
   return s;
 }
 
-int serve_command(const ServeCommandOptions& opt, const turtle::Registry& registry) {
-  server::ServeOptions so;
+PreparedServe prepare_serve(const ServeCommandOptions& opt, const turtle::Registry& registry) {
+  PreparedServe prepared;
+  server::ServeOptions& so = prepared.options;
   so.bind = opt.bind;
   if (opt.port > 65535) throw BadInput("--port must be from 0 to 65535 (got " + std::to_string(opt.port) + ")");
   so.port = static_cast<unsigned short>(opt.port);
@@ -149,7 +150,7 @@ int serve_command(const ServeCommandOptions& opt, const turtle::Registry& regist
   h.limits.max_rate = opt.max_rate;
   if (h.limits.max_websocket_read < opt.max_message) h.limits.max_websocket_read = opt.max_message;
 
-  world::Scene scene;
+  world::Scene& scene = prepared.scene;
   if (!opt.replay.empty()) {
     // The recording's world, re-simulated: the run is deterministic, so its states are the
     // recorded ones to the bit (docs/recording.md, "Replay").
@@ -190,8 +191,13 @@ int serve_command(const ServeCommandOptions& opt, const turtle::Registry& regist
     text << in.rdbuf();
     h.world_text = text.str();
   }
+  return prepared;
+}
+
+int serve_command(const ServeCommandOptions& opt, const turtle::Registry& registry) {
+  PreparedServe prepared = prepare_serve(opt, registry);
   try {
-    return server::serve(std::move(so), registry, std::move(scene));
+    return server::serve(std::move(prepared.options), registry, std::move(prepared.scene));
   } catch (const std::invalid_argument& e) {
     throw BadInput(e.what());
   }
