@@ -7,19 +7,43 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
+#include <optional>
+#include <stdexcept>
 #include <string_view>
 
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/world/file_error.hpp"
 #include "turtlegas/world/scene.hpp"
+#include "turtlegas/world/world_file.hpp"
 
 namespace turtlegas::fuzz {
 
 inline const turtle::Registry& registry() {
   static const turtle::Registry r = controllers::builtin_registry();
   return r;
+}
+
+/// A finding that is no crash of its own (an exception where an answer was due): says what and
+/// aborts, which libFuzzer saves as a crash.
+[[noreturn]] inline void finding(const char* what, const char* message) {
+  std::fprintf(stderr, "finding: %s: %s\n", what, message);
+  std::abort();
+}
+
+/// The scene of a fuzzed world file's bytes, or nullopt when the loader refuses it with its
+/// WorldFileError (the expected answer to most inputs).
+inline std::optional<world::Scene> load_scene(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  try {
+    return world::parse_scene(text, "fuzz.json", registry());
+  } catch (const world::WorldFileError&) {
+    return std::nullopt;
+  }
 }
 
 /// Bounds of a fuzzed run: at most this many engine events, this much simulated time, and this
