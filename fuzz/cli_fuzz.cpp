@@ -114,7 +114,11 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   spdlog::set_default_logger(std::make_shared<spdlog::logger>("turtlegas", std::make_shared<spdlog::sinks::null_sink_st>()));
   std::fflush(stdout);
   if (std::freopen("/dev/null", "w", stdout) == nullptr) std::abort();
-  (void)sandbox();
+  // The sandbox (and its recording, made by running a turtle world) comes with the first input,
+  // not here: libFuzzer installs its SIGALRM handler (-timeout) after this function and keeps a
+  // handler it finds, so the runtime's (turtle_runtime/src/fiber.cpp, chaining to the default
+  // action) would kill the process at libFuzzer's first timer tick; and the parent of -fork
+  // runs no input, so it stays in its directory, where its relative paths point.
   return 0;
 }
 

@@ -133,7 +133,11 @@ bool has_word(std::string_view line, std::string_view word) {
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   spdlog::set_default_logger(std::make_shared<spdlog::logger>("turtlegas", std::make_shared<spdlog::sinks::null_sink_st>()));
-  (void)sandbox();
+  // The sandbox (and its recording, made by running a turtle world) comes with the first input,
+  // not here: libFuzzer installs its SIGALRM handler (-timeout) after this function and keeps a
+  // handler it finds, so the runtime's (turtle_runtime/src/fiber.cpp, chaining to the default
+  // action) would kill the process at libFuzzer's first timer tick; and the parent of -fork
+  // runs no input, so it stays in its directory, where its relative paths point.
   return 0;
 }
 
