@@ -65,9 +65,7 @@ void restore(const Sandbox& s) {
 Sandbox& sandbox() {
   static Sandbox s = [] {
     Sandbox b;
-    char tmpl[] = "/tmp/turtlegas-cli-fuzz-XXXXXX";
-    if (::mkdtemp(tmpl) == nullptr) std::abort();
-    b.dir = tmpl;
+    b.dir = fuzz::make_sandbox("turtlegas-cli-fuzz");
     const fs::path src = TURTLEGAS_SOURCE_DIR;
     b.files["gas.json"] = read_file(src / "worlds/tests/box_bounce.json");
     b.files["turtle.json"] = read_file(src / "worlds/tests/controller_script.json");

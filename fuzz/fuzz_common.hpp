@@ -4,11 +4,17 @@
 // scene costs a bounded number of events rather than a timeout.
 #pragma once
 
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <string>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -44,6 +50,24 @@ inline std::optional<world::Scene> load_scene(const std::uint8_t* data, std::siz
   } catch (const world::WorldFileError&) {
     return std::nullopt;
   }
+}
+
+/// A private directory /tmp/NAME-PID-XXXXXX for a harness's files. libFuzzer ends its fork-mode
+/// jobs without running atexit handlers, so the sandboxes of processes that are gone are removed
+/// here, when the next one is made.
+inline std::filesystem::path make_sandbox(const std::string& name) {
+  namespace fs = std::filesystem;
+  const std::string prefix = name + "-";
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator("/tmp", ec)) {
+    const std::string leaf = e.path().filename().string();
+    if (leaf.rfind(prefix, 0) != 0) continue;
+    const long pid = std::strtol(leaf.c_str() + prefix.size(), nullptr, 10);
+    if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) fs::remove_all(e.path(), ec);
+  }
+  std::string tmpl = "/tmp/" + prefix + std::to_string(::getpid()) + "-XXXXXX";
+  if (::mkdtemp(tmpl.data()) == nullptr) finding("sandbox", "cannot make a directory in /tmp");
+  return tmpl;
 }
 
 /// Bounds of a fuzzed run: at most this many engine events, this much simulated time, and this

@@ -100,9 +100,7 @@ apps::PreparedServe record_and_prepare(const fs::path& world, const std::string&
 Sandbox& sandbox() {
   static Sandbox s = [] {
     Sandbox b;
-    char tmpl[] = "/tmp/turtlegas-protocol-fuzz-XXXXXX";
-    if (::mkdtemp(tmpl) == nullptr) std::abort();
-    b.dir = tmpl;
+    b.dir = fuzz::make_sandbox("turtlegas-protocol-fuzz");
     b.save_dir = b.dir / "saves";
     fs::create_directories(b.save_dir);
     fs::current_path(b.dir);
