@@ -4,22 +4,70 @@
 // scene costs a bounded number of events rather than a timeout.
 #pragma once
 
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
 #include <memory>
+#include <optional>
+#include <stdexcept>
 #include <string_view>
 
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/turtle/world_server.hpp"
+#include "turtlegas/world/file_error.hpp"
 #include "turtlegas/world/scene.hpp"
+#include "turtlegas/world/world_file.hpp"
 
 namespace turtlegas::fuzz {
 
 inline const turtle::Registry& registry() {
   static const turtle::Registry r = controllers::builtin_registry();
   return r;
+}
+
+/// A finding that is no crash of its own (an exception where an answer was due): says what and
+/// aborts, which libFuzzer saves as a crash.
+[[noreturn]] inline void finding(const char* what, const char* message) {
+  std::fprintf(stderr, "finding: %s: %s\n", what, message);
+  std::abort();
+}
+
+/// The scene of a fuzzed world file's bytes, or nullopt when the loader refuses it with its
+/// WorldFileError (the expected answer to most inputs).
+inline std::optional<world::Scene> load_scene(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  try {
+    return world::parse_scene(text, "fuzz.json", registry());
+  } catch (const world::WorldFileError&) {
+    return std::nullopt;
+  }
+}
+
+/// A private directory /tmp/NAME-PID-XXXXXX for a harness's files. libFuzzer ends its fork-mode
+/// jobs without running atexit handlers, so the sandboxes of processes that are gone are removed
+/// here, when the next one is made.
+inline std::filesystem::path make_sandbox(const std::string& name) {
+  namespace fs = std::filesystem;
+  const std::string prefix = name + "-";
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator("/tmp", ec)) {
+    const std::string leaf = e.path().filename().string();
+    if (leaf.rfind(prefix, 0) != 0) continue;
+    const long pid = std::strtol(leaf.c_str() + prefix.size(), nullptr, 10);
+    if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) fs::remove_all(e.path(), ec);
+  }
+  std::string tmpl = "/tmp/" + prefix + std::to_string(::getpid()) + "-XXXXXX";
+  if (::mkdtemp(tmpl.data()) == nullptr) finding("sandbox", "cannot make a directory in /tmp");
+  return tmpl;
 }
 
 /// Bounds of a fuzzed run: at most this many engine events, this much simulated time, and this

@@ -5,23 +5,16 @@
 // NaN position is a finding.
 #include <cstddef>
 #include <cstdint>
-#include <string_view>
 
 #include "fuzz_common.hpp"
-#include "turtlegas/world/world_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace turtlegas;
-  const std::string_view text(reinterpret_cast<const char*>(data), size);
-  world::Scene scene;
-  try {
-    scene = world::parse_scene(text, "fuzz.json", fuzz::registry());
-  } catch (const world::WorldFileError&) {
-    return 0;
-  }
+  const std::optional<world::Scene> scene = fuzz::load_scene(data, size);
+  if (!scene) return 0;
   for (sim::Mode mode : {sim::Mode::exact, sim::Mode::step}) {
     try {
-      fuzz::bounded_run(scene, mode);
+      fuzz::bounded_run(*scene, mode);
     } catch (const std::invalid_argument&) {
       // A scene the engine refuses to build in this mode (validate's message): not a finding.
     }

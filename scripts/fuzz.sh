@@ -1,16 +1,20 @@
 #!/usr/bin/env bash
 # Fuzzes each libFuzzer harness (fuzz/) for SECONDS (default 60), one after another or, with
-# JOBS=N, N at a time; corpora live in build/fuzz/corpus/NAME (seeded from worlds/ on the first
-# run) and findings in build/fuzz/findings/NAME. Prints each harness's executions and coverage.
-#   scripts/fuzz.sh 1800            # 30 minutes each
-#   JOBS=2 scripts/fuzz.sh 1800     # both at once
+# JOBS=N, all at once; corpora live in build/fuzz/corpus/NAME (seeded on the first run: the world
+# harnesses from worlds/, cli_fuzz and protocol_fuzz from fuzz/seeds/NAME) and findings in
+# build/fuzz/findings/NAME. Prints each harness's executions and coverage.
+#   scripts/fuzz.sh 1800                              # 30 minutes each
+#   JOBS=2 scripts/fuzz.sh 1800                       # all at once
+#   HARNESSES="cli_fuzz protocol_fuzz" scripts/fuzz.sh 1800   # only these
 # A finding (crash-*, timeout-*, oom-*) becomes a regression test: reproduce it with
 #   build/fuzz/fuzz/NAME build/fuzz/findings/NAME/crash-...
 set -euo pipefail
 cd "$(dirname "$0")/.."
+root=$PWD  # absolute paths: the cli and protocol harnesses work in a temporary directory of their own
 seconds=${1:-60}
 jobs=${JOBS:-1}
-harnesses=(world_fuzz expect_fuzz)
+read -r -a harnesses <<<"${HARNESSES:-world_fuzz expect_fuzz cli_fuzz protocol_fuzz}"
+
 
 cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz
@@ -19,9 +23,14 @@ for h in "${harnesses[@]}"; do
   corpus=build/fuzz/corpus/$h
   mkdir -p "$corpus" "build/fuzz/findings/$h"
   if [ -z "$(ls -A "$corpus")" ]; then
-    # Seeds: the repository's world files, but not the benchmarks' (10^4 balls and more: slow, and
-    # nothing the small ones do not reach).
-    find worlds controllers/examples -name '*.json' -not -path 'worlds/bench/*' -exec cp {} "$corpus/" \;
+    if [ -d "fuzz/seeds/$h" ]; then
+      # Argument vectors from docs/cli.md and the README; protocol sessions from docs/protocol.md.
+      cp fuzz/seeds/"$h"/* "$corpus/"
+    else
+      # Seeds: the repository's world files, but not the benchmarks' (10^4 balls and more: slow,
+      # and nothing the small ones do not reach).
+      find worlds controllers/examples -name '*.json' -not -path 'worlds/bench/*' -exec cp {} "$corpus/" \;
+    fi
   fi
 done
 
@@ -31,9 +40,9 @@ run_one() {
   # -fork=1: the fuzzing runs in a child that is restarted after a finding, so a crash or a hang
   # (-timeout: an input running longer than 10 s) is saved and fuzzing goes on; -rss_limit_mb:
   # 2 GB is a memory finding. The bounded run of each input is in fuzz/fuzz_common.hpp.
-  "build/fuzz/fuzz/$h" "build/fuzz/corpus/$h" -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 \
+  "$root/build/fuzz/fuzz/$h" "$root/build/fuzz/corpus/$h" -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 \
     -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=4096 \
-    -artifact_prefix="build/fuzz/findings/$h/" >"$log" 2>&1 || true
+    -artifact_prefix="$root/build/fuzz/findings/$h/" >"$log" 2>&1 || true
   # The last status line: "#EXECS: cov: EDGES ft: FEATURES corp: ..."
   local last execs cov ft
   last=$(grep -E '^#[0-9]+:? .*cov: ' "$log" | tail -1 || true)

@@ -407,8 +407,10 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   // the balls of (World(WorldDef&&)).
   const formats::IdTable ball_ids = formats::ball_ids(def);
 
-  install_stop_signals();
-  install_crash_report(opt.world);
+  if (opt.signal_handlers) {
+    install_stop_signals();
+    install_crash_report(opt.world);
+  }
 
   Progress progress(opt.until);
   RunTotals totals;

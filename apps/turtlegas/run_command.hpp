@@ -49,6 +49,10 @@ struct RunOptions {
   /// How many evenly spaced instants --stats measures the deepest overlap at (0: only at
   /// contacts and the end); unset: the default of overlap_samples() in run_command.cpp.
   std::optional<std::uint64_t> overlap_samples;
+  /// SIGINT/SIGTERM stop the run cleanly and a fatal signal is reported with the turtle and time
+  /// (signals.hpp). False leaves the process's handlers alone: fuzz/cli_fuzz runs under
+  /// libFuzzer's and the sanitizers' own.
+  bool signal_handlers = true;
 };
 
 /// The `run` subcommand's command line, parsed into a RunOptions by options() once CLI11 has run.

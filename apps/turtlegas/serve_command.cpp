@@ -2,6 +2,7 @@
 #include "serve_command.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -20,17 +21,40 @@
 #include "turtlegas/sim/mode_names.hpp"
 
 namespace turtlegas::apps {
+namespace {
+
+// Range checks on the option's text, as for every command (cli_common.hpp): CLI11 alone read
+// `--max-clients -1` as 2^64 - 1 and took `--lockstep-timeout 1e308` (a wait whose conversion to
+// the clock's nanoseconds overflows) and `--max-rate inf`.
+constexpr std::int64_t max_count = 1000000;
+constexpr std::int64_t max_message_bytes = std::int64_t{1} << 30;
+
+void add_port_options(CLI::App& s, ServeCommandOptions& opt) {
+  s.add_option("--port", opt.port, "HTTP and WebSocket port (0: any free port)")
+      ->capture_default_str()
+      ->check(integer_in(0, 65535, "port"));
+  s.add_option("--line-port", opt.line_port, "TCP-lines port (default: --port + 1; any free port when --port is 0)")
+      ->check(integer_in(0, 65535, "port"));
+}
+
+void add_max_clients_option(CLI::App& s, ServeCommandOptions& opt) {
+  s.add_option("--max-clients", opt.max_clients, "Connections at most (WebSocket and TCP lines)")
+      ->capture_default_str()
+      ->check(integer_in(1, max_count, "connections"));
+}
+
+}  // namespace
 
 CLI::App* add_serve_command(CLI::App& app, ServeCommandOptions& opt) {
   CLI::App* s = app.add_subcommand("serve", "Run a world in real time and serve it on the network (docs/protocol.md)");
   s->add_option("world", opt.world, "World file (format turtlegas-world/1)")->required();
   s->add_option("--bind", opt.bind, "Address to listen on; other than loopback needs --token")->capture_default_str();
-  s->add_option("--port", opt.port, "HTTP and WebSocket port (0: any free port)")->capture_default_str();
-  s->add_option("--line-port", opt.line_port, "TCP-lines port (default: --port + 1; any free port when --port is 0)");
+  add_port_options(*s, opt);
   s->add_option("--speed", opt.speed, "Simulated seconds per wall second, 0.01 to 1000, or max")->capture_default_str();
   s->add_flag("--paused", opt.paused, "Start paused");
   s->add_option("--token", opt.token, "Token that control messages and claims need");
-  s->add_option("--until", opt.until, "Stop at this simulated time, as on SIGINT");
+  s->add_option("--until", opt.until, "Stop at this simulated time, as on SIGINT")
+      ->check(real_in(0, std::numeric_limits<double>::max(), "seconds"));
   s->add_option("--events", opt.events, "Write the event log here (JSON lines, as `run --events`)");
   s->add_option("--inputs-out", opt.inputs_out, "Write the input log here (replay with `run --inputs`)");
   s->add_option("--record", opt.record,
@@ -44,21 +68,26 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommandOptions& opt) {
       ->check(integer_in(0, std::numeric_limits<std::int64_t>::max(), "events"));
   s->add_option("--save-dir", opt.save_dir, "The only directory save and load may touch");
   s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the installed share/turtlegas/web beside the program, else the source tree's server/web)");
-  s->add_option("--max-clients", opt.max_clients, "Connections at most (WebSocket and TCP lines)")->capture_default_str();
-  s->add_option("--max-claims", opt.max_claims, "Claimed turtles per connection at most")->capture_default_str();
-  s->add_option("--max-message", opt.max_message, "Bytes per message at most")->capture_default_str();
-  s->add_option("--max-rate", opt.max_rate, "Messages per second per connection at most")->capture_default_str();
+  add_max_clients_option(*s, opt);
+  s->add_option("--max-claims", opt.max_claims, "Claimed turtles per connection at most")
+      ->capture_default_str()
+      ->check(integer_in(0, max_count, "claims"));
+  s->add_option("--max-message", opt.max_message, "Bytes per message at most")
+      ->capture_default_str()
+      ->check(integer_in(64, max_message_bytes, "bytes"));
+  s->add_option("--max-rate", opt.max_rate, "Messages per second per connection at most")
+      ->capture_default_str()
+      ->check(real_in(0, 1e9, "messages per second", true));
   s->add_option("--lockstep-timeout", opt.lockstep_timeout,
                 "Wall seconds a lockstep world waits for a claimed turtle's command before it ends")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(real_in(0, 1e6, "seconds", true));
   s->add_option("--mode", opt.mode, "exact (event-driven) or step (the memo's fixed steps)")
       ->check(CLI::IsMember(sim::mode_names))
       ->capture_default_str();
   s->add_flag("--realtime", opt.realtime, "Remote turtles never hold the world up (default: lockstep)");
-  s->add_option("--stack-kib", opt.stack_kib, "Each turtle program's stack, KiB")->capture_default_str();
-  s->add_option("--program-budget", opt.program_budget,
-                "Wall-clock seconds a turtle program may run without issuing a command before its world ends")
-      ->capture_default_str();
+  add_stack_kib_option(*s, opt.stack_kib);
+  add_program_budget_option(*s, opt.program_budget, "its world ends");
   return s;
 }
 
@@ -67,19 +96,19 @@ CLI::App* add_replay_command(CLI::App& app, ServeCommandOptions& opt) {
       "replay", "Serve a recording (run --record) to the viewer and the protocol: play, pause, seek, reverse, speed");
   s->add_option("recording", opt.replay, "The recording (format turtlegas-recording/1, docs/recording.md)")->required();
   s->add_option("--bind", opt.bind, "Address to listen on; other than loopback needs --token")->capture_default_str();
-  s->add_option("--port", opt.port, "HTTP and WebSocket port (0: any free port)")->capture_default_str();
-  s->add_option("--line-port", opt.line_port, "TCP-lines port (default: --port + 1; any free port when --port is 0)");
+  add_port_options(*s, opt);
   s->add_option("--speed", opt.speed, "Simulated seconds per wall second, 0.01 to 1000, or max")->capture_default_str();
   s->add_flag("--paused", opt.paused, "Start paused");
   s->add_option("--token", opt.token, "Token that control messages need");
   s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the installed share/turtlegas/web beside the program, else the source tree's server/web)");
-  s->add_option("--max-clients", opt.max_clients, "Connections at most (WebSocket and TCP lines)")->capture_default_str();
-  s->add_option("--stack-kib", opt.stack_kib, "Each turtle program's stack, KiB")->capture_default_str();
+  add_max_clients_option(*s, opt);
+  add_stack_kib_option(*s, opt.stack_kib);
   return s;
 }
 
-int serve_command(const ServeCommandOptions& opt, const turtle::Registry& registry) {
-  server::ServeOptions so;
+PreparedServe prepare_serve(const ServeCommandOptions& opt, const turtle::Registry& registry) {
+  PreparedServe prepared;
+  server::ServeOptions& so = prepared.options;
   so.bind = opt.bind;
   if (opt.port > 65535) throw BadInput("--port must be from 0 to 65535 (got " + std::to_string(opt.port) + ")");
   so.port = static_cast<unsigned short>(opt.port);
@@ -149,7 +178,7 @@ int serve_command(const ServeCommandOptions& opt, const turtle::Registry& regist
   h.limits.max_rate = opt.max_rate;
   if (h.limits.max_websocket_read < opt.max_message) h.limits.max_websocket_read = opt.max_message;
 
-  world::Scene scene;
+  world::Scene& scene = prepared.scene;
   if (!opt.replay.empty()) {
     // The recording's world, re-simulated: the run is deterministic, so its states are the
     // recorded ones to the bit (docs/recording.md, "Replay").
@@ -190,8 +219,13 @@ int serve_command(const ServeCommandOptions& opt, const turtle::Registry& regist
     text << in.rdbuf();
     h.world_text = text.str();
   }
+  return prepared;
+}
+
+int serve_command(const ServeCommandOptions& opt, const turtle::Registry& registry) {
+  PreparedServe prepared = prepare_serve(opt, registry);
   try {
-    return server::serve(std::move(so), registry, std::move(scene));
+    return server::serve(std::move(prepared.options), registry, std::move(prepared.scene));
   } catch (const std::invalid_argument& e) {
     throw BadInput(e.what());
   }

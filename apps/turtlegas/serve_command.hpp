@@ -10,7 +10,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "turtlegas/server/serve.hpp"
 #include "turtlegas/turtle/registry.hpp"
+#include "turtlegas/world/scene.hpp"
 
 namespace turtlegas::apps {
 
@@ -42,6 +44,14 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommandOptions& opt);
 /// world, to the same viewers and protocol, with play, pause, seek, reverse and speed. Its options
 /// are serve's that make sense for a recording; serve_command() runs it.
 CLI::App* add_replay_command(CLI::App& app, ServeCommandOptions& opt);
+/// What serve_command() checks and loads before it listens: the options range-checked, the world
+/// (or the recording's world) loaded; BadInput for anything wrong. Nothing is opened or bound.
+struct PreparedServe {
+  server::ServeOptions options;
+  world::Scene scene;
+};
+PreparedServe prepare_serve(const ServeCommandOptions& opt, const turtle::Registry& registry);
+/// prepare_serve(), then serves until a signal or --until.
 int serve_command(const ServeCommandOptions& opt, const turtle::Registry& registry);
 
 }  // namespace turtlegas::apps

@@ -123,6 +123,44 @@ TEST_CASE("robust: numeric options out of range are refused with exit 2, naming 
   }
 }
 
+TEST_CASE("robust: serve's and replay's numeric options out of range are refused with exit 2") {
+  // CLI11 alone read `--max-clients -1` as 2^64 - 1 and served; `--lockstep-timeout 1e308` (whose
+  // wait overflows the clock's nanoseconds) and `--max-rate inf` were taken too.
+  TempDir dir;
+  const std::string w = worlds + "tag.json";
+  struct Case {
+    std::vector<std::string> args;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {{"--max-clients", "-1"}, "--max-clients"},   {{"--max-clients", "0"}, "--max-clients"},
+      {{"--max-claims", "-1"}, "--max-claims"},     {{"--max-message", "-1"}, "--max-message"},
+      {{"--max-message", "10"}, "--max-message"},   {{"--max-rate", "inf"}, "--max-rate"},
+      {{"--max-rate", "nan"}, "--max-rate"},        {{"--lockstep-timeout", "1e308"}, "--lockstep-timeout"},
+      {{"--lockstep-timeout", "0"}, "--lockstep-timeout"}, {{"--line-port", "-5"}, "--line-port"},
+      {{"--line-port", "65536"}, "--line-port"},    {{"--until", "nan"}, "--until"},
+      {{"--stack-kib", "-1"}, "--stack-kib"},       {{"--program-budget", "inf"}, "--program-budget"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"serve", w, "--port", "0", "--until", "0.1"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const Result r = run(dir, args);
+    INFO(c.args[0] << " " << c.args[1] << ": " << r.err);
+    CHECK(r.code == 2);
+    CHECK(contains(r.err, c.says));
+    CHECK(contains(r.err, "must be"));
+    CHECK(!contains(r.out, "listening"));
+  }
+  const Result port = run(dir, {"serve", w, "--port", "-1", "--until", "0.1"});
+  CHECK(port.code == 2);
+  CHECK(contains(port.err, "--port"));
+  CHECK(contains(port.err, "must be"));
+  const Result replay = run(dir, {"replay", "none.tgrec", "--max-clients", "-1"});
+  CHECK(replay.code == 2);
+  CHECK(contains(replay.err, "--max-clients"));
+  CHECK(contains(replay.err, "must be"));
+}
+
 // --- §2: output files ---------------------------------------------------------------------------
 
 TEST_CASE("robust: - is standard output") {
