@@ -418,3 +418,113 @@ TEST_CASE("40 discs poured into a 10-degree V under gravity settle, in step mode
   CHECK(w.energy() < 0.5 * e0);
   CHECK(w.energy() <= e_settled + 40 * std::pow(10.0 / 30.0, 2));
 }
+
+namespace {
+
+/// Runs w to `until` one control step at a time, as a program that drives on whenever it is
+/// stopped would: every turtle in `drivers` is told to go forward 1000 at each control boundary
+/// where its command is not running (after a touch, say). The deepest overlap seen at the steps.
+double drive_on(World& w, Run& run, const std::vector<std::size_t>& drivers, double until) {
+  w.set_event_log(&run.log);
+  w.set_event_limit(kLimit);
+  const double dt = 1.0 / 30.0;
+  double worst = 0.0;
+  for (int k = 0; k * dt < until; ++k) {
+    REQUIRE_NOTHROW(w.advance_to(k * dt));
+    for (std::size_t i : drivers)
+      if (w.turtle_alive(i) && !w.turtle(i).busy) w.command_turtle(i, {TurtleCommand::Kind::move, 1000});
+    worst = std::max(worst, w.measure_overlap().relative);
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("turtles driving head on onto a ball or a turtle stop at it: it is wedged, never crushed", "[squeeze][turtle]") {
+  // Turtles stop when they touch, so a driving turtle never closes a squeeze. The squeeze rule
+  // took the speed of a turtle still driving onto the body (about to touch it and stop) for a
+  // closing obstacle and crushed the ball, or the standing turtle, between the two.
+  for (Mode mode : kModes) {
+    for (bool turtle_body : {false, true}) {
+      INFO("mode " << (mode == Mode::exact ? "exact" : "step") << (turtle_body ? ", a turtle between" : ", a ball between"));
+      WorldDef d = box(300, 200);
+      d.effects.restitution = 0.5;
+      d.turtles.push_back(turtle("t1", {100, 100}, 90, 10, 20));
+      d.turtles.push_back(turtle("t2", {200, 100}, 270, 10, 20));
+      if (turtle_body) d.turtles.push_back(turtle("m", {150, 100}, 0, 5));
+      else d.balls.push_back(ball("b", {150, 100}, {3, 0}, 5));
+      World w(d, mode);
+      Run run;
+      const double worst = drive_on(w, run, {0, 1}, 8.0);
+      CHECK(worst <= 1e-9);
+      CHECK(run.count(EventKind::crushed) == 0);
+      CHECK(w.stats().crushed == 0);
+      if (turtle_body) CHECK(w.turtle_alive(2));
+      else CHECK(w.ball(0).alive);
+      // Both stopped touching it, on its axis: 10 + 5 + 5 + 10 apart.
+      CHECK(norm(w.turtle(0).pos - w.turtle(1).pos) == Approx(30).epsilon(1e-9));
+    }
+  }
+}
+
+TEST_CASE("a turtle a piston carries pushes a ball before it and crushes it against the wall, then is crushed",
+          "[squeeze][turtle]") {
+  // It stopped dead at the ball, the piston caught it at once and carried it on into the ball
+  // again, for ever at one instant (the run hung, deaf even to SIGTERM). A carried turtle goes on
+  // at the piston's speed: the ball bounces off it, and is crushed where the room closes.
+  for (Mode mode : kModes) {
+    for (double e : {1.0, 0.5}) {
+      for (int chain : {1, 2}) {
+        INFO("mode " << (mode == Mode::exact ? "exact" : "step") << ", e = " << e << ", turtles " << chain);
+        WorldDef d = piston_scene();  // the piston reaches x = 290 at t = 10 (27 units/s)
+        d.effects.restitution = e;
+        d.turtles.push_back(turtle("t1", {100, 150}, 0, 10));
+        if (chain == 2) d.turtles.push_back(turtle("t2", {200, 150}, 0, 10));  // carried by t1 in turn
+        d.balls.push_back(ball("b", {250, 150}, {0, 0}, 8));
+        World w(d, mode);
+        Run run;
+        run_to(w, run, 12.0);
+        CHECK(w.measure_overlap().relative <= 1e-9);
+        CHECK(w.max_contact_overlap().relative <= 1e-9);
+        REQUIRE(run.count(EventKind::crushed) == static_cast<std::size_t>(chain + 1));
+        // The front turtle's front is the piston + 20 chain; the ball is crushed when it is 2 r from
+        // the wall at x = 300, then each turtle when its centre is r from it.
+        std::vector<double> want{(300.0 - 16 - 20 * chain - 20) / 27.0};
+        for (int k = chain; k >= 1; --k) want.push_back((290.0 - 20 * k + 10 - 20) / 27.0);
+        std::vector<double> got;
+        for (const Event& ev : run.log)
+          if (ev.kind == EventKind::crushed) got.push_back(ev.t);
+        for (std::size_t k = 0; k < want.size(); ++k) CHECK(got[k] == Approx(want[k]).epsilon(1e-9));
+        CHECK_FALSE(w.ball(0).alive);
+      }
+    }
+  }
+}
+
+TEST_CASE("a ball between a piston and a turtle driving at it is crushed by the piston against the stopped turtle",
+          "[squeeze][turtle]") {
+  // The turtle stops at the ball (a touch); the ball is then caught between the piston and a
+  // standing turtle, and the turtle, carried by the piston afterwards, is crushed at the wall.
+  for (Mode mode : kModes) {
+    for (double e : {1.0, 0.5}) {
+      INFO("mode " << (mode == Mode::exact ? "exact" : "step") << ", e = " << e);
+      WorldDef d = piston_scene();
+      d.effects.restitution = e;
+      d.turtles.push_back(turtle("t", {250, 150}, 270, 10, 5));
+      d.balls.push_back(ball("b", {150, 150}, {0, 0}, 8));
+      World w(d, mode);
+      Run run;
+      const double worst = drive_on(w, run, {0}, 12.0);
+      CHECK(worst <= 1e-9);
+      REQUIRE(run.count(EventKind::crushed) == 2);
+      const Event& first = *run.first(EventKind::crushed);
+      CHECK((first.flags & kTurtleA) == 0);  // a ball, between the piston and the turtle
+      CHECK(((first.flags & kTurtleB) != 0) != ((first.flags & kTurtleC) != 0));
+      CHECK(first.a == 0);
+      CHECK(run.log.back().kind == EventKind::crushed);
+      CHECK(run.log.back().t == Approx(260.0 / 27.0).epsilon(1e-9));  // the turtle, when the piston is 2 r from x = 300
+      CHECK_FALSE(w.ball(0).alive);
+      CHECK_FALSE(w.turtle_alive(0));
+    }
+  }
+}
