@@ -410,6 +410,8 @@ TEST_CASE("40 discs poured into a 10-degree V under gravity settle, in step mode
     REQUIRE_NOTHROW(w.advance_to(0.2 * k));
     worst = std::max(worst, w.measure_overlap().relative);
     if (k == 75) e_settled = w.energy();
+    // Never above the splitting's own gain in free fall (next test): 40 m g^2 dt t / 2.
+    CHECK(w.energy() <= e0 + 40 * 100.0 * (1.0 / 30.0) * (0.2 * k) / 2.0 + 1e-12 * e0);
   }
   CHECK(worst <= 1e-9);
   for (std::size_t i = 0; i < w.ball_count(); ++i) CHECK(w.ball(i).alive);
@@ -525,6 +527,59 @@ TEST_CASE("a ball between a piston and a turtle driving at it is crushed by the 
       CHECK(run.log.back().t == Approx(260.0 / 27.0).epsilon(1e-9));  // the turtle, when the piston is 2 r from x = 300
       CHECK_FALSE(w.ball(0).alive);
       CHECK_FALSE(w.turtle_alive(0));
+    }
+  }
+}
+
+TEST_CASE("a step-mode pour into a V never gains more energy than the splitting's free-fall error", "[squeeze][rest]") {
+  // The issue measured a 38 % gain for 40 discs poured into a 10-degree V (e = 0.8) in step mode.
+  // In a walled arena it does not happen in any reading of the scene tried (a 10-degree opening or
+  // walls 10 degrees off the horizontal, one segment or four, centred or 20 off, dt 1/30, 0.1,
+  // 0.01): the total energy (kinetic plus potential) rises only while the discs fall, by exactly
+  // the Lie splitting's error (docs/physics.md, "Step mode under fields"): drift at v then kick by
+  // g dt gains m (g dt)^2 / 2 a step in free flight, N m g^2 dt t / 2 by time t (0.42 % of E0 at
+  // t = 5.2 s here at dt = 1/30), and the bounces (e = 0.8) then take far more than that away.
+  // (In a periodic arena a disc that leaves the V's rim falls through the floor seam and comes
+  // back at the top with m g H more potential energy: bookkeeping of the wrapped height, 4000 a
+  // wrap here; docs/physics.md.)
+  const double g = 10.0;
+  for (double dt : {1.0 / 30.0, 0.1, 0.01}) {
+    for (int segs : {1, 4}) {
+      for (double xoff : {0.0, 20.0}) {
+        INFO("dt " << dt << ", segments " << segs << ", off centre by " << xoff);
+        const double a = 10.0 * M_PI / 180.0;  // each wall 10 degrees off the horizontal
+        const Vec2 apex{100, 10};
+        const double len = 95 / std::cos(a);
+        const Vec2 ul{-std::cos(a), std::sin(a)}, ur{std::cos(a), std::sin(a)};
+        WorldDef d = box(200, 400);
+        d.dt = dt;
+        for (int k = 0; k < segs; ++k) {
+          d.walls.push_back({"l" + std::to_string(k), apex + (len * k / segs) * ul, apex + (len * (k + 1) / segs) * ul});
+          d.walls.push_back({"r" + std::to_string(k), apex + (len * k / segs) * ur, apex + (len * (k + 1) / segs) * ur});
+        }
+        d.effects.gravity = {0, -g};
+        d.effects.restitution = 0.8;
+        const int n = 40;
+        for (int k = 0; k < n; ++k)
+          d.balls.push_back(ball("b" + std::to_string(k), {100 + xoff + ((k % 3) - 1) * 2.5 + 0.01 * k, 150 + 3.0 * k}, {0, 0}, 1));
+        World w(d, Mode::step);
+        w.set_event_limit(1000000);
+        const double e0 = w.energy();
+        double worst = 0.0, highest = 0.0;
+        for (int k = 1; k <= 400; ++k) {
+          const double t = 0.05 * k;
+          REQUIRE_NOTHROW(w.advance_to(t));
+          worst = std::max(worst, w.measure_overlap().relative);
+          const double bound = n * g * g * dt * t / 2.0;
+          CHECK(w.energy() - e0 <= bound + 1e-12 * e0);
+          highest = std::max(highest, w.energy() - e0);
+        }
+        CHECK(worst <= 1e-9);
+        // The bound is reached (it is the splitting's error, not slack): the first disc lands at
+        // t = sqrt(2 * 140 / g) = 5.3 s, and until then every disc is in free fall.
+        CHECK(highest >= 0.9 * n * g * g * dt * 5.0 / 2.0);
+        CHECK(w.energy() < 0.3 * e0);
+      }
     }
   }
 }
