@@ -348,7 +348,8 @@ TEST_CASE("a disc pressed by gravity into one side of a tilted slot exactly 2r w
       // e = 1 the rest threshold turns the velocity (|v| kept, Restitution::bounce) and the
       // slot's cap takes the hop back, keeping |v| too (squeeze.hpp): each hop trades a little
       // between the slide and the hop, measured 3.4e-4 of the slide over this run (before the
-      // squeeze kept |v| the slide stalled at 2.7e-4 of its length). Exact to 1e-6 at e < 1.
+      // squeeze kept |v| the slide stalled at 2.7e-4 of its length): a constant speed offset from
+      // the first lift, not growing ("the elastic slide ...", below). Exact to 1e-6 at e < 1.
       const double along = dot(w.ball(0).pos - o, u);
       const double tol = mode == Mode::exact ? (e == 1.0 ? 1e-3 : 1e-6) : 0.1;
       CHECK(100.0 - along == Approx(0.5 * 10 * s * until * until).epsilon(tol));
@@ -581,5 +582,37 @@ TEST_CASE("a step-mode pour into a V never gains more energy than the splitting'
         CHECK(w.energy() < 0.3 * e0);
       }
     }
+  }
+}
+
+TEST_CASE("the elastic slide down a tilted 2r slot is off by one constant speed, which does not grow", "[squeeze][rest]") {
+  // At e = 1 the disc, at rest at first, is lifted off the pressed wall at the rest threshold's
+  // speed w = a_n t_c / 2 (energy added: it is slower than the threshold), and the slot's hop cap
+  // c = sqrt(2 w r 1e-9 / t_c) then turns sqrt(w^2 - c^2) of it along the slot (squeeze.hpp keeps
+  // |v| at e = 1). After that every hop keeps the energy: the slide runs ahead of the exact one by
+  // that constant speed (4.2e-4 units/s here), so its error is 4.2e-4 t: 3.4e-4 of the distance at
+  // 0.5 s, 1.05e-5 at 16 s (measured), never growing faster than t. docs/physics.md.
+  const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
+  const Vec2 u{c, s}, n{-s, c};
+  const Vec2 o{20, 20};
+  WorldDef d = box(400, 300);
+  d.walls.push_back({"lo", o - (1 + 1e-12) * n, o - (1 + 1e-12) * n + 350.0 * u});
+  d.walls.push_back({"hi", o + (1 + 1e-12) * n, o + (1 + 1e-12) * n + 350.0 * u});
+  const double g = 10;
+  d.effects.gravity = {0, -g};
+  d.balls.push_back(ball("disc", o + 300.0 * u, {0, 0}, 1));
+  World w(d, Mode::exact);
+  w.set_event_limit(5000000);
+  const double tc = d.effects.tc;
+  const double hop = g * c * tc / 2.0, cap = std::sqrt(2.0 * hop / tc * 1e-9);
+  const double offset = std::sqrt(hop * hop - cap * cap);
+  for (double t : {0.5, 1.0, 2.0, 4.0}) {
+    INFO("t = " << t);
+    REQUIRE_NOTHROW(w.advance_to(t));
+    const double slide = 300.0 - dot(w.ball(0).pos - o, u);
+    const double speed = norm(w.ball(0).vel);
+    CHECK(speed - g * s * t == Approx(offset).epsilon(0.02));
+    CHECK(slide - 0.5 * g * s * t * t == Approx(offset * t).epsilon(0.02));
+    CHECK(w.measure_overlap().relative <= 1e-9);
   }
 }
