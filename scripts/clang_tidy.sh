@@ -11,8 +11,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# The directories that are clean; a directory added here stays clean (docs/development.md).
-CLEAN=(sim turtle_runtime controllers world_files formats server apps bench tests)
+# What is kept clean (checked 2026-12-02 with clang-tidy 14): the library layers' sources, and the
+# engine's templates through two of the sixteen generated variants (one exact, one step; the
+# others instantiate the same headers). apps/, server/, bench/, tests/ and the other variants have
+# not been run through yet; add each here once `scripts/clang_tidy.sh DIR` passes.
+CLEAN=(sim/src turtle_runtime controllers world_files formats
+       sim/engine_variants/FreeFlight_balls_meet_exact_extras.cpp
+       sim/engine_variants/GravityFlight_balls_meet_step_extras.cpp)
 
 [ -f build/release/compile_commands.json ] || cmake --preset release >/dev/null
 targets=("$@")
