@@ -40,7 +40,10 @@ int main(int argc, char** argv) {
     }
   }
   // Turtles of radius 5 on a lattice 30 apart, wandering with random turns; three interior bars.
-  const auto [def, programs] = bench::turtle_lattice(turtles, "turtle soak", 17, "wander");
+  // (Not a structured binding: the check below captures def, which clang 14 cannot do with one.)
+  const bench::TurtleLattice lattice = bench::turtle_lattice(turtles, "turtle soak", 17, "wander");
+  const sim::WorldDef& def = lattice.def;
+  const std::vector<turtle::TurtleProgram>& programs = lattice.programs;
   const double radius = 5.0, size = def.arena.width;
   turtle::ServerOptions options;
   options.mode = mode;

@@ -9,7 +9,7 @@ packages=(
   libboost-dev libboost-context-dev   # libboost-dev: Asio and Beast (header-only) for server/
   python3
   dpkg-dev binutils   # the Debian package: cpack (dpkg-shlibdeps), tests/package/deb_test.py (readelf)
-  clang libclang-rt-14-dev clang-tidy   # the clang and fuzz presets, scripts/tidy.sh
+  clang libclang-rt-14-dev clang-tidy   # the clang and fuzz presets, scripts/clang_tidy.sh
   libopenmpi-dev openmpi-bin   # turtlegas sweep under mpirun (optional at build time; its test runs mpirun)
   chromium   # the viewer's browser tests (tests/server/test_browser.py) and bench/viewer_bench.py, headless
   libcairo2-dev   # turtlegas render: PNG pictures and frames

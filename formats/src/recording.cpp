@@ -223,10 +223,10 @@ Recording read_recording(const std::string& path) {
       }
     } else if (starts_with(line, "{\"t\":")) {
       ++lines;
-    } else if (starts_with(line, "{\"step\":")) {
-      // a served run's input
-    } else if (starts_with(line, "{\"index\":") || starts_with(line, "{\"end_of_recording\":")) {
-      // A finished recording whose end line is damaged: what precedes is whole.
+    } else if (starts_with(line, "{\"step\":") || starts_with(line, "{\"index\":") ||
+               starts_with(line, "{\"end_of_recording\":")) {
+      // A served run's input; or the index or end line of a finished recording whose end is
+      // damaged (what precedes is whole).
     } else {
       break;
     }

@@ -154,7 +154,8 @@ void HttpSession::serve(Request req) {
 }
 
 void HttpSession::write(std::shared_ptr<Response> res) {
-  http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
+  Response& out = *res;  // (taken before the lambda moves res: the order of the arguments is unspecified)
+  http::async_write(stream_, out, [self = shared_from_this(), res = std::move(res)](beast::error_code ec, std::size_t) {
     if (ec || !res->keep_alive()) {
       beast::error_code ignored;
       self->stream_.socket().shutdown(boost::asio::ip::tcp::socket::shutdown_send, ignored);

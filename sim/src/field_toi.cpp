@@ -187,7 +187,9 @@ double first_fall_pieces(const Projection& p, const Gap1* gaps, int ngaps, doubl
   GapD p0 = p.eval(t0);
   while (t0 < t_end) {
     double t1 = t_end;
-    while (np > 0) {
+    // The next critical time after t0: the phases' times grow by a period every np turns, so the
+    // search ends.
+    for (bool found = np == 0; !found;) {
       const double tc = (phases[j] + kTwoPi * k) / aw;
       if (++j == np) {
         j = 0;
@@ -195,7 +197,7 @@ double first_fall_pieces(const Projection& p, const Gap1* gaps, int ngaps, doubl
       }
       if (tc > t0) {
         t1 = std::min(tc, t_end);
-        break;
+        found = true;
       }
     }
     const GapD p1 = p.eval(t1);

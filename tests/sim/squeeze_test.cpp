@@ -348,7 +348,8 @@ TEST_CASE("a disc pressed by gravity into one side of a tilted slot exactly 2r w
       // e = 1 the rest threshold turns the velocity (|v| kept, Restitution::bounce) and the
       // slot's cap takes the hop back, keeping |v| too (squeeze.hpp): each hop trades a little
       // between the slide and the hop, measured 3.4e-4 of the slide over this run (before the
-      // squeeze kept |v| the slide stalled at 2.7e-4 of its length). Exact to 1e-6 at e < 1.
+      // squeeze kept |v| the slide stalled at 2.7e-4 of its length): a constant speed offset from
+      // the first lift, not growing ("the elastic slide ...", below). Exact to 1e-6 at e < 1.
       const double along = dot(w.ball(0).pos - o, u);
       const double tol = mode == Mode::exact ? (e == 1.0 ? 1e-3 : 1e-6) : 0.1;
       CHECK(100.0 - along == Approx(0.5 * 10 * s * until * until).epsilon(tol));
@@ -410,6 +411,8 @@ TEST_CASE("40 discs poured into a 10-degree V under gravity settle, in step mode
     REQUIRE_NOTHROW(w.advance_to(0.2 * k));
     worst = std::max(worst, w.measure_overlap().relative);
     if (k == 75) e_settled = w.energy();
+    // Never above the splitting's own gain in free fall (next test): 40 m g^2 dt t / 2.
+    CHECK(w.energy() <= e0 + 40 * 100.0 * (1.0 / 30.0) * (0.2 * k) / 2.0 + 1e-12 * e0);
   }
   CHECK(worst <= 1e-9);
   for (std::size_t i = 0; i < w.ball_count(); ++i) CHECK(w.ball(i).alive);
@@ -417,4 +420,199 @@ TEST_CASE("40 discs poured into a 10-degree V under gravity settle, in step mode
   // own scale, m (g dt)^2 a disc (a disc at rest takes a kick of g dt every step and bounces it off).
   CHECK(w.energy() < 0.5 * e0);
   CHECK(w.energy() <= e_settled + 40 * std::pow(10.0 / 30.0, 2));
+}
+
+namespace {
+
+/// Runs w to `until` one control step at a time, as a program that drives on whenever it is
+/// stopped would: every turtle in `drivers` is told to go forward 1000 at each control boundary
+/// where its command is not running (after a touch, say). The deepest overlap seen at the steps.
+double drive_on(World& w, Run& run, const std::vector<std::size_t>& drivers, double until) {
+  w.set_event_log(&run.log);
+  w.set_event_limit(kLimit);
+  const double dt = 1.0 / 30.0;
+  double worst = 0.0;
+  for (int k = 0; k * dt < until; ++k) {
+    REQUIRE_NOTHROW(w.advance_to(k * dt));
+    for (std::size_t i : drivers)
+      if (w.turtle_alive(i) && !w.turtle(i).busy) w.command_turtle(i, {TurtleCommand::Kind::move, 1000});
+    worst = std::max(worst, w.measure_overlap().relative);
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("turtles driving head on onto a ball or a turtle stop at it: it is wedged, never crushed", "[squeeze][turtle]") {
+  // Turtles stop when they touch, so a driving turtle never closes a squeeze. The squeeze rule
+  // took the speed of a turtle still driving onto the body (about to touch it and stop) for a
+  // closing obstacle and crushed the ball, or the standing turtle, between the two.
+  for (Mode mode : kModes) {
+    for (bool turtle_body : {false, true}) {
+      INFO("mode " << (mode == Mode::exact ? "exact" : "step") << (turtle_body ? ", a turtle between" : ", a ball between"));
+      WorldDef d = box(300, 200);
+      d.effects.restitution = 0.5;
+      d.turtles.push_back(turtle("t1", {100, 100}, 90, 10, 20));
+      d.turtles.push_back(turtle("t2", {200, 100}, 270, 10, 20));
+      if (turtle_body) d.turtles.push_back(turtle("m", {150, 100}, 0, 5));
+      else d.balls.push_back(ball("b", {150, 100}, {3, 0}, 5));
+      World w(d, mode);
+      Run run;
+      const double worst = drive_on(w, run, {0, 1}, 8.0);
+      CHECK(worst <= 1e-9);
+      CHECK(run.count(EventKind::crushed) == 0);
+      CHECK(w.stats().crushed == 0);
+      if (turtle_body) CHECK(w.turtle_alive(2));
+      else CHECK(w.ball(0).alive);
+      // Both stopped touching it, on its axis: 10 + 5 + 5 + 10 apart.
+      CHECK(norm(w.turtle(0).pos - w.turtle(1).pos) == Approx(30).epsilon(1e-9));
+    }
+  }
+}
+
+TEST_CASE("a turtle a piston carries pushes a ball before it and crushes it against the wall, then is crushed",
+          "[squeeze][turtle]") {
+  // It stopped dead at the ball, the piston caught it at once and carried it on into the ball
+  // again, for ever at one instant (the run hung, deaf even to SIGTERM). A carried turtle goes on
+  // at the piston's speed: the ball bounces off it, and is crushed where the room closes.
+  for (Mode mode : kModes) {
+    for (double e : {1.0, 0.5}) {
+      for (int chain : {1, 2}) {
+        INFO("mode " << (mode == Mode::exact ? "exact" : "step") << ", e = " << e << ", turtles " << chain);
+        WorldDef d = piston_scene();  // the piston reaches x = 290 at t = 10 (27 units/s)
+        d.effects.restitution = e;
+        d.turtles.push_back(turtle("t1", {100, 150}, 0, 10));
+        if (chain == 2) d.turtles.push_back(turtle("t2", {200, 150}, 0, 10));  // carried by t1 in turn
+        d.balls.push_back(ball("b", {250, 150}, {0, 0}, 8));
+        World w(d, mode);
+        Run run;
+        run_to(w, run, 12.0);
+        CHECK(w.measure_overlap().relative <= 1e-9);
+        CHECK(w.max_contact_overlap().relative <= 1e-9);
+        REQUIRE(run.count(EventKind::crushed) == static_cast<std::size_t>(chain + 1));
+        // The front turtle's front is the piston + 20 chain; the ball is crushed when it is 2 r from
+        // the wall at x = 300, then each turtle when its centre is r from it.
+        std::vector<double> want{(300.0 - 16 - 20 * chain - 20) / 27.0};
+        for (int k = chain; k >= 1; --k) want.push_back((290.0 - 20 * k + 10 - 20) / 27.0);
+        std::vector<double> got;
+        for (const Event& ev : run.log)
+          if (ev.kind == EventKind::crushed) got.push_back(ev.t);
+        for (std::size_t k = 0; k < want.size(); ++k) CHECK(got[k] == Approx(want[k]).epsilon(1e-9));
+        CHECK_FALSE(w.ball(0).alive);
+      }
+    }
+  }
+}
+
+TEST_CASE("a ball between a piston and a turtle driving at it is crushed by the piston against the stopped turtle",
+          "[squeeze][turtle]") {
+  // The turtle stops at the ball (a touch); the ball is then caught between the piston and a
+  // standing turtle, and the turtle, carried by the piston afterwards, is crushed at the wall.
+  for (Mode mode : kModes) {
+    for (double e : {1.0, 0.5}) {
+      INFO("mode " << (mode == Mode::exact ? "exact" : "step") << ", e = " << e);
+      WorldDef d = piston_scene();
+      d.effects.restitution = e;
+      d.turtles.push_back(turtle("t", {250, 150}, 270, 10, 5));
+      d.balls.push_back(ball("b", {150, 150}, {0, 0}, 8));
+      World w(d, mode);
+      Run run;
+      const double worst = drive_on(w, run, {0}, 12.0);
+      CHECK(worst <= 1e-9);
+      REQUIRE(run.count(EventKind::crushed) == 2);
+      const Event& first = *run.first(EventKind::crushed);
+      CHECK((first.flags & kTurtleA) == 0);  // a ball, between the piston and the turtle
+      CHECK(((first.flags & kTurtleB) != 0) != ((first.flags & kTurtleC) != 0));
+      CHECK(first.a == 0);
+      CHECK(run.log.back().kind == EventKind::crushed);
+      CHECK(run.log.back().t == Approx(260.0 / 27.0).epsilon(1e-9));  // the turtle, when the piston is 2 r from x = 300
+      CHECK_FALSE(w.ball(0).alive);
+      CHECK_FALSE(w.turtle_alive(0));
+    }
+  }
+}
+
+TEST_CASE("a step-mode pour into a V never gains more energy than the splitting's free-fall error", "[squeeze][rest]") {
+  // The issue measured a 38 % gain for 40 discs poured into a 10-degree V (e = 0.8) in step mode.
+  // In a walled arena it does not happen in any reading of the scene tried (a 10-degree opening or
+  // walls 10 degrees off the horizontal, one segment or four, centred or 20 off, dt 1/30, 0.1,
+  // 0.01): the total energy (kinetic plus potential) rises only while the discs fall, by exactly
+  // the Lie splitting's error (docs/physics.md, "Step mode under fields"): drift at v then kick by
+  // g dt gains m (g dt)^2 / 2 a step in free flight, N m g^2 dt t / 2 by time t (0.42 % of E0 at
+  // t = 5.2 s here at dt = 1/30), and the bounces (e = 0.8) then take far more than that away.
+  // (In a periodic arena a disc that leaves the V's rim falls through the floor seam and comes
+  // back at the top with m g H more potential energy: bookkeeping of the wrapped height, 4000 a
+  // wrap here; docs/physics.md.)
+  const double g = 10.0;
+  for (double dt : {1.0 / 30.0, 0.1, 0.01}) {
+    for (int segs : {1, 4}) {
+      for (double xoff : {0.0, 20.0}) {
+        INFO("dt " << dt << ", segments " << segs << ", off centre by " << xoff);
+        const double a = 10.0 * M_PI / 180.0;  // each wall 10 degrees off the horizontal
+        const Vec2 apex{100, 10};
+        const double len = 95 / std::cos(a);
+        const Vec2 ul{-std::cos(a), std::sin(a)}, ur{std::cos(a), std::sin(a)};
+        WorldDef d = box(200, 400);
+        d.dt = dt;
+        for (int k = 0; k < segs; ++k) {
+          d.walls.push_back({"l" + std::to_string(k), apex + (len * k / segs) * ul, apex + (len * (k + 1) / segs) * ul});
+          d.walls.push_back({"r" + std::to_string(k), apex + (len * k / segs) * ur, apex + (len * (k + 1) / segs) * ur});
+        }
+        d.effects.gravity = {0, -g};
+        d.effects.restitution = 0.8;
+        const int n = 40;
+        for (int k = 0; k < n; ++k)
+          d.balls.push_back(ball("b" + std::to_string(k), {100 + xoff + ((k % 3) - 1) * 2.5 + 0.01 * k, 150 + 3.0 * k}, {0, 0}, 1));
+        World w(d, Mode::step);
+        w.set_event_limit(1000000);
+        const double e0 = w.energy();
+        double worst = 0.0, highest = 0.0;
+        for (int k = 1; k <= 400; ++k) {
+          const double t = 0.05 * k;
+          REQUIRE_NOTHROW(w.advance_to(t));
+          worst = std::max(worst, w.measure_overlap().relative);
+          const double bound = n * g * g * dt * t / 2.0;
+          CHECK(w.energy() - e0 <= bound + 1e-12 * e0);
+          highest = std::max(highest, w.energy() - e0);
+        }
+        CHECK(worst <= 1e-9);
+        // The bound is reached (it is the splitting's error, not slack): the first disc lands at
+        // t = sqrt(2 * 140 / g) = 5.3 s, and until then every disc is in free fall.
+        CHECK(highest >= 0.9 * n * g * g * dt * 5.0 / 2.0);
+        CHECK(w.energy() < 0.3 * e0);
+      }
+    }
+  }
+}
+
+TEST_CASE("the elastic slide down a tilted 2r slot is off by one constant speed, which does not grow", "[squeeze][rest]") {
+  // At e = 1 the disc, at rest at first, is lifted off the pressed wall at the rest threshold's
+  // speed w = a_n t_c / 2 (energy added: it is slower than the threshold), and the slot's hop cap
+  // c = sqrt(2 w r 1e-9 / t_c) then turns sqrt(w^2 - c^2) of it along the slot (squeeze.hpp keeps
+  // |v| at e = 1). After that every hop keeps the energy: the slide runs ahead of the exact one by
+  // that constant speed (4.2e-4 units/s here), so its error is 4.2e-4 t: 3.4e-4 of the distance at
+  // 0.5 s, 1.05e-5 at 16 s (measured), never growing faster than t. docs/physics.md.
+  const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
+  const Vec2 u{c, s}, n{-s, c};
+  const Vec2 o{20, 20};
+  WorldDef d = box(400, 300);
+  d.walls.push_back({"lo", o - (1 + 1e-12) * n, o - (1 + 1e-12) * n + 350.0 * u});
+  d.walls.push_back({"hi", o + (1 + 1e-12) * n, o + (1 + 1e-12) * n + 350.0 * u});
+  const double g = 10;
+  d.effects.gravity = {0, -g};
+  d.balls.push_back(ball("disc", o + 300.0 * u, {0, 0}, 1));
+  World w(d, Mode::exact);
+  w.set_event_limit(5000000);
+  const double tc = d.effects.tc;
+  const double hop = g * c * tc / 2.0, cap = std::sqrt(2.0 * hop / tc * 1e-9);
+  const double offset = std::sqrt(hop * hop - cap * cap);
+  for (double t : {0.5, 1.0, 2.0, 4.0}) {
+    INFO("t = " << t);
+    REQUIRE_NOTHROW(w.advance_to(t));
+    const double slide = 300.0 - dot(w.ball(0).pos - o, u);
+    const double speed = norm(w.ball(0).vel);
+    CHECK(speed - g * s * t == Approx(offset).epsilon(0.02));
+    CHECK(slide - 0.5 * g * s * t * t == Approx(offset * t).epsilon(0.02));
+    CHECK(w.measure_overlap().relative <= 1e-9);
+  }
 }

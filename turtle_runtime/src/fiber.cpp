@@ -7,6 +7,7 @@
 #include <cstring>
 #include <exception>
 #include <mutex>
+#include <new>
 #include <stdexcept>
 #include <algorithm>
 #include <atomic>
@@ -278,9 +279,16 @@ Fiber::~Fiber() {
     // the resume() we jumped out of, and destroying `self` would unwind a body that refuses to
     // be unwound. Let both handles go without touching them; the fiber's stack is leaked with
     // them (kept reachable, so that leak checkers do not report it as lost).
-    static std::vector<ctx::fiber>* const leaked = new std::vector<ctx::fiber>;
-    leaked->push_back(std::move(impl_->caller));
-    if (impl_->self) leaked->push_back(std::move(impl_->self));
+    // Out of memory for that list (a destructor must not throw), the whole record is let go
+    // instead, unreachable but never destroyed.
+    try {
+      static std::vector<ctx::fiber>* const leaked = new std::vector<ctx::fiber>;
+      if (leaked->capacity() - leaked->size() < 2) leaked->reserve(2 * leaked->size() + 2);  // (the moves cannot fail then)
+      leaked->push_back(std::move(impl_->caller));
+      if (impl_->self) leaked->push_back(std::move(impl_->self));
+    } catch (const std::bad_alloc&) {
+      static_cast<void>(impl_.release());
+    }
   }
 }
 

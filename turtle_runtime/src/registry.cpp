@@ -33,7 +33,7 @@ bool is_comment(const std::string& key) { return key.rfind("x-", 0) == 0; }
 std::string kind_of(const nlohmann::json& v) {
   switch (v.type()) {
     case nlohmann::json::value_t::null: return "null";
-    case nlohmann::json::value_t::boolean: return v.dump();
+    case nlohmann::json::value_t::boolean:
     case nlohmann::json::value_t::string: return v.dump();
     case nlohmann::json::value_t::array: return "a list";
     case nlohmann::json::value_t::object: return "an object";

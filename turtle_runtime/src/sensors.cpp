@@ -15,6 +15,7 @@ std::vector<SensorArc> default_sensors() {
 std::vector<SensorArc> equal_sensors(int n) {
   if (n < 1) throw std::invalid_argument("a turtle needs at least one sensor (got " + std::to_string(n) + ")");
   std::vector<SensorArc> arcs;
+  arcs.reserve(static_cast<std::size_t>(n));
   const double w = 360.0 / n;
   for (int k = 0; k < n; ++k) arcs.push_back({"s" + std::to_string(k), k * w - w / 2, k * w + w / 2});
   return arcs;

@@ -110,7 +110,7 @@ std::unique_ptr<Agent> WorldServer::Impl::make_agent(std::size_t k, TurtleProgra
 
 WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> programs, const Registry& registry,
                          ServerOptions options)
-    : impl_(std::make_unique<Impl>(with_builder_layers(def, programs), options)) {
+    : impl_(std::make_unique<Impl>(with_builder_layers(def, programs), std::move(options))) {
   if (programs.size() != def.turtles.size())
     throw std::invalid_argument("WorldServer: " + std::to_string(programs.size()) + " programs for " +
                                 std::to_string(def.turtles.size()) + " turtles");

@@ -71,7 +71,7 @@ void ExpectParser::check_keys(const json& entry, const std::string& path, std::s
 }
 
 std::string ExpectParser::body_id(const json& v, const std::string& path) const {
-  const std::string id = string(v, path);
+  std::string id = string(v, path);  // (not const: returned, it moves)
   for (const auto& t : def_.turtles)
     if (t.id == id) return id;
   for (const auto& b : def_.balls)
@@ -86,7 +86,7 @@ std::string ExpectParser::body_id(const json& v, const std::string& path) const 
 }
 
 std::string ExpectParser::turtle_id(const json& v, const std::string& path) const {
-  const std::string id = string(v, path);
+  std::string id = string(v, path);  // (not const: returned, it moves)
   for (const auto& t : def_.turtles)
     if (t.id == id) return id;
   fail(path, "no turtle has id \"" + id + "\"");
@@ -95,7 +95,7 @@ std::string ExpectParser::turtle_id(const json& v, const std::string& path) cons
 std::vector<std::string> ExpectParser::who(const json& v, const std::string& path) const {
   if (v.is_string() && v.get<std::string>() == "*") return {};
   auto one = [&](const json& x, const std::string& p) {
-    const std::string id = string(x, p);
+    std::string id = string(x, p);
     for (const auto& t : def_.turtles)
       if (t.id == id) return id;
     for (const auto& b : def_.balls)
@@ -110,7 +110,7 @@ std::vector<std::string> ExpectParser::who(const json& v, const std::string& pat
 }
 
 std::string ExpectParser::event_kind(const json& v, const std::string& path) const {
-  const std::string k = string(v, path);
+  std::string k = string(v, path);
   if (std::find(event_kinds.begin(), event_kinds.end(), k) == event_kinds.end())
     fail(path, "unknown event kind \"" + k + "\"; known: " + join_names(event_kinds));
   return k;

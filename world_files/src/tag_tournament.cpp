@@ -116,7 +116,8 @@ Comparison compare(const std::string& a, const std::vector<double>& a_rounds, co
 TournamentResult run_tag_tournament(const Scene& scene, const std::string& world_file,
                                     const TournamentOptions& options, const turtle::Registry& registry) {
   const std::vector<std::string>& names = options.controllers;
-  if (names.empty()) throw std::invalid_argument("--controllers: name at least one controller");
+  const std::size_t c = names.size();
+  if (c == 0) throw std::invalid_argument("--controllers: name at least one controller");
   std::set<std::string> seen;
   for (const std::string& n : names) {
     registry.require(n, "--controllers");
@@ -134,7 +135,6 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
   TournamentResult result;
   result.world = world_file;
   result.options = options;
-  const std::size_t c = names.size();
   std::vector<TournamentRow> rows(c);
   std::vector<double> time_it(c, 0.0);
   for (std::size_t k = 0; k < c; ++k) rows[k].controller = names[k];

@@ -264,7 +264,7 @@ void Reader::read_balls(const json& v, std::vector<sim::BallDef>& balls) {
 
 std::string Reader::path_of(const sim::DefProblem& p) const {
   using Where = sim::DefProblem::Where;
-  auto with_field = [&](std::string base) { return p.field.empty() ? base : at(base, p.field); };
+  auto with_field = [&](const std::string& base) { return p.field.empty() ? base : at(base, p.field); };
   switch (p.where) {
     case Where::world: return p.field.empty() ? "" : at("", p.field);
     case Where::arena: return with_field("/arena");

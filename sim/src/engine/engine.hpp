@@ -338,6 +338,7 @@ Engine<F, kBallBall, kStep, kExtras>::Engine(const WorldDef& def, std::vector<Ba
   if constexpr (kExtras) {
     schedule_.apply_visibility(walls_, now_, t_base_);
     turtles_.pushed_by.assign(turtles_.size(), kNone);
+    turtles_.pushed_via.assign(turtles_.size(), kNone);
     schedule_.aim_all(walls_, t_base_);
   }
   rebase_every_ = std::max<std::uint64_t>(4 * n, 4096);
@@ -554,6 +555,7 @@ void Engine<F, kBallBall, kStep, kExtras>::keyframe() {
       // (Another wall's keyframe changes nothing here: the push goes on.)
       b.v = {};
       turtles_.pushed_by[i - nb] = kNone;
+      turtles_.pushed_via[i - nb] = kNone;
       ++b.count;
     }
     // "Just collided, cannot meet again" does not survive a change of the wall's velocity.

@@ -135,6 +135,9 @@ Changed apply_turtle_body(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, s
     // off a wall of infinite mass moving at the turtle's new velocity. (Against the old velocity,
     // a ball that caught up with a turtle from behind would keep closing on it once it stopped.)
     w.touch(t, EventKind::turtle_ball, o, -n);
+    // A turtle a moving wall carries goes on at the wall's speed (it used to stop, be caught by the
+    // wall at once and meet the ball again, for ever at one instant).
+    if (Vec2 vc; w.carried(t, vc)) bt.v = vc;
     const Vec2 rel = bo.v - bt.v;
     if (dot(rel, n) < 0.0) bo.v = bt.v + w.bounce(o, rel, n);
     ++w.record.stats.turtle_ball;
@@ -144,6 +147,22 @@ Changed apply_turtle_body(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, s
     w.note(EventKind::turtle_turtle, t - nb, o - nb);
     w.touch(t, EventKind::turtle_turtle, o - nb, -n);
     w.touch(o, EventKind::turtle_turtle, t - nb, n);
+    // A carried turtle goes on; one it meets that is not carried is pushed along by it (both have
+    // infinite mass) at its normal speed, carried by the same wall through it.
+    Vec2 vt, vo;
+    const bool ct = w.carried(t, vt), co = w.carried(o, vo);
+    if (ct) bt.v = vt;
+    if (co) bo.v = vo;
+    if (ct != co) {
+      const std::uint32_t c = ct ? t : o, q = ct ? o : t;
+      const Vec2 nq = ct ? n : -n;  // from the carrier to the other
+      const double un = dot(ct ? vt : vo, nq);
+      if (un > 0.0) {
+        w.bodies.body[q].v = un * nq;
+        w.turtles.pushed_by[q - nb] = w.turtles.pushed_by[c - nb];
+        w.turtles.pushed_via[q - nb] = c - nb;
+      }
+    }
   }
   w.changed(t);
   w.changed(o);
@@ -208,6 +227,7 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
     if (knock > 0.0) {
       a.v = knock * n;
       p.turtles.pushed_by[i - p.bodies.balls()] = mi;
+      p.turtles.pushed_via[i - p.bodies.balls()] = kNone;
     }
   } else {
     const Vec2 va = a.v;

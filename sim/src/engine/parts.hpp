@@ -172,6 +172,46 @@ struct Parts {
   void touch(std::uint32_t id, EventKind kind, std::uint32_t other, Vec2 normal) const {
     turtles.touch(id - bodies.balls(), bodies.body[id], bodies.end[id], now, t_base, dt, kind, other, normal);
   }
+  /// Whether turtle `id` is carried (Turtles::pushed_by): by a translating moving wall, or by a
+  /// turtle so carried, that still touches it and still pushes it; then `v` is the velocity it is
+  /// carried at (the pusher's normal speed, along the normal). Such a turtle cannot stop dead at a
+  /// touch as a driving one does: what pushes it has infinite mass (docs/physics.md, "Wedged and
+  /// crushed bodies").
+  bool carried(std::uint32_t id, Vec2& v, std::size_t depth = 0) const {
+    const std::uint32_t nb = bodies.balls();
+    const std::size_t k = id - nb;
+    if (id < nb || k >= turtles.pushed_by.size() || turtles.pushed_by[k] == kNone || depth > turtles.size()) return false;
+    const Body& b = bodies.body[id];
+    const Vec2 x = b.x + (now - b.t) * b.v;  // (a turtle flies straight)
+    Vec2 n, u;
+    double gap = 0.0;
+    if (const std::uint32_t via = turtles.pushed_via[k]; via == kNone) {
+      const Mover& m = schedule.movers[turtles.pushed_by[k]];
+      if (!m.rigid()) return false;  // a turning wall knocks a turtle off instead (apply_wall)
+      const Segment s = m.segment_at(walls.segments[m.wall], now);
+      const Vec2 rel = arena.rel_to_segment(x, s);
+      const Vec2 off = rel - std::clamp(dot(rel, s.u), 0.0, s.len) * s.u;
+      const double dist = norm(off);
+      if (!(dist > 0.0)) return false;
+      n = off / dist;
+      gap = dist - b.r;
+      u = m.u;
+    } else {
+      const std::uint32_t j = nb + via;
+      if (!carried(j, u, depth + 1)) return false;
+      const Body& bj = bodies.body[j];
+      const Vec2 d = arena.min_image(x - (bj.x + (now - bj.t) * bj.v));
+      const double dist = norm(d);
+      if (!(dist > 0.0)) return false;
+      n = d / dist;
+      gap = dist - b.r - bj.r;
+    }
+    // Touching: within the overlap budget (and the round-off of positions far from the origin).
+    const double un = dot(u, n);
+    if (!(gap <= 1e-9 * b.r + 0x1p-46 * (std::abs(x.x) + std::abs(x.y))) || !(un > 0.0)) return false;
+    v = un * n;
+    return true;
+  }
   /// The bounce of ball i (at the contact, its velocity not yet changed) off an obstacle, v its
   /// velocity relative to the obstacle (Restitution::bounce, under the ball's field, plus `press`:
   /// the ball's acceleration along n relative to the obstacle that the obstacle's own motion adds,

@@ -66,7 +66,12 @@ Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner wh
       const double dist = norm(F);
       if (!(dist > 0.0)) return s;
       s.n = F / dist;
+      // Turtles stop when they touch: a turtle driving onto the body stops at its contact with it,
+      // so its own motion never closes a squeeze (it counts as standing); one that a moving wall
+      // carries goes on (Parts::carried) and closes it at the wall's speed.
       s.u = t.v;
+      if (Vec2 vc; p.carried(k, vc)) s.u = vc;
+      else if (dot(t.v, F) > 0.0) s.u = {};
       s.gap = dist - a.r - t.r;
       s.name = k - p.bodies.balls();
       s.turtle = true;

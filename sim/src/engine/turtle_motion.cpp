@@ -151,6 +151,7 @@ void Turtles::add(const TurtleDef& d) {
   run_.push_back(r);
   busy_.push_back(0);
   pushed_by.push_back(kNone);
+  pushed_via.push_back(kNone);
 }
 
 void Turtles::place(std::size_t k, double heading, Body& b, double& end, double now) {
@@ -170,6 +171,7 @@ void Turtles::place(std::size_t k, double heading, Body& b, double& end, double 
   end = kNever;
   b.v = {};
   pushed_by[k] = kNone;
+  pushed_via[k] = kNone;
 }
 
 void Turtles::exit(std::size_t k, Body& b, double& end) {

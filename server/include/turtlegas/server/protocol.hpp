@@ -28,7 +28,7 @@ const std::vector<std::string>& message_types();
 /// A message that fails: the error reply's code, message and JSON pointer (docs/protocol.md,
 /// "Errors"). Thrown by the readers below and by the host's handlers; nothing has changed.
 struct RequestError : std::runtime_error {
-  RequestError(std::string code, std::string message, std::string field = {})
+  RequestError(std::string code, const std::string& message, std::string field = {})
       : std::runtime_error(message), code(std::move(code)), field(std::move(field)) {}
   std::string code;
   std::string field;
