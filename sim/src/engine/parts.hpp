@@ -66,7 +66,7 @@ struct Restitution {
     return v + (w + w_out) * n;
   }
   /// The elastic bounce below the threshold (bounce()): out of line, off the common path.
-  [[gnu::noinline]] Vec2 elastic_floor(Vec2 v, Vec2 n, double w, double floor, double a_rest) const {
+  [[gnu::cold]] Vec2 elastic_floor(Vec2 v, Vec2 n, double w, double floor, double a_rest) const {
     const Vec2 vt = v + w * n;  // the tangential part
     const double speed2 = dot(v, v), floor2 = floor * floor, vt2 = dot(vt, vt);
     if (speed2 > floor2 && vt2 > 0.0) return floor * n + std::sqrt((speed2 - floor2) / vt2) * vt;
