@@ -399,8 +399,8 @@ TEST_CASE("a tiny circle (radius 1e-10) neither hangs nor loses time; drifting, 
   // E = (1e7, 0): drift J(a)/w = (0, -1e-3): the guiding centre (0.5, 0.5 - 1e-10) reaches the
   // floor's contact line y = 0.01 at t = 490 s, 7.8e11 gyrations. (From then on the drift keeps
   // pressing the circle into the floor and it skips along it, bounce after bounce, as it should:
-  // some 250 in the first 1e-7 s, 3e5 in 1e-4 s. Before the rest threshold stopped lifting fast
-  // balls under B, contacts 3e-7 of the radius deep appeared within 1e-6 s, 3000 bounces.)
+  // some 250 in the first 1e-7 s, 3e5 in 1e-4 s. With the rest threshold that lifted fast balls
+  // under B the 1e-4 s made 1.2e7 bounces, a contact 1.1e-3 of the radius deep and lost the ball.)
   d.effects.electric = {1e7, 0.0};
   World w(d, Mode::exact);
   std::vector<Event> log;
