@@ -2,6 +2,8 @@
 #include "event_queue.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 
 namespace turtlegas::sim::detail {
@@ -142,7 +144,37 @@ void EventQueue::rebuild() {
   // n / (sum / n) events per second, so this width gives a few events per bucket and a year
   // of about four mean look-aheads.
   const double n = static_cast<double>(count);
-  const double mean_ahead = n > 0 ? sum / n : 0.0;
+  double mean_ahead = n > 0 ? sum / n : 0.0;
+  // Unless a few keys far beyond the rest set the mean alone (a charged gas: a slow ball whose
+  // small circle never leaves its cell re-plans 2^30 periods ahead, 6.7e9 s, among keys of about
+  // a second; ten such made the mean 10^7 s, every key fell into the bucket being served, and its
+  // heap held them all). When the mean is over 64 times the median look-ahead (known to a binade,
+  // from the exponent bits of every 16th id's when there are many), the mean is taken again
+  // without the keys over 2^12 times the median, which wait in the overflow. Only the buckets
+  // change, never the order of service; gases of straight flights (mean within a few medians)
+  // keep their width to the bit.
+  std::array<std::uint32_t, 2048> binade{};
+  std::size_t sampled = 0;
+  const std::uint32_t step = count >= 4096 ? 16 : 1;
+  for (std::uint32_t id = 0; id < ids_; id += step)
+    if (node(id).where == kRebuilding) {
+      ++binade[(std::bit_cast<std::uint64_t>(node(id).key - start) >> 52) & 0x7FF];  // >= 0
+      ++sampled;
+    }
+  std::size_t below = 0;
+  int median_binade = 0;
+  while (median_binade < 2047 && (below += binade[median_binade]) < (sampled + 1) / 2) ++median_binade;
+  const double median_bound = std::ldexp(1.0, median_binade - 1023 + 1);  // above the median
+  if (sampled > 0 && mean_ahead > 64.0 * median_bound) {
+    const double cut = 4096.0 * median_bound;
+    double kept_sum = 0.0, kept = 0.0;
+    for (std::uint32_t id = 0; id < ids_; ++id)
+      if (node(id).where == kRebuilding && node(id).key - start <= cut) {
+        kept_sum += node(id).key - start;
+        kept += 1.0;
+      }
+    if (kept > 0.0) mean_ahead = kept_sum / kept;
+  }
   width_ = mean_ahead > 0.0 ? 4.0 * mean_ahead / static_cast<double>(year_) : 1.0;
   if (!(width_ > 0.0) || !std::isfinite(width_)) width_ = 1.0;
   inv_width_ = 1.0 / width_;

@@ -21,7 +21,7 @@ bool charges_feel_fields(const WorldDef& def) {
 
 ChargedFlight::ChargedFlight(const WorldDef& def) {
   const EffectsDef& fx = def.effects;
-  species_.push_back({fx.gravity, 0.0});  // species 0: uncharged
+  species_.push_back({fx.gravity, 0.0, false, kNever});  // species 0: uncharged
   of_.resize(def.balls.size(), 0);
   std::map<std::tuple<double, double, double>, std::uint32_t> index{{{fx.gravity.x, fx.gravity.y, 0.0}, 0}};
   bool charged = false;
@@ -32,6 +32,7 @@ ChargedFlight::ChargedFlight(const WorldDef& def) {
     const double qm = b.charge / b.mass;
     Species s{fx.gravity + qm * fx.electric, qm * fx.magnetic};
     s.circle = s.w != 0.0 && s.a == Vec2{};
+    s.period = gyration_period(s.w);
     const auto [it, added] = index.try_emplace({s.a.x, s.a.y, s.w}, static_cast<std::uint32_t>(species_.size()));
     if (added) species_.push_back(s);
     of_[i] = it->second;
@@ -58,7 +59,7 @@ CellExit ChargedFlight::cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const Cell
   if (s.w == 0.0)
     return earlier_exit(axis_exit(x.x, v.x, s.a.x, b.x_lo, b.x_hi), axis_exit(x.y, v.y, s.a.y, b.y_lo, b.y_hi));
   const FieldFlight f{v, s.a, s.w};
-  const double period = gyration_period(s.w);
+  const double period = s.period;
   // The cell's searches look at most kPeriods ahead, then the body re-plans: a circle much smaller
   // than its cell, drifting slowly across a cell line, stays within reach of it for very many
   // periods, and the exact exit would be searched over all of them in one call.
@@ -69,8 +70,10 @@ CellExit ChargedFlight::cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const Cell
   // drift-free circle inside its cell).
   // A circle wider than its cell (gyration radius, as flight_envelope forms it, at least 3/4 of the
   // cell's side, well clear of round-off) is never inside it: skip forming the envelope.
-  const double rho = norm(field_acceleration(f)) / (f.w * f.w);
-  const bool wider = rho > 0.75 * std::min(b.x_hi - b.x_lo, b.y_hi - b.y_lo);
+  // (A drift-free circle's radius is |v| / |w|: compared squared, without a root or a division.)
+  const double side = 0.75 * std::min(b.x_hi - b.x_lo, b.y_hi - b.y_lo);
+  const bool wider = s.circle ? dot(v, v) > (side * s.w) * (side * s.w)
+                              : norm(field_acceleration(f)) / (f.w * f.w) > side;
   double quiet = 0.0;
   if (!wider) {
     const Envelope env = flight_envelope(x, f, 0.0);

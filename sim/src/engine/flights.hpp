@@ -197,6 +197,7 @@ class ChargedFlight {
     Vec2 a;          ///< g + (q/m) E
     double w = 0.0;  ///< q Bz / m
     bool circle = false;  ///< w != 0 and a == 0: a drift-free circle (circle_advance)
+    double period = 0.0;  ///< gyration_period(w), seconds (kNever when w == 0): cell_exit's horizons
   };
   const Species& species(std::uint32_t ball) const { return species_[of_[ball]]; }
   std::size_t species_count() const { return species_.size(); }

@@ -42,9 +42,10 @@ struct Restitution {
   }
   /// A ball's velocity v relative to an obstacle after bouncing off it; n is the unit contact
   /// normal pointing from the obstacle to the ball, a_n the field's acceleration of the ball along
-  /// it. Walls take the plain restitution: the TC rule is for ball clusters; a ball pressed onto
-  /// a wall is kept from collapsing by the rest threshold.
-  Vec2 bounce(Vec2 v, Vec2 n, double a_n) const {
+  /// it, a_rest the same for the ball at rest (a_n without the magnetic part). Walls take the
+  /// plain restitution: the TC rule is for ball clusters; a ball pressed onto a wall is kept from
+  /// collapsing by the rest threshold.
+  Vec2 bounce(Vec2 v, Vec2 n, double a_n, double a_rest) const {
     const double w = -dot(v, n);
     double w_out = e * w;
     // The rest threshold: a ball pressed onto the obstacle by the field leaves it at least fast
@@ -58,15 +59,28 @@ struct Restitution {
         // ball slower than the threshold is lifted with energy (a ball at rest would sink). Under
         // a strong field (q/m = 1e6 in E: floor ~ 10) adding it at every skipping bounce made
         // energy grow without bound.
-        if (e == 1.0) {
-          const Vec2 vt = v + w * n;  // the tangential part
-          const double speed2 = dot(v, v), floor2 = floor * floor, vt2 = dot(vt, vt);
-          if (speed2 > floor2 && vt2 > 0.0) return floor * n + std::sqrt((speed2 - floor2) / vt2) * vt;
-        }
+        if (e == 1.0) return elastic_floor(v, n, w, floor, a_rest);
         w_out = floor;
       }
     }
     return v + (w + w_out) * n;
+  }
+  /// The elastic bounce below the threshold (bounce()): out of line, off the common path.
+  [[gnu::cold]] Vec2 elastic_floor(Vec2 v, Vec2 n, double w, double floor, double a_rest) const {
+    const Vec2 vt = v + w * n;  // the tangential part
+    const double speed2 = dot(v, v), floor2 = floor * floor, vt2 = dot(vt, vt);
+    if (speed2 > floor2 && vt2 > 0.0) return floor * n + std::sqrt((speed2 - floor2) / vt2) * vt;
+    // Slower than the threshold, but faster than the threshold of a ball at rest (the pull
+    // without its magnetic part, which a resting ball does not feel): all of its speed
+    // along the normal, still without adding energy. Under a strong B the pull includes
+    // W n.J(v), which grows with the speed itself (|W| tc / 2 = 1 at W = 2e4 asks for a
+    // normal speed of |v_t|), and fast balls skipping along a wall were lifted with energy
+    // (a mixed gas at q/m 1e6, Bz 0.01, gained 6e-5 of its energy in 200 events). Such a
+    // ball leaves at least as fast as the resting threshold asks, so it stays away for about tc
+    // against the rest of the pull, and B alone brings it back after about half a turn.
+    const double rest_floor = -std::min(a_rest, 0.0) * tc / 2.0;
+    if (speed2 > rest_floor * rest_floor) return std::sqrt(speed2) * n;
+    return v + (w + floor) * n;
   }
 };
 
@@ -217,7 +231,10 @@ struct Parts {
   /// the ball's acceleration along n relative to the obstacle that the obstacle's own motion adds,
   /// a turning wall's; negative presses).
   Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n, double press = 0.0) const {
-    return restitution.bounce(v, n, motion.flight().normal_accel(i, bodies.body[i].v, n) + press);
+    const double a_n = motion.flight().normal_accel(i, bodies.body[i].v, n) + press;
+    // A ball at rest feels no magnetic part (only the charged flight has one).
+    if constexpr (F::kBoundedHorizon) return restitution.bounce(v, n, a_n, motion.flight().normal_accel(i, Vec2{}, n) + press);
+    else return restitution.bounce(v, n, a_n, a_n);
   }
 };
 
