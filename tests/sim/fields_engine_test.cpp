@@ -653,19 +653,27 @@ void compare_with_reference(const WorldDef& d, double T, std::size_t min_events)
   compare_runs(d, T, min_events, field_reference(d, T), "reference");
 }
 
-}  // namespace
+/// The held-out oracle's scenes (issue 14's bar): each runs against the brute-force reference and
+/// against the independent long-double oracle.
+struct OracleScene {
+  std::string name;
+  WorldDef def;
+  double until;
+  std::size_t min_events;
+};
 
-TEST_CASE("held-out-oracle scenes: the engine agrees with the brute-force reference to 1e-9", "[fields][engine][oracle]") {
-  SECTION("cyclotron in a box") {
+std::vector<OracleScene> held_out_scenes() {
+  std::vector<OracleScene> out;
+  {
     WorldDef d = box(60, 60);
     d.effects.magnetic = 0.5;
     d.arena.cell = 4.0;
     d.balls.push_back(charged("a", {30, 40}, {6, 0}, 1.0, 1.0, 1.0));
     d.balls.push_back(charged("b", {30, 20}, {6, 1}, 1.0, 1.0, -1.0));
     d.balls.push_back(charged("c", {12, 12}, {0, 5}, 1.5, 2.0, 1.0));
-    compare_with_reference(d, 40.0, 10);
+    out.push_back({"cyclotron in a box", d, 40.0, 10});
   }
-  SECTION("grazing circles near walls and ends") {
+  {
     WorldDef d = box(40, 40);
     d.effects.magnetic = 1.0;
     // p's edge reaches y = 7.5 at x = 10: the shelf 1e-7 above it grazes it; q's edge passes the
@@ -678,18 +686,18 @@ TEST_CASE("held-out-oracle scenes: the engine agrees with the brute-force refere
     d.balls.push_back(charged("p", {10.0, 10.0}, {1.0, 0.0}, 0.5, 1.0, 1.0));
     d.balls.push_back(charged("q", {25.0, 10.0}, {1.0, 0.0}, 0.5, 1.0, 1.0));
     d.balls.push_back(charged("s", {30.0, 30.0}, {2.0, 0.0}, 0.5, 1.0, 1.0));
-    compare_with_reference(d, 60.0, 1);
+    out.push_back({"grazing circles near walls and ends", d, 60.0, 1});
   }
-  SECTION("equal and unequal q/m pairs") {
+  {
     WorldDef d = box(30, 30);
     d.effects.magnetic = 0.8;
     d.effects.electric = {0.2, 0.0};
     for (int k = 0; k < 8; ++k)
       d.balls.push_back(charged("p" + std::to_string(k), {5.0 + 3.0 * k, 8.0 + 2.0 * (k % 3)},
                                 {std::cos(2.1 * k), std::sin(2.1 * k)}, 1.0, 1.0 + (k % 2), k % 4 == 3 ? 0.0 : 1.0));
-    compare_with_reference(d, 25.0, 10);
+    out.push_back({"equal and unequal q/m pairs", d, 25.0, 10});
   }
-  SECTION("E x B drift against a wall end") {
+  {
     WorldDef d = box(100, 40);
     d.effects.electric = {0.0, -2.0};
     d.effects.magnetic = 1.0;  // drift (-2, 0)
@@ -697,22 +705,30 @@ TEST_CASE("held-out-oracle scenes: the engine agrees with the brute-force refere
     d.walls.push_back({"hook", {30.0, 30.0}, {30.0, 40.0}});
     d.balls.push_back(charged("p", {80.0, 14.0}, {0.5, 1.0}, 1.0, 1.0, 1.0));
     d.balls.push_back(charged("q", {70.0, 27.0}, {0.0, 1.5}, 1.0, 1.0, 1.0));
-    compare_with_reference(d, 40.0, 3);
+    out.push_back({"E x B drift against a wall end", d, 40.0, 3});
   }
+  {
+    WorldDef d = charged_gas(16, 0.15, 1.0, 1.5, 272, {1.0, -2.0, 0.0});
+    d.effects.gravity = {0.0, -0.2};
+    d.effects.electric = {0.15, 0.0};
+    d.effects.magnetic = 0.4;
+    d.walls.push_back({"baffle", {d.arena.width * 0.3, d.arena.height * 0.6}, {d.arena.width * 0.5, d.arena.height * 0.5}});
+    out.push_back({"all three fields in a small memo gas", d, 10.0, 30});
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("held-out-oracle scenes: the engine agrees with the brute-force reference to 1e-9", "[fields][engine][oracle]") {
+  for (const OracleScene& s : held_out_scenes())
+    DYNAMIC_SECTION(s.name) { compare_with_reference(s.def, s.until, s.min_events); }
   SECTION("one drift-free species in B: crossings keep old predictions and scan the new strip") {
     // (ChargedFlight::closed_forms(): predictions beyond the cell exit, found before crossings.)
     WorldDef d = charged_gas(24, 0.2, 1.0, 2.0, 1414, {1.0});
     d.effects.magnetic = 0.6;
     d.arena.cell = 2.0;
     compare_with_reference(d, 6.0, 30);
-  }
-  SECTION("all three fields in a small memo gas") {
-    WorldDef d = charged_gas(16, 0.15, 1.0, 1.5, 272, {1.0, -2.0, 0.0});
-    d.effects.gravity = {0.0, -0.2};
-    d.effects.electric = {0.15, 0.0};
-    d.effects.magnetic = 0.4;
-    d.walls.push_back({"baffle", {d.arena.width * 0.3, d.arena.height * 0.6}, {d.arena.width * 0.5, d.arena.height * 0.5}});
-    compare_with_reference(d, 10.0, 30);
   }
 }
 
@@ -943,51 +959,6 @@ void compare_with_oracle(const WorldDef& d, double T, std::size_t min_events) {
 
 TEST_CASE("held-out-oracle scenes, long-double oracle: events and final state to 1e-9",
           "[fields][engine][oracle]") {
-  SECTION("cyclotron in a box") {
-    WorldDef d = box(60, 60);
-    d.effects.magnetic = 0.5;
-    d.arena.cell = 4.0;
-    d.balls.push_back(charged("a", {30, 40}, {6, 0}, 1.0, 1.0, 1.0));
-    d.balls.push_back(charged("b", {30, 20}, {6, 1}, 1.0, 1.0, -1.0));
-    d.balls.push_back(charged("c", {12, 12}, {0, 5}, 1.5, 2.0, 1.0));
-    compare_with_oracle(d, 40.0, 10);
-  }
-  SECTION("grazing circles near walls and ends") {
-    WorldDef d = box(40, 40);
-    d.effects.magnetic = 1.0;
-    d.walls.push_back({"shelf", {9.9, 7.5 + 1e-7}, {10.1, 7.5 + 1e-7}});
-    d.walls.push_back({"pin", {25.0, 8.5 + 1e-7}, {25.0, 9.0}});
-    d.walls.push_back({"ledge", {29.0, 25.5 - 1e-7}, {31.0, 25.5 - 1e-7}});
-    d.balls.push_back(charged("p", {10.0, 10.0}, {1.0, 0.0}, 0.5, 1.0, 1.0));
-    d.balls.push_back(charged("q", {25.0, 10.0}, {1.0, 0.0}, 0.5, 1.0, 1.0));
-    d.balls.push_back(charged("s", {30.0, 30.0}, {2.0, 0.0}, 0.5, 1.0, 1.0));
-    compare_with_oracle(d, 60.0, 1);
-  }
-  SECTION("E x B drift against a wall end") {
-    WorldDef d = box(100, 40);
-    d.effects.electric = {0.0, -2.0};
-    d.effects.magnetic = 1.0;
-    d.walls.push_back({"post", {40.0, 0.0}, {40.0, 15.0}});
-    d.walls.push_back({"hook", {30.0, 30.0}, {30.0, 40.0}});
-    d.balls.push_back(charged("p", {80.0, 14.0}, {0.5, 1.0}, 1.0, 1.0, 1.0));
-    d.balls.push_back(charged("q", {70.0, 27.0}, {0.0, 1.5}, 1.0, 1.0, 1.0));
-    compare_with_oracle(d, 40.0, 3);
-  }
-  SECTION("equal and unequal q/m pairs") {
-    WorldDef d = box(30, 30);
-    d.effects.magnetic = 0.8;
-    d.effects.electric = {0.2, 0.0};
-    for (int k = 0; k < 8; ++k)
-      d.balls.push_back(charged("p" + std::to_string(k), {5.0 + 3.0 * k, 8.0 + 2.0 * (k % 3)},
-                                {std::cos(2.1 * k), std::sin(2.1 * k)}, 1.0, 1.0 + (k % 2), k % 4 == 3 ? 0.0 : 1.0));
-    compare_with_oracle(d, 25.0, 10);
-  }
-  SECTION("all three fields in a small memo gas") {
-    WorldDef d = charged_gas(16, 0.15, 1.0, 1.5, 272, {1.0, -2.0, 0.0});
-    d.effects.gravity = {0.0, -0.2};
-    d.effects.electric = {0.15, 0.0};
-    d.effects.magnetic = 0.4;
-    d.walls.push_back({"baffle", {d.arena.width * 0.3, d.arena.height * 0.6}, {d.arena.width * 0.5, d.arena.height * 0.5}});
-    compare_with_oracle(d, 10.0, 30);
-  }
+  for (const OracleScene& s : held_out_scenes())
+    DYNAMIC_SECTION(s.name) { compare_with_oracle(s.def, s.until, s.min_events); }
 }
