@@ -22,6 +22,7 @@
 
 #include "cli_common.hpp"
 #include "output_file.hpp"
+#include "scene_scales.hpp"
 #include "turtlegas/formats/recording.hpp"
 #include "turtlegas/formats/svg_snapshot.hpp"
 #include "turtlegas/sim/angles.hpp"
@@ -317,6 +318,14 @@ class Renderer {
   void advance_to(double t) {
     if (t > server_->time()) server_->run_until(t);
   }
+  /// Warns, with numbers, when running the scene to t predicts a run that will not finish (as run
+  /// and check do): `render --at 1e300` otherwise ran for ever without a word.
+  void warn_if_absurd(double t, const std::string& span) const {
+    SceneScales scales = predict_scales(source_.scene.def, source_.mode);
+    scales.set_cell(server_->world().cell_size());
+    for (const std::string& w : scale_warnings(scales, t - server_->time(), span))
+      spdlog::warn("{}: {}", opt_.input, w);
+  }
 
   /// The whole arena, or what view `opt.view` shows now (a view of the world file's, or one a
   /// program has opened by this time); layers: the view's (turtle/view.hpp).
@@ -444,6 +453,7 @@ int render_command(const RenderOptions& opt, const turtle::Registry& registry) {
   {
     if (one) {
       within(*opt.at, "--at");
+      renderer.warn_if_absurd(*opt.at, "drawing at --at " + fmt(*opt.at));
       renderer.advance_to(*opt.at);
       renderer.draw(opt.out, "--out");
       return exit_ok;
@@ -455,8 +465,13 @@ int render_command(const RenderOptions& opt, const turtle::Registry& registry) {
     if (!(t1 >= t0)) throw BadInput("--to " + fmt(t1) + " must not be before --from " + fmt(t0));
     // Frame k at t0 + k / fps, k = 0 .. floor(fps (t1 - t0)) (the last at or just before t1; the
     // tolerance keeps a span of whole frames from losing its last one to rounding).
-    const auto count = static_cast<std::size_t>(std::floor((t1 - t0) * opt.fps * (1 + 1e-12) + 1e-9)) + 1;
-    if (count > 1000000) throw BadInput("render: " + std::to_string(count) + " frames is too many (at most 1000000)");
+    // Counted in double first: `--to 1e300` made the cast to an integer overflow (undefined; it drew
+    // one frame and said nothing).
+    const double frames = std::floor((t1 - t0) * opt.fps * (1 + 1e-12) + 1e-9) + 1;
+    if (!(frames <= 1000000))
+      throw BadInput("render: " + fmt(frames) + " frames is too many (at most 1000000); narrow --from/--to or lower --fps");
+    const auto count = static_cast<std::size_t>(frames);
+    renderer.warn_if_absurd(t1, "frames to --to " + fmt(t1));
     fs::path dir = opt.frames;
     const bool temporary = dir.empty();
     if (temporary) dir = fs::temp_directory_path() / ("turtlegas-frames-" + std::to_string(::getpid()));

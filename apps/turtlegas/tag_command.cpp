@@ -12,6 +12,7 @@
 
 #include "output_file.hpp"
 #include "cli_common.hpp"
+#include "scene_scales.hpp"
 
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/tag_tournament.hpp"
@@ -73,6 +74,11 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
   std::optional<OutputFile> json_file;
   if (!options.json_out.empty()) json_file.emplace(options.json_out, "--json");
   const world::Scene scene = load(options.world, registry);
+  // Rounds whose scales predict a run that will not finish say so, with numbers, before they
+  // start (as run and check do): `tag --until 1e300` otherwise ran for ever without a word.
+  for (const std::string& w : scale_warnings(predict_scales(scene.def, t.server.mode), t.until,
+                                             "each round to --until " + fmt(t.until)))
+    spdlog::warn("{}: {}; lower --until", options.world, w);
   world::TournamentResult result;
   try {
     result = world::run_tag_tournament(scene, options.world, t, registry);

@@ -678,3 +678,36 @@ TEST_CASE("robust: serve refuses an output that is its world file, or a director
   CHECK(twice.code == 2);
   CHECK(contains(twice.err, "both write"));
 }
+
+TEST_CASE("robust: tag and render say, with numbers, when their run will not finish") {
+  // Before: `tag --until 1e300` and `render --at 1e300` ran for ever without a word (run and
+  // check warned; these two did not). Both are killed here once the warning is read.
+  const std::string tag = worlds + "tag.json", gas = worlds + "gas.json";
+  const std::vector<std::vector<std::string>> cases{
+      {"tag", tag, "--controllers", "tag_chaser,tag_evader", "--until", "1e300"},
+      {"render", gas, "--at", "1e300", "--out", "x.png"},
+  };
+  for (const auto& args : cases) {
+    INFO(args[0]);
+    TempDir dir;
+    Spawned p(dir.path, args);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (!contains(p.err(), "predicts about") && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    INFO(p.err());
+    CHECK(contains(p.err(), "predicts about"));
+    CHECK(contains(p.err(), "1e+300"));
+    CHECK(contains(p.err(), "years"));
+  }
+}
+
+TEST_CASE("robust: render refuses more frames than it draws, however far --to is") {
+  // Before: --to 1e300 overflowed the frame count's cast to an integer (undefined behaviour): it
+  // drew one frame at t = 0 and exited 0.
+  TempDir dir;
+  const Result r = run(dir, {"render", worlds + "tag.json", "--from", "0", "--to", "1e300", "--frames", "f"});
+  INFO(r.err);
+  CHECK(r.code == 2);
+  CHECK(contains(r.err, "frames is too many"));
+  CHECK(!fs::exists(dir.path / "f" / "frame-00000.png"));
+}
