@@ -22,7 +22,9 @@
 #   SETS         edmd (EDMD peer), box2d (step mode against Box2D), scaling (turtlegas alone at
 #                N = 10^3 and 10^6, walled) [all three]
 #   BOX2D_POINTS N<n>_phi<f>_dt<n> [N = 10^4, phi 0.05 and 0.30, dt = 1/60 and 1/600: target 4]
-#                (SETS=box2d alone is about 1 CPU-minute at 5 rounds)
+#                (SETS=box2d alone is about 1 CPU-minute at 5 rounds). The generated block of
+#                docs/performance.md gets the sets of this run only: after a run of some of them,
+#                put its tables elsewhere (bench/make_peers.py RESULTS prints them) and restore it
 #   BALL_STEPS   per Box2D / step-mode run [3e6]
 #   SCALING_ROUNDS [3]
 #   PER_DISC     collisions per disc of the shared start's equilibration [10]
