@@ -350,7 +350,7 @@ def main():
         parts += [f"### Charged balls in B: step mode's rotation kick against exact circles (`{c['world_file']}`: "
                   f"N = {c['N']}, T = {c['sim_seconds']:.3g} s; positions against exact mode's)", "",
                   charged_table(charged), ""]
-    if report.args.svg:
+    if report.args.svg and (ballistic or gas):
         svg_plot([r for r in rows if r["scene"] in ("ballistic", "gas")], report.args.svg)
         parts += [f"![error against CPU seconds per simulated second]({report.rel(report.args.svg)})", ""]
     groups = walled_groups(rows)
