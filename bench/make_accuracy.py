@@ -183,8 +183,9 @@ def walled_svg(groups, path):
     svg = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{pw * len(groups) + 40}" height="{2 * ph + 40}" '
            f'font-family="sans-serif" font-size="12">',
            f'<rect width="{pw * len(groups) + 40}" height="{2 * ph + 40}" fill="white"/>',
-           '<text x="14" y="22" font-size="15">the walled gas: turtlegas (exact mode ◆, step mode) and Box2D, '
-           'error against CPU seconds per simulated second (log-log), by dt; an error of 0 sits on the bottom edge</text>']
+           '<text x="14" y="18" font-size="14">the walled gas: turtlegas (exact mode ◆, step mode) and Box2D,</text>',
+           '<text x="14" y="35" font-size="14">error against CPU seconds per simulated second (log-log), by dt; '
+           'an error of 0 sits on the bottom edge</text>']
     x_range = cost_range([r for g in groups for r in g])
     for col, g in enumerate(groups):
         n = make_tables.n_label(g[0]["N"])
@@ -197,7 +198,7 @@ def walled_svg(groups, path):
             diamonds = [("exact", WALLED_COLOURS["exact"],
                          [(r["cpu_per_sim_second"], r[key]) for r in g if r["mode"] == "exact"], True)]
             svg += draw_panel(2 * col + row, col * pw + 30, row * ph + 10, pw, ph, x_range, f"N = {n}: {what}",
-                              y_label, lines, diamonds, False, legend_top_left=True)
+                              y_label, lines, diamonds, False, legend_mid_right=True)
     write_svg(svg, path)
 
 
@@ -242,12 +243,12 @@ def write_svg(svg, path):
     pathlib.Path(path).write_text("\n".join(svg) + "\n")
 
 
-def draw_panel(k, ox, oy, pw, ph, x_range, title, y_label, lines, diamonds, guide, legend_top_left=False):
+def draw_panel(k, ox, oy, pw, ph, x_range, title, y_label, lines, diamonds, guide, legend_mid_right=False):
     """One log-log panel at (ox, oy), pw by ph with its margins: lines are (label, colour,
     [(cost, error, point label)], whether to print the point labels), diamonds (label, colour,
     [(cost, error)], whether to print the label beside them); guide draws a line of slope -1
-    through the first line's last point. The legend goes in the bottom right corner, or the top
-    left one. Returns the SVG elements."""
+    through the first line's last point. The legend goes in the bottom right corner, or half way up
+    the right edge. Returns the SVG elements."""
     left, right, top, bottom = 64, 14, 58, 52
     x0, x1 = x_range
     # Zero errors cannot sit on a log axis; they occur only where round-off cancels exactly, and
@@ -312,7 +313,10 @@ def draw_panel(k, ox, oy, pw, ph, x_range, title, y_label, lines, diamonds, guid
     entries += [(label, colour, "diamond") for label, colour, *_ in diamonds]
     if guide:
         entries.append(("error ∝ dt (slope −1)", "#999", "guide"))
-    lx, ly = (px0 + 14, py0 + 18) if legend_top_left else (px1 - 150, py1 - 18 * len(entries) + 4)
+    # Beside Box2D the errors sit at the top (Box2D) and the bottom (turtlegas) and the costs span
+    # the width: the middle of the right edge is what they leave empty.
+    lx, ly = ((px1 - 150, (py0 + py1) / 2 - 9 * len(entries) + 12) if legend_mid_right
+              else (px1 - 150, py1 - 18 * len(entries) + 4))
     svg.append(f'<rect x="{lx - 8}" y="{ly - 12}" width="156" height="{18 * len(entries) + 6}" fill="white" '
                'stroke="#bbb"/>')
     for j, (text, colour, kind) in enumerate(entries):
