@@ -324,7 +324,7 @@ int run_main(int argc, char** argv) {
   out["cells"] = static_cast<std::uint64_t>(world.cells_x()) * static_cast<std::uint64_t>(world.cells_y());
   out["dt"] = world.dt();
   if (opt.mode == sim::Mode::exact) {
-    nlohmann::json ends = nlohmann::json::array();
+    nlohmann::ordered_json ends = nlohmann::ordered_json::array();  // out's type: moved in, not copied
     for (const auto& [t, c] : run.chunk_ends) ends.push_back({t, c});
     out["chunk_ends"] = std::move(ends);
   }
