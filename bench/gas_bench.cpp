@@ -324,9 +324,9 @@ int run_main(int argc, char** argv) {
   out["cells"] = static_cast<std::uint64_t>(world.cells_x()) * static_cast<std::uint64_t>(world.cells_y());
   out["dt"] = world.dt();
   if (opt.mode == sim::Mode::exact) {
-    nlohmann::ordered_json ends = nlohmann::ordered_json::array();  // out's type: moved in, not copied
+    nlohmann::json ends = nlohmann::json::array();
     for (const auto& [t, c] : run.chunk_ends) ends.push_back({t, c});
-    out["chunk_ends"] = std::move(ends);
+    out["chunk_ends"] = ends;  // copied: a json does not move into an ordered_json
   }
   std::cout << out.dump() << '\n';
   return 0;
