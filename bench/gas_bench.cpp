@@ -326,7 +326,7 @@ int run_main(int argc, char** argv) {
   if (opt.mode == sim::Mode::exact) {
     nlohmann::json ends = nlohmann::json::array();
     for (const auto& [t, c] : run.chunk_ends) ends.push_back({t, c});
-    out["chunk_ends"] = std::move(ends);
+    out["chunk_ends"] = ends;  // copied: a json does not move into an ordered_json
   }
   std::cout << out.dump() << '\n';
   return 0;

@@ -39,7 +39,8 @@ WorldDef dense_gas(int n, bool moving, std::uint64_t seed) {
   std::normal_distribution<double> gauss(0.0, 1.0);
   const double x0 = moving ? 2 * d : 0.0;
   for (int k = 0; k < n; ++k) {
-    const Vec2 p{x0 + (k % side + 0.5) * d, (k / side + 0.5) * d};
+    const int column = k % side, row = k / side;  // a square lattice, filled row by row
+    const Vec2 p{x0 + (column + 0.5) * d, (row + 0.5) * d};
     def.balls.push_back({"b" + std::to_string(k), p, {gauss(rng), gauss(rng)}, r, 1.0, 0.0});
   }
   if (moving) {

@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   std::atomic<bool> counting{false}, stop{false};
   std::vector<std::uint64_t> frames(static_cast<std::size_t>(viewers)), bytes(static_cast<std::size_t>(viewers));
   std::vector<std::thread> threads;
+  threads.reserve(static_cast<std::size_t>(viewers));
   std::atomic<int> ready{0};
   for (int k = 0; k < viewers; ++k)
     threads.emplace_back([&, k] {

@@ -31,13 +31,15 @@ inline TurtleLattice turtle_lattice(int turtles, const std::string& name, std::u
   def.arena.width = def.arena.height = size;
   def.arena.boundary = sim::Boundary::walls;
   for (int k = 1; k < 4; ++k) {
-    const double y = 20.0 + pitch * (k * side / 4);  // midway between two lattice rows
+    const int row = k * side / 4;  // a whole row: the bar lies midway between two lattice rows
+    const double y = 20.0 + pitch * row;
     def.walls.push_back({"bar" + std::to_string(k), {size * 0.2, y}, {size * 0.8, y}});
   }
   for (int k = 0; k < turtles; ++k) {
     sim::TurtleDef t;
     t.id = "t" + std::to_string(k);
-    t.pos = {20.0 + pitch * (k % side) + pitch / 2, 20.0 + pitch * (k / side) + pitch / 2};
+    const int column = k % side, row = k / side;  // filled row by row
+    t.pos = {20.0 + pitch * column + pitch / 2, 20.0 + pitch * row + pitch / 2};
     t.heading = std::fmod(k * 2.399963, 2 * M_PI);  // golden-angle spread
     t.radius = 5;
     t.speed = 20;

@@ -329,6 +329,7 @@ int test_command(const TestOptions& options, const turtle::Registry& registry, c
     std::printf("%s%zu passed, %zu failed, %zu could not run\n", options.tap ? "# " : "", passed, failed, bad);
   if (junit) {
     std::vector<Outcome> outcomes;
+    outcomes.reserve(done.size());
     for (auto& o : done) outcomes.push_back(std::move(*o));
     junit->stream() << junit_xml(options.worlds, outcomes, seconds);
     junit->commit();

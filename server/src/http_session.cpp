@@ -118,7 +118,7 @@ void HttpSession::serve(Request req) {
                            error_text("too_many_clients", "the server has its maximum of connections (--max-clients)") + "\n",
                            "application/json"));
     stream_.expires_never();
-    std::make_shared<WebSocketSession>(stream_.release_socket(), host_)->run(std::move(req));
+    std::make_shared<WebSocketSession>(stream_.release_socket(), host_)->run(req);
     return;
   }
   if (req.method() != http::verb::get && req.method() != http::verb::head) {

@@ -30,7 +30,7 @@ std::filesystem::path default_web_root() {
   std::error_code ec;
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (!ec) {
-    const std::filesystem::path installed = (exe.parent_path() / TURTLEGAS_WEB_FROM_BIN).lexically_normal();
+    std::filesystem::path installed = (exe.parent_path() / TURTLEGAS_WEB_FROM_BIN).lexically_normal();
     if (std::filesystem::is_regular_file(installed / "index.html", ec)) return installed;
   }
   return TURTLEGAS_DEFAULT_WEB_ROOT;
@@ -88,8 +88,9 @@ int serve(ServeOptions options, const turtle::Registry& registry, world::Scene s
   std::fflush(stdout);
 
   asio::signal_set signals(ioc, SIGINT, SIGTERM);
-  signals.async_wait([&host](boost::system::error_code e, int sig) {
-    if (!e) host.request_stop(sig == SIGINT ? "signal" : "signal");
+  // SIGINT and SIGTERM both stop with the reason "signal" (docs/protocol.md).
+  signals.async_wait([&host](boost::system::error_code e, int /*sig*/) {
+    if (!e) host.request_stop("signal");
   });
   // When the world has stopped: no new connections, the clients' last messages written, then out.
   asio::steady_timer grace(ioc);

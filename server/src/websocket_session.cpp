@@ -16,7 +16,7 @@ WebSocketSession::WebSocketSession(boost::asio::ip::tcp::socket&& socket, WorldH
   id = host.next_client_id();
 }
 
-void WebSocketSession::run(beast::http::request<beast::http::string_body> req) {
+void WebSocketSession::run(const beast::http::request<beast::http::string_body>& req) {
   // Results and frames go out as soon as they are written (as on TCP lines): no Nagle delay for a
   // lockstep client's next round trip.
   boost::system::error_code nodelay_ec;  // (a socket that will not take it just keeps Nagle)

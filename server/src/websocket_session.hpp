@@ -14,8 +14,9 @@ namespace turtlegas::server::detail {
 class WebSocketSession : public Session {
  public:
   WebSocketSession(boost::asio::ip::tcp::socket&& socket, WorldHost& host);
-  /// Accepts the upgrade request `req` (read by the HTTP session), then reads messages.
-  void run(boost::beast::http::request<boost::beast::http::string_body> req);
+  /// Accepts the upgrade request `req` (read by the HTTP session; the reply is built from it before
+  /// this returns, so it need not outlive the call), then reads messages.
+  void run(const boost::beast::http::request<boost::beast::http::string_body>& req);
   bool binary_capable() const override { return true; }
 
  private:

@@ -44,6 +44,7 @@ class Spawned {
       ::dup2(err, 2);
       ::chdir(dir.c_str());
       std::vector<char*> argv;
+      argv.reserve(argv_s.size() + 1);  // and the closing null
       for (std::string& a : argv_s) argv.push_back(a.data());
       argv.push_back(nullptr);
       ::execv(argv[0], argv.data());
