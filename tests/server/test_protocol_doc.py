@@ -140,16 +140,18 @@ def session(w, save_dir):
     # In lockstep a boundary (where add_wall happens) needs t1's next command: let it go first.
     reply_shape("ok", ask(w, doc["release"][0]))
     # The world runs at speed max, so where the balls are at the boundary that takes the wall is
-    # a matter of timing: a wall through a ball is refused with the reason (a documented reply);
-    # the same request at a later boundary, when the ball has moved on, is taken.
+    # a matter of timing: a wall through a ball or a turtle (t2 drives its square) is refused with
+    # the reason (a documented reply); the same request at a later boundary, when it has moved on,
+    # is taken.
     for attempt in range(8):
         try:
             r = ask(w, doc["add_wall"][0])
             break
         except Exception as e:
             reply_shape("error", e.reply)
-            check(e.reply["code"] == "refused" and "would overlap a ball" in e.reply["message"],
-                  "add_wall refused only by a ball in the way: %r" % e.reply)
+            check(e.reply["code"] == "refused" and ("would overlap a ball" in e.reply["message"] or
+                                                    "would overlap a turtle" in e.reply["message"]),
+                  "add_wall refused only by a ball or turtle in the way: %r" % e.reply)
     reply_shape("ok", r)
     check(r["request"] == "add_wall", "add_wall ok")
     r = ask(w, doc["save"][0])
