@@ -22,7 +22,9 @@
 
 #include "cli_common.hpp"
 #include "output_file.hpp"
+#include "run_loop.hpp"
 #include "scene_scales.hpp"
+#include "signals.hpp"
 #include "turtlegas/formats/recording.hpp"
 #include "turtlegas/formats/svg_snapshot.hpp"
 #include "turtlegas/sim/angles.hpp"
@@ -315,16 +317,24 @@ class Renderer {
     server_ = make_server(source.scene, registry, o, opt.input);
   }
 
-  void advance_to(double t) {
-    if (t > server_->time()) server_->run_until(t);
+  /// Makes the scene stop inside a step too (run_loop.hpp), and paces its chunks by its scales.
+  void limit(const Limits& limits, Clock::time_point start) {
+    stop_inside_steps(*server_, limits, start);
+    pace_ = first_pace(predict_scales(source_.scene.def, source_.mode), server_->world(), source_.scene.def.dt);
   }
+  /// Runs the scene to t in chunks, as `run` runs: a stop (a signal, a limit) leaves it short of t.
+  Stopped advance_to(double t, const Limits& limits, Clock::time_point start, Progress& progress,
+                     const std::string& doing) {
+    return run_server_in_chunks(*server_, t, 0, limits, pace_, start, progress, doing);
+  }
+  double time() const { return server_->time(); }
   /// Warns, with numbers, when running the scene to t predicts a run that will not finish (as run
   /// and check do): `render --at 1e300` otherwise ran for ever without a word.
   void warn_if_absurd(double t, const std::string& span) const {
     SceneScales scales = predict_scales(source_.scene.def, source_.mode);
     scales.set_cell(server_->world().cell_size());
     for (const std::string& w : scale_warnings(scales, t - server_->time(), span))
-      spdlog::warn("{}: {}", opt_.input, w);
+      spdlog::warn("{}: {}; --max-wall-seconds or --max-events end it cleanly", opt_.input, w);
   }
 
   /// The whole arena, or what view `opt.view` shows now (a view of the world file's, or one a
@@ -385,6 +395,7 @@ class Renderer {
   Source& source_;
   const RenderOptions& opt_;
   std::unique_ptr<turtle::WorldServer> server_;
+  Pace pace_;
 };
 
 std::string find_on_path(const std::string& program) {
@@ -398,6 +409,13 @@ std::string find_on_path(const std::string& program) {
     start = end + 1;
   }
   return {};
+}
+
+/// "frame-00042.png"
+std::string frame_name(std::size_t k) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame-%05zu.png", k);
+  return name;
 }
 
 bool ends_with(const std::string& s, const std::string& e) { return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0; }
@@ -418,10 +436,12 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opt) {
       ->check(real_in(0, big, "seconds"));
   r->add_option("--width", opt.width, "Pixels across the arena's longer side")->capture_default_str()->check(real_in(16, 8192, "pixels"));
   r->add_option("--view", opt.view, "Draw what this view of the world shows (its \"views\")");
+  opt.limits.add_to(*r, "the rendering", "the frames drawn so far kept");
   return r;
 }
 
 int render_command(const RenderOptions& opt, const turtle::Registry& registry) {
+  const auto start = Clock::now();
   const bool one = opt.at.has_value();
   const bool many = !opt.frames.empty() || !opt.video.empty();
   if (one == many)
@@ -450,11 +470,26 @@ int render_command(const RenderOptions& opt, const turtle::Registry& registry) {
                      " s");
   };
   Renderer renderer(source, registry, opt);
+  install_stop_signals();
+  install_crash_report(opt.input);
+  Limits limits;
+  limits.max_wall_seconds = opt.limits.wall_seconds();
+  limits.max_events = opt.limits.events();
+  renderer.limit(limits, start);
+  // A stop before the picture asked for: nothing is drawn, and the message says how far it got.
+  auto stopped = [&](Stopped end, const std::string& what) {
+    spdlog::warn("{}: stopped at t = {} s ({}); {}", opt.input, fmt(renderer.time()), stop_name(end), what);
+    return exit_code_for(end);
+  };
   {
     if (one) {
       within(*opt.at, "--at");
       renderer.warn_if_absurd(*opt.at, "drawing at --at " + fmt(*opt.at));
-      renderer.advance_to(*opt.at);
+      Progress progress(*opt.at);
+      const Stopped end = renderer.advance_to(*opt.at, limits, start, progress, "drawing at --at: ");
+      progress.clear();
+      if (end.first != Stop::until)
+        return stopped(end, "the picture at --at " + fmt(*opt.at) + " is not drawn (--out " + opt.out + " untouched)");
       renderer.draw(opt.out, "--out");
       return exit_ok;
     }
@@ -478,13 +513,26 @@ int render_command(const RenderOptions& opt, const turtle::Registry& registry) {
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (!fs::is_directory(dir)) throw BadInput("--frames " + dir.string() + ": cannot make that directory");
+    Progress progress(t1);
+    progress.set_part(t1, -t0, t1 - t0);
     for (std::size_t k = 0; k < count; ++k) {
       const double t = t0 + static_cast<double>(k) / opt.fps;
-      renderer.advance_to(t);
-      char name[32];
-      std::snprintf(name, sizeof name, "frame-%05zu.png", k);
-      renderer.draw((dir / name).string(), "--frames");
+      const std::string doing = "frame " + std::to_string(k + 1) + " of " + std::to_string(count) + ": ";
+      const Stopped end = renderer.advance_to(t, limits, start, progress, doing);
+      if (end.first != Stop::until) {
+        progress.clear();
+        if (temporary) fs::remove_all(dir, ec);
+        std::string kept = "no frames are kept";
+        if (!opt.frames.empty() && k > 0)
+          kept = "frame-00000.png to " + frame_name(k - 1) + " in " + dir.string() + " are whole";
+        else if (!opt.frames.empty())
+          kept = "no frame was drawn";
+        return stopped(end, "before " + frame_name(k) + ", " + std::to_string(k + 1) + " of " + std::to_string(count) +
+                                " (t = " + fmt(t) + " s); " + kept + (opt.video.empty() ? "" : "; --video " + opt.video + " is not made"));
+      }
+      renderer.draw((dir / frame_name(k)).string(), "--frames");
     }
+    progress.clear();
     if (!opt.frames.empty()) spdlog::info("{} frames, t = {} to {} s, in {}", count, fmt(t0), fmt(t0 + (count - 1) / opt.fps), dir.string());
     if (!opt.video.empty()) {
       const fs::path target = opt.video;

@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "run_loop.hpp"
 #include "turtlegas/turtle/registry.hpp"
 
 namespace turtlegas::apps {
@@ -24,9 +25,12 @@ struct RenderOptions {
   std::optional<double> from, to;  ///< the frames' span (default: 0 to the recording's end)
   double width = 800.0;            ///< pixels across the arena's longer side
   std::string view;                ///< a view id (the world's "views")
+  LimitOptions limits;             ///< --max-wall-seconds, --max-events
 };
 
 CLI::App* add_render_command(CLI::App& app, RenderOptions& opt);
+/// Draws what `opt` asks for: exit_ok, or exit_limit or 128 + a signal when it stopped early (the
+/// frames drawn before it are whole; a stopped --at or --video is not written).
 int render_command(const RenderOptions& opt, const turtle::Registry& registry);
 
 }  // namespace turtlegas::apps

@@ -25,6 +25,7 @@
 #include "cli_common.hpp"
 #include "output_file.hpp"
 #include "scene_scales.hpp"
+#include "run_loop.hpp"
 #include "signals.hpp"
 #include "turtlegas/formats/ball_trails.hpp"
 #include "turtlegas/formats/event_log.hpp"
@@ -44,50 +45,6 @@
 namespace turtlegas::apps {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-/// A line on stderr, refreshed in place, only on a terminal and only once a run has taken long
-/// enough for it to help: simulated time, events per second, and when it will be done.
-class Progress {
- public:
-  explicit Progress(double until) : until_(until), start_(Clock::now()), enabled_(::isatty(STDERR_FILENO) != 0) {}
-  Progress(const Progress&) = delete;
-  Progress& operator=(const Progress&) = delete;
-
-  void update(double t, std::uint64_t events, const char* doing) {
-    if (!enabled_) return;
-    const auto now = Clock::now();
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    if (elapsed < 2.0 || now - last_ < std::chrono::milliseconds(200)) return;
-    if (!shown_) t0_ = t, events0_ = events, since_ = now;  // rates from the first line on
-    last_ = now;
-    const double span = std::chrono::duration<double>(now - since_).count();
-    const double pct = until_ > 0.0 ? 100.0 * t / until_ : 100.0;
-    const double rate = span > 0.0 ? static_cast<double>(events - events0_) / span : 0.0;
-    const double sim_rate = span > 0.0 ? (t - t0_) / span : 0.0;
-    const std::string eta = sim_rate > 0.0 ? human_duration((until_ - t) / sim_rate) : std::string("unknown");
-    std::fprintf(stderr, "\r\033[K  %st = %.6g / %.6g s  %5.1f%%  %.3g events/s  ETA %s ", doing, t, until_, pct, rate,
-                 eta.c_str());
-    std::fflush(stderr);
-    shown_ = true;
-  }
-  ~Progress() { clear(); }
-  void clear() {
-    if (shown_) std::fputs("\r\033[K", stderr), std::fflush(stderr);
-    shown_ = false;
-  }
-
- private:
-  double until_;
-  Clock::time_point start_, since_{}, last_{};
-  double t0_ = 0.0;
-  std::uint64_t events0_ = 0;
-  bool enabled_;
-  bool shown_ = false;
-};
-
 /// What a run adds up besides the engine's own Stats.
 struct RunTotals {
   double energy_start = 0.0;
@@ -95,90 +52,6 @@ struct RunTotals {
   std::uint64_t faults = 0;
   std::size_t turtles_finished = 0;
 };
-
-/// Why the chunk loop ended.
-enum class Stop { until, signal, max_wall_seconds, max_events };
-
-const char* stop_name(Stop s, int sig) {
-  switch (s) {
-    case Stop::until: return "";
-    case Stop::signal: return signal_name(sig);
-    case Stop::max_wall_seconds: return "max-wall-seconds";
-    case Stop::max_events: return "max-events";
-  }
-  return "";
-}
-
-/// How the loop cuts a run into chunks. The physics does not depend on where a run is cut; the
-/// cuts are where outputs are flushed, progress is shown, limits and Ctrl-C are looked at, and
-/// checkpoints are written. A chunk starts small enough for the scene's predicted event rate
-/// (scene_scales.hpp: a runaway scene still comes back every ~2^14 events) and then adapts to
-/// about 0.1 s of wall time, halving above 0.25 s or 2^20 events, doubling below 0.05 s and 2^18.
-struct Pace {
-  double chunk = 0.0;
-};
-
-struct Limits {
-  double until = 0.0;
-  std::optional<double> max_wall_seconds;
-  std::optional<std::uint64_t> max_events;
-  std::optional<double> checkpoint_every;
-  std::optional<double> keyframe_every;  ///< a recording's keyframes: cuts at its multiples
-  std::optional<double> sample_every;    ///< the overlap's samples: cuts at its multiples
-};
-
-/// Runs chunks until `limits.until` or a stop. `advance(t)` runs to t and returns the engine's
-/// event count; `flush()` writes what the chunk logged; `checkpoint(t, why)` is called at every
-/// multiple of checkpoint_every; `cut(t, events, at_key)` after every chunk (a recording's
-/// keyframes; the chunks are also cut at every multiple of keyframe_every, and at_key says this is one;
-/// likewise at every multiple of sample_every, and at_sample).
-template <class Advance, class Flush, class AtCheckpoint, class AtCut>
-std::pair<Stop, int> run_in_chunks(double from, const Limits& limits, Pace& pace, Clock::time_point start,
-                                   Progress& progress, const char* doing, Advance&& advance, Flush&& flush,
-                                   AtCheckpoint&& checkpoint, AtCut&& cut) {
-  double t = from;
-  std::uint64_t events = 0;
-  double events_per_second = 0.0;  // simulated, measured over the last chunk
-  const double every = limits.checkpoint_every.value_or(0.0);
-  double next_checkpoint = every > 0.0 ? (std::floor(t / every) + 1.0) * every : INFINITY;
-  const double key_every = limits.keyframe_every.value_or(0.0);
-  double next_key = key_every > 0.0 ? (std::floor(t / key_every) + 1.0) * key_every : INFINITY;
-  const double sample_every = limits.sample_every.value_or(0.0);
-  double next_sample = sample_every > 0.0 ? (std::floor(t / sample_every) + 1.0) * sample_every : INFINITY;
-  while (t < limits.until) {
-    if (const int sig = stop_signal()) return {Stop::signal, sig};
-    if (limits.max_wall_seconds && seconds_since(start) >= *limits.max_wall_seconds) return {Stop::max_wall_seconds, 0};
-    if (limits.max_events && events >= *limits.max_events) return {Stop::max_events, 0};
-    double chunk = pace.chunk;
-    // Near --max-events, a chunk of about what is left.
-    if (limits.max_events && events_per_second > 0.0)
-      chunk = std::min(chunk, std::max(static_cast<double>(*limits.max_events - events) / events_per_second, chunk / 1024));
-    double next = std::min({limits.until, t + chunk, next_checkpoint, next_key, next_sample});
-    if (!(next > t)) next = std::nextafter(t, INFINITY);  // a chunk below one ulp of t
-    const auto chunk_start = Clock::now();
-    const std::uint64_t before = events;
-    events = advance(next);
-    const double took = seconds_since(chunk_start);
-    flush();
-    const double done = static_cast<double>(events - before);
-    events_per_second = done / (next - t);
-    if ((took > 0.25 || done > 0x1p20) && pace.chunk / 2.0 > 0.0) pace.chunk /= 2.0;
-    else if (took < 0.05 && done < 0x1p18 && pace.chunk * 2.0 < INFINITY) pace.chunk *= 2.0;
-    t = next;
-    const bool at_key = t >= next_key;
-    if (at_key) next_key = (std::floor(t / key_every) + 1.0) * key_every;
-    const bool at_sample = t >= next_sample;
-    if (at_sample) next_sample = (std::floor(t / sample_every) + 1.0) * sample_every;
-    cut(t, events, at_key, at_sample);
-    note_run_time(t);
-    if (t >= next_checkpoint) {
-      checkpoint(t, "every " + fmt(every) + " s");
-      next_checkpoint = (std::floor(t / every) + 1.0) * every;
-    }
-    progress.update(t, events, doing);
-  }
-  return {Stop::until, 0};
-}
 
 /// How many times a run measures the deepest overlap when --overlap-samples does not say: at every
 /// control step of the run, but at most 1000 times, and fewer for large scenes (at least 16), so
@@ -295,14 +168,7 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
                   "Replay this input log (written by `turtlegas serve --inputs-out`) into the world's remote turtles");
   add_stack_kib_option(*run, opt.stack_kib);
   add_program_budget_option(*run, opt.program_budget, "the run stops");
-  line.max_wall_option =
-      run->add_option("--max-wall-seconds", line.max_wall_seconds,
-                      "Stop the run cleanly after this much wall-clock time, outputs written up to there (exit 3)")
-          ->check(real_in(0, 1e9, "seconds", true));
-  line.max_events_option =
-      run->add_option("--max-events", line.max_events,
-                      "Stop the run cleanly once the engine has taken this many events, outputs written (exit 3)")
-          ->check(integer_in(1, std::numeric_limits<std::int64_t>::max(), "events"));
+  line.limits.add_to(*run, "the run", "outputs written up to there");
   run->add_option("--checkpoint", opt.checkpoint,
                   "Write a checkpoint here at the end, when the run stops early, and every --checkpoint-every");
   line.checkpoint_every_option =
@@ -500,6 +366,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     sim::World& world = *bare;
     totals.energy_start = world.energy();
     world.set_event_log(&bare_events);
+    stop_inside_steps(world, limits, start);
     if (observe_file) observer.emplace(world, def, observing, opt.until);
     if (trails && observer) observer->forward = [&trails](const std::vector<sim::Impulse>& b) { trails->take(b); };
     else if (trails) world.set_impulse_log(&trail_impulses);
@@ -538,6 +405,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     totals.energy_start = server->world().energy();
     // The log is always kept: touches and faults are counted from it.
     server->set_event_log(&server_events);
+    stop_inside_steps(*server, limits, start);
     // Whole control steps at first; programs run only at step boundaries anyway.
     first_chunk = def.dt;
     turtle::WorldServer& s = *server;
@@ -574,8 +442,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   for (const std::string& w :
        scale_warnings(scales, opt.until - world.time(), "this run to --until " + fmt(opt.until)))
     spdlog::warn("{}: {}; --max-wall-seconds or --max-events end it cleanly", opt.world, w);
-  if (scales.events_per_second > 0.0) first_chunk = std::min(first_chunk, 0x1p14 / scales.events_per_second);
-  Pace pace{std::max(first_chunk, std::numeric_limits<double>::denorm_min())};
+  Pace pace = first_pace(scales, world, first_chunk);
 
   auto write_checkpoint_at = [&](double t, const std::string& why) {
     Checkpoint c;
@@ -592,14 +459,14 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     out.commit();
   };
 
-  std::pair<Stop, int> end{Stop::until, 0};
+  Stopped end{Stop::until, 0};
   if (resume) {
     // The replay: the same run to the checkpoint's time, its events dropped, then the proof that
     // it is the same run.
     Limits to_checkpoint = limits;
     to_checkpoint.until = resume->t;
     to_checkpoint.checkpoint_every.reset();
-    end = run_in_chunks(world.time(), to_checkpoint, pace, start, progress, "replaying: ", advance,
+    end = run_in_chunks(world.time(), world.stats().events, to_checkpoint, pace, start, progress, "replaying: ", advance,
                         [&] { flush(false); }, [](double, const std::string&) {}, [](double, std::uint64_t, bool, bool) {});
     if (end.first == Stop::until) {
       const bool same = world.time() == resume->t && world.stats().events == resume->events &&
@@ -613,7 +480,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   if (recorder) recorder->keyframe(world, current_names());  // the first, at the start
   if (end.first == Stop::until) {
     limits.until = opt.until;
-    end = run_in_chunks(world.time(), limits, pace, start, progress, "", advance, [&] { flush(true); },
+    end = run_in_chunks(world.time(), world.stats().events, limits, pace, start, progress, "", advance, [&] { flush(true); },
                         [&](double t, const std::string& why) { write_checkpoint_at(t, why); },
                         [&](double, std::uint64_t events, bool at_key, bool at_sample) {
                           if (recorder && (at_key || recorder->keyframe_due(events))) recorder->keyframe(world, current_names());
@@ -637,7 +504,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
       bare->set_impulse_log(nullptr);
     }
   }
-  const std::string stopped = stop_name(end.first, end.second);
+  const std::string stopped = stop_name(end);
 
   const sim::Overlap now = world.measure_overlap(), seen = world.max_contact_overlap();
   formats::RunFigures run;
@@ -696,7 +563,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   spdlog::warn("{}: stopped at t = {} s of {} ({}); the outputs are written up to there{}", opt.world,
                fmt(world.time()), fmt(opt.until), stopped,
                opt.checkpoint.empty() ? "" : "; continue with --resume " + opt.checkpoint);
-  return end.first == Stop::signal ? exit_code_for(end.second) : exit_limit;
+  return exit_code_for(end);
 }
 
 }  // namespace turtlegas::apps

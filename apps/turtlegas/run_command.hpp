@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "run_loop.hpp"
 #include "turtlegas/turtle/registry.hpp"
 
 namespace turtlegas::apps {
@@ -59,26 +60,21 @@ struct RunOptions {
 struct RunCommandLine {
   RunOptions parsed;
   std::string mode = "exact";
-  double dt = 0.0, max_wall_seconds = 0.0, checkpoint_every = 0.0;
-  std::uint64_t max_events = 0;
-  CLI::Option *mode_option = nullptr, *dt_option = nullptr, *max_wall_option = nullptr, *max_events_option = nullptr,
-              *checkpoint_every_option = nullptr;
+  double dt = 0.0, checkpoint_every = 0.0;
+  LimitOptions limits;  ///< --max-wall-seconds, --max-events
+  CLI::Option *mode_option = nullptr, *dt_option = nullptr, *checkpoint_every_option = nullptr;
   const std::vector<std::string>* plugins = nullptr;
   RunOptions options() const {
     RunOptions o = parsed;
     if (mode_option && *mode_option) o.mode = mode;
     if (dt_option && *dt_option) o.dt = dt;
-    if (max_wall_option && *max_wall_option) o.max_wall_seconds = max_wall_seconds;
-    if (max_events_option && *max_events_option) o.max_events = max_events;
+    o.max_wall_seconds = limits.wall_seconds();
+    o.max_events = limits.events();
     if (checkpoint_every_option && *checkpoint_every_option) o.checkpoint_every = checkpoint_every;
     if (plugins) o.plugins = *plugins;
     return o;
   }
 };
-
-/// Exit code of a run that stopped at --max-wall-seconds or --max-events before --until (its
-/// outputs are whole, up to the time it reached). Ctrl-C and SIGTERM give 130 and 143.
-constexpr int exit_limit = 3;
 
 /// Adds the `run` subcommand to `app`, parsing into `line`; --plugin goes into `plugins`.
 CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::string>& plugins,

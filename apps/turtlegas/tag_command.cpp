@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "tag_command.hpp"
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <optional>
@@ -12,7 +14,9 @@
 
 #include "output_file.hpp"
 #include "cli_common.hpp"
+#include "run_loop.hpp"
 #include "scene_scales.hpp"
+#include "signals.hpp"
 
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/tag_tournament.hpp"
@@ -40,10 +44,12 @@ CLI::App* add_tag_command(CLI::App& app, TagCommandOptions& options) {
                   "repeatable");
   add_stack_kib_option(*tag, options.stack_kib);
   add_program_budget_option(*tag, options.program_budget, "the round stops");
+  options.limits.add_to(*tag, "the tournament", "the rounds played so far ranked and written");
   return tag;
 }
 
 int run_tag_command(const TagCommandOptions& options, const turtle::Registry& registry) {
+  const auto start = Clock::now();
   world::TournamentOptions t;
   std::string name;
   for (char ch : options.controllers + ",") {
@@ -74,19 +80,45 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
   std::optional<OutputFile> json_file;
   if (!options.json_out.empty()) json_file.emplace(options.json_out, "--json");
   const world::Scene scene = load(options.world, registry);
+  install_stop_signals();  // before the warnings: once they are out, Ctrl-C stops cleanly
+  install_crash_report(options.world);
   // Rounds whose scales predict a run that will not finish say so, with numbers, before they
   // start (as run and check do): `tag --until 1e300` otherwise ran for ever without a word.
-  for (const std::string& w : scale_warnings(predict_scales(scene.def, t.server.mode), t.until,
-                                             "each round to --until " + fmt(t.until)))
-    spdlog::warn("{}: {}; lower --until", options.world, w);
+  SceneScales scales = predict_scales(scene.def, t.server.mode);
+  for (const std::string& w : scale_warnings(scales, t.until, "each round to --until " + fmt(t.until)))
+    spdlog::warn("{}: {}; lower --until, or --max-wall-seconds or --max-events end it cleanly", options.world, w);
+
+  // Each round in chunks, as `run` runs (run_loop.hpp): a progress line, the limits over the
+  // whole tournament, Ctrl-C. A round stopped part way is not counted.
+  Limits limits;
+  limits.max_wall_seconds = options.limits.wall_seconds();
+  limits.max_events = options.limits.events();
+  Progress progress(t.until);
+  Pace pace;
+  std::uint64_t events = 0;  // of the rounds played
+  Stopped end{Stop::until, 0};
+  std::size_t round_stopped = 0;
+  t.play = [&](turtle::WorldServer& server, std::size_t r) {
+    stop_inside_steps(server, limits, start, events);
+    if (r == 0) pace = first_pace(scales, server.world(), scene.def.dt);
+    progress.set_part(t.until, static_cast<double>(r) * t.until, static_cast<double>(t.rounds) * t.until);
+    const std::string doing = "round " + std::to_string(r + 1) + " of " + std::to_string(t.rounds) + ": ";
+    end = run_server_in_chunks(server, t.until, events, limits, pace, start, progress, doing);
+    events += server.world().stats().events;
+    round_stopped = r;
+    return end.first == Stop::until;
+  };
   world::TournamentResult result;
   try {
     result = world::run_tag_tournament(scene, options.world, t, registry);
   } catch (const std::invalid_argument& e) {
     throw BadInput(e.what());
   }
-  std::printf("%s: %zu rounds of %g s, %zu turtles\n", options.world.c_str(), t.rounds, t.until,
-              scene.def.turtles.size());
+  progress.clear();
+  result.stopped = stop_name(end);
+  std::printf("%s: %zu rounds of %g s, %zu turtles%s\n", options.world.c_str(), result.rounds.size(), t.until,
+              scene.def.turtles.size(),
+              result.stopped.empty() ? "" : (" (stopped early: " + result.stopped + ")").c_str());
   std::fputs(world::ranking_table(result).c_str(), stdout);
   for (const std::string& note : result.notes)
     if (note.find("do not divide") != std::string::npos) spdlog::warn("{}", note);
@@ -94,7 +126,11 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
     json_file->stream() << world::to_json(result).dump(2) << '\n';
     json_file->commit();
   }
-  return 0;
+  if (end.first == Stop::until) return exit_ok;
+  spdlog::warn("{}: stopped in round {} of {} ({}); the {} rounds played before it are ranked{}", options.world,
+               round_stopped + 1, t.rounds, result.stopped, result.rounds.size(),
+               json_file ? " and written to --json " + options.json_out : "");
+  return exit_code_for(end);
 }
 
 }  // namespace turtlegas::apps

@@ -32,6 +32,9 @@ void World::advance_to(double t) { impl_->engine->advance_to(t); }
 void World::set_event_log(std::vector<Event>* log) { impl_->engine->set_event_log(log); }
 void World::set_impulse_log(std::vector<Impulse>* log) { impl_->engine->set_impulse_log(log); }
 void World::set_event_limit(std::uint64_t limit) { impl_->engine->set_event_limit(limit); }
+void World::set_stop_poll(std::function<bool()> poll, std::uint64_t every) {
+  impl_->engine->set_stop_poll(std::move(poll), every);
+}
 double World::time() const { return impl_->engine->time(); }
 Mode World::mode() const { return impl_->engine->mode(); }
 double World::dt() const { return impl_->engine->dt(); }

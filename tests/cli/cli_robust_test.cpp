@@ -570,50 +570,70 @@ TEST_CASE("robust: resume refuses a world with a controller that is not restarta
 
 // --- §1: the progress line ---------------------------------------------------------------------------
 
-TEST_CASE("robust: a long run on a terminal shows a progress line with events/s and an ETA") {
-  // Before: a runaway run was silent for ever. stderr is a pseudo-terminal here, as in a shell.
-  TempDir dir;
-  const fs::path w = dir.write("w.json", runaway);
+namespace {
+
+/// What turtlegas wrote to its terminal, run with `args` in `dir` on a pseudo-terminal (as in a
+/// shell), and how it ended: killed after 60 s.
+struct OnTerminal {
+  std::string seen;
+  bool ended = false;
+  int status = 0;
+};
+
+OnTerminal run_on_terminal(const fs::path& dir, const std::vector<std::string>& args) {
+  std::vector<std::string> argv_s{TURTLEGAS_BIN};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
   int master = -1;
   const pid_t pid = ::forkpty(&master, nullptr, nullptr, nullptr);
   REQUIRE(pid >= 0);
   if (pid == 0) {
-    const std::string bin = TURTLEGAS_BIN, world = w.string();
-    ::execl(bin.c_str(), bin.c_str(), "run", world.c_str(), "--until", "1", "--max-wall-seconds", "4", nullptr);
+    ::chdir(dir.c_str());
+    std::vector<char*> argv;
+    for (std::string& a : argv_s) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
     ::_exit(127);
   }
-  std::string seen;
+  OnTerminal r;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  int status = 0;
-  bool ended = false;
   while (std::chrono::steady_clock::now() < deadline) {
     pollfd pfd{master, POLLIN, 0};
     if (::poll(&pfd, 1, 100) > 0) {
       char buf[4096];
       const ssize_t n = ::read(master, buf, sizeof buf);
-      if (n > 0) seen.append(buf, static_cast<std::size_t>(n));
-      if (n <= 0 && ::waitpid(pid, &status, WNOHANG) == pid) {
-        ended = true;
+      if (n > 0) r.seen.append(buf, static_cast<std::size_t>(n));
+      if (n <= 0 && ::waitpid(pid, &r.status, WNOHANG) == pid) {
+        r.ended = true;
         break;
       }
-    } else if (::waitpid(pid, &status, WNOHANG) == pid) {
-      ended = true;
+    } else if (::waitpid(pid, &r.status, WNOHANG) == pid) {
+      r.ended = true;
       break;
     }
   }
-  if (!ended) {
+  if (!r.ended) {
     ::kill(pid, SIGKILL);
-    ::waitpid(pid, &status, 0);
+    ::waitpid(pid, &r.status, 0);
   }
   ::close(master);
-  INFO(seen);
-  REQUIRE(ended);
-  CHECK(WIFEXITED(status));
-  CHECK(WEXITSTATUS(status) == 3);
-  CHECK(contains(seen, "t = "));
-  CHECK(contains(seen, " / 1 s"));
-  CHECK(contains(seen, "events/s"));
-  CHECK(contains(seen, "ETA"));
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("robust: a long run on a terminal shows a progress line with events/s and an ETA") {
+  // Before: a runaway run was silent for ever. stderr is a pseudo-terminal here, as in a shell.
+  TempDir dir;
+  const fs::path w = dir.write("w.json", runaway);
+  const OnTerminal r = run_on_terminal(dir.path, {"run", w.string(), "--until", "1", "--max-wall-seconds", "4"});
+  INFO(r.seen);
+  REQUIRE(r.ended);
+  CHECK(WIFEXITED(r.status));
+  CHECK(WEXITSTATUS(r.status) == 3);
+  CHECK(contains(r.seen, "t = "));
+  CHECK(contains(r.seen, " / 1 s"));
+  CHECK(contains(r.seen, "events/s"));
+  CHECK(contains(r.seen, "ETA"));
 }
 
 TEST_CASE("robust: a resumed run stopped during its replay leaves the checkpoint as it was") {
@@ -710,4 +730,201 @@ TEST_CASE("robust: render refuses more frames than it draws, however far --to is
   CHECK(r.code == 2);
   CHECK(contains(r.err, "frames is too many"));
   CHECK(!fs::exists(dir.path / "f" / "frame-00000.png"));
+}
+
+// --- §1: tag and render have run's limits, progress line and Ctrl-C -----------------------------
+
+namespace {
+
+const std::vector<std::string> endless_tag{"tag", worlds + "tag.json", "--controllers", "tag_chaser,tag_evader",
+                                           "--rounds", "4", "--until", "1e300"};
+/// 900001 frames of the gas: far more than a test waits for.
+const std::vector<std::string> endless_frames{"render", worlds + "gas.json", "--frames", "f", "--from", "0",
+                                              "--to", "90000", "--fps", "10"};
+
+std::vector<std::string> with(std::vector<std::string> args, const std::vector<std::string>& more) {
+  args.insert(args.end(), more.begin(), more.end());
+  return args;
+}
+
+/// Waits (up to 60 s) for the warning that a scene predicts an absurd run: it comes once the world
+/// is built and the signal handlers are in place.
+bool wait_for_warning(const Spawned& p) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!contains(p.err(), "predicts about") && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  return contains(p.err(), "predicts about");
+}
+
+/// Every file in `dir` is a whole PNG: its signature first and its IEND chunk last.
+std::size_t whole_pngs(const fs::path& dir) {
+  std::size_t n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string bytes = read(e.path());
+    INFO(e.path());
+    REQUIRE(bytes.size() > 20);
+    CHECK(bytes.substr(0, 8) == "\x89PNG\r\n\x1a\n");
+    CHECK(bytes.substr(bytes.size() - 8, 4) == "IEND");
+    ++n;
+  }
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("robust: tag stops cleanly at --max-wall-seconds and --max-events, the rounds played written") {
+  // Before: tag had neither option (exit 2), and `tag --until 1e300` ran for ever.
+  TempDir dir;
+  const fs::path out = dir.path / "t.json";
+  Spawned p(dir.path, with(endless_tag, {"--max-wall-seconds", "1", "--json", out.string()}));
+  const auto ended = p.wait_for(60);
+  REQUIRE(ended.has_value());
+  INFO(p.out() << p.err());
+  CHECK(ended->code == 3);
+  CHECK(contains(p.err(), "stopped in round 1 of 4 (max-wall-seconds)"));
+  const json j = json::parse(read(out));
+  CHECK(j.at("stopped") == "max-wall-seconds");
+  CHECK(j.at("rounds_played") == 0);
+  CHECK(j.at("round_results").empty());
+
+  // Rounds of 2 s: some are played whole before the event limit, which stops one part way.
+  const fs::path events_json = dir.path / "e.json";
+  const std::vector<std::string> short_rounds{"tag", worlds + "tag.json", "--controllers", "tag_chaser,tag_evader",
+                                              "--rounds", "1000", "--until", "2"};
+  Spawned q(dir.path, with(short_rounds, {"--max-events", "2000", "--json", events_json.string()}));
+  const auto q_ended = q.wait_for(60);
+  REQUIRE(q_ended.has_value());
+  INFO(q.out() << q.err());
+  CHECK(q_ended->code == 3);
+  const json k = json::parse(read(events_json));
+  CHECK(k.at("stopped") == "max-events");
+  CHECK(k.at("rounds_played").get<int>() >= 1);
+  CHECK(k.at("rounds_played").get<int>() < 1000);
+  CHECK(k.at("round_results").size() == k.at("rounds_played").get<std::size_t>());
+  CHECK(contains(q.out(), std::to_string(k.at("rounds_played").get<int>()) + " rounds of 2 s"));
+  CHECK(!has_temporaries(dir.path));
+}
+
+TEST_CASE("robust: render stops cleanly at --max-wall-seconds and --max-events, its frames whole") {
+  // Before: render had neither option (exit 2); `render --at 1e300` and 900001 frames ran for ever.
+  TempDir dir;
+  Spawned p(dir.path, with(endless_frames, {"--max-wall-seconds", "2"}));
+  const auto ended = p.wait_for(60);
+  REQUIRE(ended.has_value());
+  INFO(p.err());
+  CHECK(ended->code == 3);
+  CHECK(contains(p.err(), "(max-wall-seconds); before frame"));
+  const std::size_t frames = whole_pngs(dir.path / "f");
+  CHECK(frames >= 1);
+  CHECK(frames < 900001);
+  CHECK(!has_temporaries(dir.path / "f"));
+
+  Spawned q(dir.path, {"render", worlds + "gas.json", "--at", "1e300", "--out", "x.png", "--max-events", "10000"});
+  const auto q_ended = q.wait_for(60);
+  REQUIRE(q_ended.has_value());
+  INFO(q.err());
+  CHECK(q_ended->code == 3);
+  CHECK(contains(q.err(), "(max-events); the picture at --at 1e+300 is not drawn"));
+  CHECK(!fs::exists(dir.path / "x.png"));
+  CHECK(!has_temporaries(dir.path));
+}
+
+TEST_CASE("robust: SIGTERM stops tag and render cleanly, with what they made written") {
+  // Before: both died of the signal (no exit code, tag's --json not written).
+  TempDir dir;
+  const fs::path out = dir.path / "t.json";
+  Spawned p(dir.path, with(endless_tag, {"--json", out.string()}));
+  REQUIRE(wait_for_warning(p));  // it comes once the handlers are in place
+  p.send(SIGTERM);
+  const auto ended = p.wait_for(30);
+  REQUIRE(ended.has_value());
+  INFO(p.err());
+  CHECK(ended->code == 143);
+  CHECK(json::parse(read(out)).at("stopped") == "SIGTERM");
+  CHECK(!has_temporaries(dir.path));
+
+  Spawned q(dir.path, endless_frames);
+  REQUIRE(Spawned::wait_for_file(dir.path / "f" / "frame-00002.png", 1, 60));
+  q.send(SIGTERM);
+  const auto q_ended = q.wait_for(30);
+  REQUIRE(q_ended.has_value());
+  INFO(q.err());
+  CHECK(q_ended->code == 143);
+  CHECK(contains(q.err(), "(SIGTERM); before frame"));
+  CHECK(whole_pngs(dir.path / "f") >= 3);
+  CHECK(!has_temporaries(dir.path / "f"));
+}
+
+TEST_CASE("robust: tag and render on a terminal show a progress line: round k of n, frame k of n") {
+  struct Case {
+    std::vector<std::string> args, says;
+  };
+  const std::vector<Case> cases{{endless_tag, {"round 1 of 4: t = ", " / 1e+300 s"}},
+                                {endless_frames, {" of 900001: t = ", " / 90000 s"}}};
+  for (const Case& c : cases) {
+    TempDir dir;
+    const OnTerminal r = run_on_terminal(dir.path, with(c.args, {"--max-wall-seconds", "4"}));
+    INFO(c.args[0] << ": " << r.seen);
+    REQUIRE(r.ended);
+    CHECK(WEXITSTATUS(r.status) == 3);
+    for (const std::string& s : c.says) CHECK(contains(r.seen, s));
+    CHECK(contains(r.seen, "ETA"));
+  }
+}
+
+// --- §1: a run stuck inside one advance of the engine ----------------------------------------------
+
+namespace {
+
+// 2000 fast discs in a box that is one cell (arena.cell): the scales predict a crossing of that cell
+// per disc, not the ~50 times more collisions, so the run's first chunk alone holds minutes of
+// events (each checked against every disc).
+const std::string one_long_chunk = R"({"format": "turtlegas-world/1",
+  "arena": {"width": 100, "height": 100, "boundary": "walls", "cell": 100},
+  "gas": [{"count": 2000, "radius": 1, "speed": 1e9, "seed": 3}]})";
+
+}  // namespace
+
+TEST_CASE("robust: SIGTERM and --max-wall-seconds stop a run inside one long advance of the engine") {
+  // Before: both were looked at only between chunks: SIGTERM was answered, and --max-wall-seconds 1
+  // obeyed, only after minutes (38 s with 1000 discs).
+  TempDir dir;
+  const fs::path w = dir.write("w.json", one_long_chunk);
+  const fs::path events = dir.path / "e.jsonl", stats = dir.path / "stats.json", state = dir.path / "state.json";
+  const std::vector<std::string> args{"run", w.string(), "--until", "1", "--events", events.string(), "--stats-json",
+                                      stats.string(), "--state-out", state.string()};
+  Spawned p(dir.path, args);
+  REQUIRE(wait_for_warning(p));  // the run has started
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  p.send(SIGTERM);
+  const auto ended = p.wait_for(20);
+  REQUIRE(ended.has_value());
+  INFO(p.err());
+  CHECK(ended->code == 143);
+  const json s = json::parse(read(stats));
+  CHECK(s.at("stopped") == "SIGTERM");
+  CHECK(s.at("t").get<double>() > 0.0);
+  CHECK(s.at("t").get<double>() < 1e-5);  // the first chunk, 2^14 predicted events, is 4.1e-7 s
+  CHECK(json::parse(read(state)).at("t") == s.at("t"));
+  // The log holds every event up to the stop: one line per collision (and none cut short).
+  CHECK(well_formed_lines(events) == s.at("collisions").get<std::size_t>());
+  CHECK(!has_temporaries(dir.path));
+
+  const auto start = std::chrono::steady_clock::now();
+  Spawned q(dir.path, with(args, {"--max-wall-seconds", "1"}));
+  const auto q_ended = q.wait_for(20);
+  REQUIRE(q_ended.has_value());
+  INFO(q.err());
+  CHECK(q_ended->code == 3);
+  CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(15));
+  CHECK(json::parse(read(stats)).at("stopped") == "max-wall-seconds");
+  CHECK(well_formed_lines(events) == json::parse(read(stats)).at("collisions").get<std::size_t>());
+
+  // --max-events is counted inside the advance too: exactly that many.
+  Spawned m(dir.path, with(args, {"--max-events", "5000"}));
+  const auto m_ended = m.wait_for(20);
+  REQUIRE(m_ended.has_value());
+  INFO(m.err());
+  CHECK(m_ended->code == 3);
+  CHECK(json::parse(read(stats)).at("events") == 5000);
 }

@@ -272,6 +272,19 @@ void WorldServer::Impl::drain_sim_events() {
 
 void WorldServer::run_until(double t) {
   Impl& s = *impl_;
+  // An engine stopped inside a step (an event limit, a stop poll) has logged up to its last event:
+  // that much reaches the log too.
+  auto advance = [&s](double to) {
+    try {
+      s.world.advance_to(to);
+    } catch (const sim::EventLimitReached&) {
+      s.drain_sim_events();
+      throw;
+    } catch (const sim::StopRequested&) {
+      s.drain_sim_events();
+      throw;
+    }
+  };
   for (;;) {
     if (!s.boundary_done) {
       s.control_step();
@@ -279,16 +292,21 @@ void WorldServer::run_until(double t) {
     }
     const double next = s.boundary_time(s.step + 1);
     if (next <= t) {
-      s.world.advance_to(next);
+      advance(next);
       s.drain_sim_events();
       ++s.step;
       s.boundary_done = false;
       continue;
     }
-    if (t > s.world.time()) s.world.advance_to(t);
+    if (t > s.world.time()) advance(t);
     s.drain_sim_events();
     return;
   }
+}
+
+void WorldServer::set_event_limit(std::uint64_t limit) { impl_->world.set_event_limit(limit); }
+void WorldServer::set_stop_poll(std::function<bool()> poll, std::uint64_t every) {
+  impl_->world.set_stop_poll(std::move(poll), every);
 }
 
 double WorldServer::time() const { return impl_->world.time(); }

@@ -175,7 +175,8 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
     auto game = std::make_unique<turtle::TagGame>(rules);
     const turtle::TagGame* tag = game.get();
     server.set_game(std::move(game));
-    server.run_until(options.until);
+    if (!options.play) server.run_until(options.until);
+    else if (!options.play(server, r)) break;  // stopped: the rounds so far are the tournament
     round.score = tag->tally(server.time());
 
     // Per controller, this round's values: its turtles' mean (a round is one sample).
@@ -224,11 +225,12 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
   };
   for (std::size_t i = 0; i < rows.size(); ++i)
     for (std::size_t j = i + 1; j < rows.size(); ++j) result.pairwise.push_back(compare_rows(rows[i], rows[j]));
-  if (options.rounds % c != 0) {
+  const std::size_t played = result.rounds.size();
+  if (played % c != 0) {
     std::string starts;
     for (const TournamentRow& row : rows)
       starts += (starts.empty() ? "" : ", ") + row.controller + " " + std::to_string(row.starts_it);
-    result.notes.push_back(std::to_string(options.rounds) + " rounds do not divide among " + std::to_string(c) +
+    result.notes.push_back(std::to_string(played) + " rounds do not divide among " + std::to_string(c) +
                            " controllers, so they do not start as \"it\" equally often (" + starts +
                            "); play a multiple of " + std::to_string(c) + " rounds");
   }
@@ -246,7 +248,7 @@ TournamentResult run_tag_tournament(const Scene& scene, const std::string& world
               ")";
       if (d > 0.0) {
         // The interval narrows as 1/sqrt(rounds): this many would make a difference this size stand out.
-        const double need = std::ceil(static_cast<double>(options.rounds) * (hw / d) * (hw / d) /
+        const double need = std::ceil(static_cast<double>(played) * (hw / d) * (hw / d) /
                                       static_cast<double>(c)) * static_cast<double>(c);
         note += "; a difference this size would need about " + number(need, 0) + " rounds";
       }
@@ -295,7 +297,7 @@ nlohmann::json to_json(const TournamentResult& result) {
     rounds.push_back({{"round", r.round}, {"seed", r.seed}, {"first_it", r.first_it}, {"it_at_end", r.score.it},
                       {"turtles", turtles}});
   }
-  return {{"format", "turtlegas-tag-tournament/1"},
+  nlohmann::json j = {{"format", "turtlegas-tag-tournament/1"},
           {"world", result.world},
           {"rounds", result.options.rounds},
           {"until", result.options.until},
@@ -307,6 +309,11 @@ nlohmann::json to_json(const TournamentResult& result) {
           {"pairwise", pairwise},
           {"notes", result.notes},
           {"round_results", rounds}};
+  if (!result.stopped.empty()) {  // a tournament cut short: what it played
+    j["stopped"] = result.stopped;
+    j["rounds_played"] = result.rounds.size();
+  }
+  return j;
 }
 
 std::string ranking_table(const TournamentResult& result) {

@@ -58,6 +58,7 @@
 #include <cmath>
 #include <concepts>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -106,10 +107,20 @@ class Engine final : public EngineBase {
     copy->heap_.rebind(copy->bodies_.nodes());
     copy->record_.log = nullptr;
     copy->record_.impulses = nullptr;
+    copy->stop_poll_ = nullptr;  // the caller's, like the logs
+    copy->arm_check();
     return copy;
   }
   void set_impulse_log(std::vector<Impulse>* log) override { record_.impulses = log; }
-  void set_event_limit(std::uint64_t limit) override { event_limit_ = limit; }
+  void set_event_limit(std::uint64_t limit) override {
+    event_limit_ = limit;
+    arm_check();
+  }
+  void set_stop_poll(std::function<bool()> poll, std::uint64_t every) override {
+    stop_poll_ = std::move(poll);
+    poll_every_ = std::max<std::uint64_t>(every, 1);
+    arm_check();
+  }
   double time() const override { return t_base_ + now_; }
   std::size_t ball_count() const override { return bodies_.balls(); }
   BallState ball(std::size_t i) const override {
@@ -284,6 +295,16 @@ class Engine final : public EngineBase {
   std::uint64_t events_since_rebase_ = 0;
   std::uint64_t rebase_every_ = 0;
   std::uint64_t event_limit_ = ~std::uint64_t{0};  ///< World::set_event_limit
+  std::function<bool()> stop_poll_;                 ///< World::set_stop_poll
+  std::uint64_t poll_every_ = 1;
+  /// The event count at which process() next looks at the limit and the poll: the one compare
+  /// per event that the limit alone used to cost, so a poll adds nothing to the loop itself.
+  std::uint64_t next_check_ = ~std::uint64_t{0};
+  void arm_check() {
+    next_check_ = stop_poll_ ? std::min(event_limit_, record_.stats.events + poll_every_) : event_limit_;
+  }
+  /// At next_check_: throws EventLimitReached or StopRequested, or sets the next check.
+  [[gnu::cold, gnu::noinline]] void check_stop();
   StepState step_;  ///< step mode only
 
   EventRecord record_;
@@ -401,9 +422,7 @@ bool Engine<F, kBallBall, kStep, kExtras>::process(double limit) {
       }
     }
     if (next_event > limit) break;
-    if (record_.stats.events >= event_limit_) [[unlikely]]
-      throw EventLimitReached("the event limit (" + std::to_string(event_limit_) + ") was reached at t = " +
-                              std::to_string(t_base_ + now_));
+    if (record_.stats.events >= next_check_) [[unlikely]] check_stop();
     const std::uint32_t i = heap_.top_id();
     now_ = heap_.top_key();
     ++record_.stats.events;
@@ -430,6 +449,15 @@ bool Engine<F, kBallBall, kStep, kExtras>::process(double limit) {
     }
   }
   return true;
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::check_stop() {
+  if (record_.stats.events >= event_limit_)
+    throw EventLimitReached("the event limit (" + std::to_string(event_limit_) + ") was reached at t = " +
+                            std::to_string(t_base_ + now_));
+  if (stop_poll_ && stop_poll_()) throw StopRequested("stopped by the poll at t = " + std::to_string(t_base_ + now_));
+  arm_check();
 }
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>

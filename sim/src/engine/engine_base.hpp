@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -18,6 +20,7 @@ class EngineBase {
   virtual void set_event_log(std::vector<Event>* log) = 0;
   virtual void set_impulse_log(std::vector<Impulse>* log) = 0;
   virtual void set_event_limit(std::uint64_t limit) = 0;
+  virtual void set_stop_poll(std::function<bool()> poll, std::uint64_t every) = 0;
   virtual double time() const = 0;
   virtual std::size_t ball_count() const = 0;
   virtual BallState ball(std::size_t i) const = 0;

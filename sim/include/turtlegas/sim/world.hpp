@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -35,6 +36,11 @@ struct Stats {
 
 /// World::advance_to ran into the bound set with World::set_event_limit.
 struct EventLimitReached : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// World::advance_to was stopped because the poll set with World::set_stop_poll returned true.
+struct StopRequested : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
@@ -152,6 +158,15 @@ class World {
   /// state at the time of the last event served, but the run cannot go on. For tests and fuzzing
   /// harnesses that must end whatever the scene does.
   void set_event_limit(std::uint64_t limit);
+
+  /// A way to stop a long advance_to from outside (a signal, a wall-clock limit: the caller's,
+  /// for sim/ has neither): `poll` is called after every `every` events served (at an event
+  /// boundary, before the next event), and when it returns true advance_to throws StopRequested.
+  /// The world is then as after EventLimitReached: consistent at the time of the last event
+  /// served (time() says which), its state, stats and logs whole up to there, but the run cannot
+  /// go on. It costs nothing per event: process() makes the one compare the event limit always
+  /// did. nullptr removes it. A copy() has none.
+  void set_stop_poll(std::function<bool()> poll, std::uint64_t every = 4096);
 
   double time() const;
   Mode mode() const;

@@ -133,7 +133,13 @@ class WorldServer {
 
   /// Runs control steps until time t (seconds). Throws BusyLoopError if a program hangs, and
   /// whatever the InputSource throws; after an exception the server must not be run further.
+  /// The engine's sim::EventLimitReached and sim::StopRequested (set_event_limit, set_stop_poll)
+  /// come through too, the event log then whole up to the last event served.
   void run_until(double t);
+  /// sim::World::set_event_limit and set_stop_poll on this server's world: bounds on a run that
+  /// hold inside a control step as well as at its boundaries.
+  void set_event_limit(std::uint64_t limit);
+  void set_stop_poll(std::function<bool()> poll, std::uint64_t every = 4096);
   double time() const;
   /// The index of the control boundary last reached (time() == step() * dt there; run_until(t)
   /// runs the programs of a boundary at t, and the physics stops at t).

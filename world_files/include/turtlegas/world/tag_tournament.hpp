@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -22,6 +23,10 @@ struct TournamentOptions {
   /// Per controller, params that every turtle running it gets on top of its own (--params
   /// name.key=value); a key here replaces the world file's.
   std::map<std::string, nlohmann::json> params;
+  /// Plays round `round` on `server` to `until` (unset: server.run_until(until)); false stops the
+  /// tournament there, that round not counted (the CLI's limits and Ctrl-C: the rounds played
+  /// are ranked and written).
+  std::function<bool(turtle::WorldServer& server, std::size_t round)> play;
 };
 
 /// A mean over rounds with its 95 % confidence interval: Student's t-interval over the per-round
@@ -83,6 +88,9 @@ struct TournamentResult {
   std::vector<TournamentRow> ranking;  ///< best first
   std::vector<Comparison> pairwise;    ///< every pair of the ranking, (i, j) for i < j in rank order
   std::vector<std::string> notes;      ///< ranks that cannot be told apart, unbalanced starts
+  /// Why the tournament stopped before its last round (the caller's word, for the JSON's
+  /// "stopped"), or empty; rounds.size() rounds were played.
+  std::string stopped;
 };
 
 /// The 0.975 quantile of Student's t with `df` degrees of freedom (df >= 1; fractional df, for

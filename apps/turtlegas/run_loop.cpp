@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: MIT
+#include "run_loop.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+
+
+namespace turtlegas::apps {
+
+Progress::Progress(double until)
+    : until_(until), total_(until), start_(Clock::now()), enabled_(::isatty(STDERR_FILENO) != 0) {}
+
+void Progress::set_part(double until, double offset, double total) {
+  until_ = until;
+  offset_ = offset;
+  total_ = total;
+}
+
+void Progress::update(double t, std::uint64_t events, const std::string& doing) {
+  if (!enabled_) return;
+  const auto now = Clock::now();
+  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  if (elapsed < 2.0 || now - last_ < std::chrono::milliseconds(200)) return;
+  const double done = offset_ + t;
+  if (!shown_) done0_ = done, events0_ = events, since_ = now;  // rates from the first line on
+  last_ = now;
+  const double span = std::chrono::duration<double>(now - since_).count();
+  const double pct = total_ > 0.0 ? 100.0 * done / total_ : 100.0;
+  const double rate = span > 0.0 ? static_cast<double>(events - events0_) / span : 0.0;
+  const double sim_rate = span > 0.0 ? (done - done0_) / span : 0.0;
+  const std::string eta = sim_rate > 0.0 ? human_duration((total_ - done) / sim_rate) : std::string("unknown");
+  std::fprintf(stderr, "\r\033[K  %st = %.6g / %.6g s  %5.1f%%  %.3g events/s  ETA %s ", doing.c_str(), t, until_, pct,
+               rate, eta.c_str());
+  std::fflush(stderr);
+  shown_ = true;
+}
+
+void Progress::clear() {
+  if (shown_) std::fputs("\r\033[K", stderr), std::fflush(stderr);
+  shown_ = false;
+}
+
+Pace first_pace(SceneScales scales, const sim::World& world, double natural) {
+  scales.set_cell(world.cell_size());
+  double first = natural;
+  if (scales.events_per_second > 0.0) first = std::min(first, 0x1p14 / scales.events_per_second);
+  return {std::max(first, std::numeric_limits<double>::denorm_min())};
+}
+
+const char* stop_name(Stopped s) {
+  switch (s.first) {
+    case Stop::until: return "";
+    case Stop::signal: return signal_name(s.second);
+    case Stop::max_wall_seconds: return "max-wall-seconds";
+    case Stop::max_events: return "max-events";
+  }
+  return "";
+}
+
+int exit_code_for(Stopped s) {
+  if (s.first == Stop::until) return exit_ok;
+  return s.first == Stop::signal ? exit_code_for(s.second) : exit_limit;
+}
+
+void LimitOptions::add_to(CLI::App& cmd, const std::string& what, const std::string& written) {
+  wall_option = cmd.add_option("--max-wall-seconds", max_wall_seconds,
+                               "Stop " + what + " cleanly after this much wall-clock time, " + written + " (exit 3)")
+                    ->check(real_in(0, 1e9, "seconds", true));
+  events_option = cmd.add_option("--max-events", max_events,
+                                 "Stop " + what + " cleanly once the engine has taken this many events, " + written +
+                                     " (exit 3)")
+                      ->check(integer_in(1, std::numeric_limits<std::int64_t>::max(), "events"));
+}
+
+std::optional<double> LimitOptions::wall_seconds() const {
+  if (wall_option && *wall_option) return max_wall_seconds;
+  return std::nullopt;
+}
+
+std::optional<std::uint64_t> LimitOptions::events() const {
+  if (events_option && *events_option) return max_events;
+  return std::nullopt;
+}
+
+}  // namespace turtlegas::apps
