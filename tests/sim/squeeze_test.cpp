@@ -616,3 +616,59 @@ TEST_CASE("the elastic slide down a tilted 2r slot is off by one constant speed,
     CHECK(w.measure_overlap().relative <= 1e-9);
   }
 }
+
+namespace {
+
+/// A pile pressed onto a held disc by a piston: a 300 x 200 walled arena, a V opening to the left
+/// with its apex at (290, 100) and a half-angle of 30°, a disc of radius 8 exactly at the apex
+/// (2 r from it) moving into it, `between` discs of radius 8 at rest on its axis, and a short
+/// piston (y from 90 to 110) sweeping from x = 20 to x = 290 in 10 s (27 units/s).
+WorldDef held_pile_scene(int between, double e) {
+  WorldDef d = box(300, 200);
+  d.effects.restitution = e;
+  const double h = M_PI / 6;
+  const Vec2 apex{290, 100};
+  d.walls.push_back({"vu", apex, apex + 150.0 * Vec2{-std::cos(h), std::sin(h)}});
+  d.walls.push_back({"vl", apex, apex + 150.0 * Vec2{-std::cos(h), -std::sin(h)}});
+  d.walls.push_back(moving("piston", {20, 90}, {20, 110}, {{10.0, {290, 90}, {290, 110}}}));
+  d.balls.push_back(ball("held", {290 - 16, 100}, {1, 0}, 8));
+  for (int k = 0; k < between; ++k) d.balls.push_back(ball("b" + std::to_string(k), {200 - 40.0 * k, 100}, {0, 0}, 8));
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("a piston pressing discs onto a disc held in a V crushes them against it, then it", "[squeeze]") {
+  // The held disc is as heavy as the V's walls. A disc the piston drives onto it slips into the
+  // corner between it and a wall, and the piston closes that corner: no velocity leaves all three
+  // (a wall, the held disc, the piston), so it is crushed there, when the piston is at
+  // x = 290 - 16 - 16 cos 30° - 8; the last disc left is crushed when the piston is r from the
+  // apex disc's place (246 / 27 s): the piston and the V's two walls leave it no way out. Before, the discs bounced
+  // between the three at one instant for ever (e = 0.5, both modes: the event limit).
+  for (Mode mode : kModes) {
+    for (int between : {1, 2}) {
+      INFO("mode " << (mode == Mode::exact ? "exact" : "step") << ", discs between " << between);
+      World w(held_pile_scene(between, 0.5), mode);
+      Run run;
+      double worst = 0.0;
+      w.set_event_log(&run.log);
+      w.set_event_limit(kLimit);
+      for (int k = 1; k <= 120; ++k) {
+        REQUIRE_NOTHROW(w.advance_to(0.1 * k));
+        worst = std::max(worst, w.measure_overlap().relative);
+      }
+      CHECK(worst <= 1e-9);
+      CHECK(w.max_contact_overlap().relative <= 1e-9);
+      CHECK(w.stats().events < 2000);
+      REQUIRE(run.count(EventKind::crushed) == static_cast<std::size_t>(between + 1));
+      const double corner = (290 - 16 - 16 * std::cos(M_PI / 6) - 8 - 20) / 27.0;
+      std::vector<const Event*> crushed;
+      for (const Event& ev : run.log)
+        if (ev.kind == EventKind::crushed) crushed.push_back(&ev);
+      // `between` crushes in the corners, then the last disc between the piston and the V.
+      for (int k = 0; k < between; ++k) CHECK(crushed[k]->t == Approx(corner).epsilon(1e-9));
+      CHECK(crushed.back()->t == Approx(246.0 / 27.0).epsilon(1e-9));
+      for (std::size_t i = 0; i < w.ball_count(); ++i) CHECK_FALSE(w.ball(i).alive);
+    }
+  }
+}

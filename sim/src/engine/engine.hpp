@@ -485,8 +485,12 @@ void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
       } else {
         // A ball the squeeze rule holds, pushed into its holders, is as heavy as they are.
         if (!bodies_.held.empty()) [[unlikely]] {
-          if (push_held(parts(), i, p.partner)) {
-            served({i, p.partner});
+          const LastPartner before_partner = bodies_.last[p.partner];
+          if (const std::uint32_t o = push_held(parts(), i, p.partner); o != kNone) {
+            // The pusher met an obstacle of infinite mass: the squeeze rule answers it.
+            const std::uint32_t k = o == i ? p.partner : i;
+            if (squeezed(o, o == i ? before : before_partner)) repredict(o);
+            repredict(k);
             return;
           }
         }
@@ -529,7 +533,7 @@ void Engine<F, kBallBall, kStep, kExtras>::crush(std::uint32_t i, const Side& A,
   const bool turtle = is_turtle(i);
   const std::uint32_t nb = bodies_.balls();
   record_.note(t_base_ + now_, EventKind::crushed, turtle ? i - nb : i, A.name, B.name,
-               static_cast<std::uint8_t>((turtle ? kTurtleA : 0) | (A.turtle ? kTurtleB : 0) | (B.turtle ? kTurtleC : 0)));
+               squeeze_flags(turtle, A, B));
   ++record_.stats.crushed;
   unlink(i);
   Body& b = bodies_.body[i];

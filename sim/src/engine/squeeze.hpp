@@ -12,6 +12,9 @@
 //      the body stays between them until then (flying straight), no sequence of bounces can save
 //      it: it stops bouncing and rides on B (its velocity along the normal becomes B's), meets A
 //      at now + g/c, and is crushed there by rule 1.
+// A ball the rule holds is an obstacle of infinite mass too (still_held), and rule 1 also counts
+// the other obstacle of the body's last hold if it still touches it: with three, no velocity
+// leaving all of them (leave_all) means a crush.
 // A `wedged` event marks a velocity the rule set; `crushed` the removal (the engine's crush()).
 // A body held by rule 1 keeps the pair in BodyStore::held, so that the round-off of a velocity
 // that should leave both exactly tangent cannot make it meet them again: while its course is
@@ -47,12 +50,35 @@ struct Side {
   double gap = 0.0;      ///< distance from the obstacle minus the contact distance
   std::uint32_t name = 0;  ///< the wall's index, or the turtle's
   bool turtle = false;
+  bool ball = false;     ///< a ball the rule holds (still_held): as heavy as its holders
   std::uint32_t mover = kNone;  ///< the moving wall it is (or belongs to)
   Segment seg;           ///< a wall's segment now (interior only)
 };
 
 template <Flight Fl, bool kStep, bool kExtras>
-Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner who) {
+Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner who, int depth = 0);
+
+/// Whether ball k is held by the rule (docs/physics.md, "Discs squeezed by discs"): its mark is
+/// current (its course, and that of a turtle or ball among its holders, unchanged since) and it
+/// still touches both holders. Such a ball is as heavy as they are. A held ball among k's holders
+/// is taken on its mark alone (depth 1), so that a ring of marks cannot recurse.
+template <Flight Fl, bool kStep, bool kExtras>
+bool still_held(const Parts<Fl, kStep, kExtras>& p, std::uint32_t k, int depth = 0) {
+  const BodyStore& bs = p.bodies;
+  if (bs.held.empty()) return false;
+  const BodyStore::Held& h = bs.held[k];
+  if (h.a.is_none() || h.b.is_none() || h.count != bs.body[k].count || bs.body[k].cell == kNone) return false;
+  // (A turtle or ball obstacle that has changed course since may have let go.)
+  for (const LastPartner who : {h.a, h.b})
+    if (who.kind() == Partner::body && bs.body[who.index()].count != (who == h.a ? h.count_a : h.count_b)) return false;
+  if (depth > 0) return true;
+  p.sync(k);
+  const Side A = side_of(p, k, h.a, depth + 1), B = side_of(p, k, h.b, depth + 1);
+  return A.ok && B.ok && A.gap <= held_gap(bs.body[k]) && B.gap <= held_gap(bs.body[k]);
+}
+
+template <Flight Fl, bool kStep, bool kExtras>
+Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner who, int depth) {
   Side s;
   if (who.is_none()) return s;
   const Body& a = p.bodies.body[i];
@@ -60,7 +86,9 @@ Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner wh
   switch (who.kind()) {
     case Partner::none: return s;
     case Partner::body: {
-      if (!p.is_turtle(k) || p.bodies.body[k].cell == kNone) return s;  // a ball has a finite mass
+      if (p.bodies.body[k].cell == kNone) return s;
+      // A ball has a finite mass, unless the rule holds it.
+      if (!p.is_turtle(k) && (depth > 1 || !still_held(p, k, depth))) return s;
       const Body& t = p.bodies.body[k];
       const Vec2 F = p.arena.min_image(a.x - (t.x + (p.now - t.t) * t.v));
       const double dist = norm(F);
@@ -73,8 +101,10 @@ Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner wh
       if (Vec2 vc; p.carried(k, vc)) s.u = vc;
       else if (dot(t.v, F) > 0.0) s.u = {};
       s.gap = dist - a.r - t.r;
-      s.name = k - p.bodies.balls();
-      s.turtle = true;
+      s.turtle = p.is_turtle(k);
+      s.ball = !s.turtle;
+      if (s.ball) s.u = t.v;  // a held ball moves only along both its holders
+      s.name = s.turtle ? k - p.bodies.balls() : k;
       s.point = true;
       s.at = a.x - F;
       break;
@@ -134,6 +164,58 @@ Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner wh
 
 enum class Squeeze : std::uint8_t { none, wedged, crushed };
 
+/// The squeeze events' flags: which of the body and its two obstacles are turtles, or held balls.
+inline std::uint8_t squeeze_flags(bool turtle, const Side& A, const Side& B) {
+  return static_cast<std::uint8_t>((turtle ? kTurtleA : 0) | (A.turtle ? kTurtleB : 0) | (B.turtle ? kTurtleC : 0) |
+                                   (A.ball ? kBallB : 0) | (B.ball ? kBallC : 0));
+}
+
+/// An obstacle of body i's last hold mark other than a and b that it still touches (its mark's
+/// course may have changed since: what counts is that it is still there).
+template <Flight Fl, bool kStep, bool kExtras>
+Side third_side(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner a, LastPartner b) {
+  if (p.bodies.held.empty()) return {};
+  const BodyStore::Held& h = p.bodies.held[i];
+  for (const LastPartner c : {h.a, h.b}) {
+    if (c.is_none() || c == a || c == b) continue;
+    const Side C = side_of(p, i, c);
+    if (C.ok && C.gap <= held_gap(p.bodies.body[i])) return C;
+  }
+  return {};
+}
+
+/// The velocity nearest v0 that leaves every obstacle in `sides` ((v - u) . n >= 0 for each, to
+/// round-off): v0 itself, v0 brought onto one contact, or onto two at once. False when there is
+/// none: the obstacles close on the body from every side, and it is crushed.
+inline bool leave_all(Vec2 v0, std::initializer_list<Side> sides, Vec2& v) {
+  double scale = norm(v0);
+  for (const Side& s : sides) scale = std::max(scale, norm(s.u));
+  const double tol = 1e-12 * scale;
+  auto leaves = [&](Vec2 w) {
+    for (const Side& s : sides)
+      if (dot(w - s.u, s.n) < -tol) return false;
+    return true;
+  };
+  bool found = false;
+  double best = 0.0;
+  auto offer = [&](Vec2 w) {
+    if (!leaves(w)) return;
+    const double d = norm2(w - v0);
+    if (!found || d < best) v = w, best = d, found = true;
+  };
+  offer(v0);
+  if (found) return true;
+  for (const Side& s : sides) offer(v0 + (dot(s.u, s.n) - dot(v0, s.n)) * s.n);
+  for (auto x = sides.begin(); x != sides.end(); ++x)
+    for (auto y = x + 1; y != sides.end(); ++y) {
+      const double det = cross(x->n, y->n);
+      if (std::abs(det) <= kParallel) continue;
+      const double cx = dot(x->u, x->n), cy = dot(y->u, y->n);
+      offer({(cx * y->n.y - cy * x->n.y) / det, (cy * x->n.x - cx * y->n.x) / det});
+    }
+  return found;
+}
+
 /// Whether the body's centre stays over segment s (foot strictly inside) from now to now + tau,
 /// flying straight at v while s translates at u: the foot is linear in time, so both ends suffice.
 inline bool stays_over(Vec2 x, Vec2 v, const Side& s, double tau) {
@@ -172,7 +254,16 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
   Vec2 v = v0;
   bool held = true;
   if (A.gap <= held_gap(body)) {
-    // 1. Held between A and B.
+    // 1. Held between A and B, and a third obstacle it was held by before, if it still touches
+    // that one too (a disc jammed between a wall, a held disc and a piston).
+    if (p.motion.straight(i)) {
+      const Side C = third_side(p, i, a, b);
+      if (C.ok) {
+        if (!leave_all(v0, {A, B, C}, v)) return Squeeze::crushed;
+        if (v == v0) return Squeeze::none;
+        goto done;
+      }
+    }
     const double ra = dot(v0 - A.u, A.n), rb = dot(v0 - B.u, B.n);
     if (ra >= 0.0 && rb >= 0.0) return Squeeze::none;  // it leaves both already
     if (parallel) {
@@ -248,46 +339,48 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
     if (!keeps(A, B) || !keeps(B, A)) return Squeeze::none;
     held = false;  // it must meet A at t*: no mark
   }
+done:
   body.v = v;
   const std::uint32_t nb = p.bodies.balls();
   const bool turtle = p.is_turtle(i);
   p.record.note(p.t_base + p.now, EventKind::wedged, turtle ? i - nb : i, A.name, B.name,
-                static_cast<std::uint8_t>((turtle ? kTurtleA : 0) | (A.turtle ? kTurtleB : 0) | (B.turtle ? kTurtleC : 0)));
+                squeeze_flags(turtle, A, B));
   ++p.record.stats.wedged;
   if (held) p.bodies.hold(i, a, b, p.now, p.motion.straight(i));
   return Squeeze::wedged;
 }
 
-/// Discs squeezed by discs: a ball held by the rule between two obstacles (its course unchanged
-/// since, still touching both) that another ball pushes into both of them at once cannot move
-/// that way: it is as heavy as they are. The pusher bounces off it as off an obstacle of infinite
-/// mass moving at its velocity (with the rest threshold, so a pile rests on a wedged disc as on a
-/// wall); the held ball keeps its course and its mark. Returns false (nothing done) when neither
-/// ball is so held, or the push has a component that one obstacle alone would let it take.
+/// Discs squeezed by discs: a ball held by the rule between two obstacles (still_held) that
+/// another ball pushes into them (the push, along the line of centres, is a sum of their normals
+/// turned against it: it can take no part of it) cannot move that way: it is as heavy as they are.
+/// The pusher bounces off it as off an obstacle of infinite mass moving at its velocity (with the
+/// rest threshold, so a pile rests on a wedged disc as on a wall); the held ball keeps its course
+/// and its mark. Returns the pusher, whose contact the squeeze rule then answers like any contact
+/// with an obstacle of infinite mass, or kNone (nothing done) when neither ball is so held, or
+/// the push has a component that the obstacles would let it take.
 /// (Without it, a disc pressed onto a disc wedged in a V exchanged round-off velocities of 1e-19
 /// with it and the walls for ever at one instant, in step mode.)
 template <Flight Fl, bool kStep, bool kExtras>
-[[gnu::noinline, gnu::cold]] bool push_held(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t j) {
+[[gnu::noinline, gnu::cold]] std::uint32_t push_held(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t j) {
   // (Out of line and cold: inlined into the ball-ball path it changed GCC's inlining of the
   // engine's loop and cost 1.25 % more instructions on a gas that never squeezes.)
   const BodyStore& bs = p.bodies;
   auto holds = [&](std::uint32_t k, std::uint32_t other) {
-    const BodyStore::Held& h = bs.held[k];
-    if (h.a.is_none() || h.b.is_none() || h.count != bs.body[k].count) return false;
-    // (A turtle obstacle that has changed course since may have let go.)
-    for (const LastPartner who : {h.a, h.b})
-      if (who.kind() == Partner::body && bs.body[who.index()].count != (who == h.a ? h.count_a : h.count_b)) return false;
-    p.sync(k);
+    if (!still_held(p, k)) return false;
     p.sync(other);
-    const Side A = side_of(p, k, h.a), B = side_of(p, k, h.b);
-    const Body& bk = bs.body[k];
-    if (!A.ok || !B.ok || A.gap > held_gap(bk) || B.gap > held_gap(bk)) return false;
-    const Vec2 d = p.arena.min_image(bk.x - bs.body[other].x);  // the way `other` pushes k
-    return dot(d, A.n) < 0.0 && dot(d, B.n) < 0.0;
+    const BodyStore::Held& h = bs.held[k];
+    const Side A = side_of(p, k, h.a, 1), B = side_of(p, k, h.b, 1);
+    const Vec2 d = p.arena.min_image(bs.body[k].x - bs.body[other].x);  // the way `other` pushes k
+    // d = -(alpha n_A + beta n_B) with alpha, beta >= 0 (to round-off): the holders take all of it.
+    const double det = cross(A.n, B.n);
+    if (std::abs(det) <= kParallel) return dot(d, A.n) < 0.0 && dot(d, B.n) < 0.0;
+    const double alpha = -cross(d, B.n) / det, beta = -cross(A.n, d) / det;
+    const double tol = -kParallel * norm(d);
+    return alpha >= tol && beta >= tol;
   };
   std::uint32_t k = j, other = i;
   if (!holds(j, i)) {
-    if (!holds(i, j)) return false;
+    if (!holds(i, j)) return kNone;
     k = i;
     other = j;
   }
@@ -305,7 +398,7 @@ template <Flight Fl, bool kStep, bool kExtras>
   p.note(EventKind::ball_ball, i, j);
   p.changed(other);
   p.bodies.last[other] = LastPartner::of(Partner::body, k);
-  return true;
+  return other;
 }
 
 }  // namespace

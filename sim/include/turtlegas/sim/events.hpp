@@ -23,8 +23,9 @@ enum class EventKind : std::uint8_t {
   crushed,  ///< two obstacles closing on the body left it no room: it is removed
 };
 
-/// Event::flags bits: which of a, b and c index turtles (the squeeze events only).
-inline constexpr std::uint8_t kTurtleA = 1, kTurtleB = 2, kTurtleC = 4;
+/// Event::flags bits: which of a, b and c index turtles (the squeeze events only), and which of
+/// b and c index balls (a ball the squeeze rule holds is an obstacle too); the others are walls.
+inline constexpr std::uint8_t kTurtleA = 1, kTurtleB = 2, kTurtleC = 4, kBallB = 8, kBallC = 16;
 
 /// True for the kinds whose `a` is always a turtle.
 constexpr bool involves_turtle(EventKind k) { return k >= EventKind::turtle_wall && k <= EventKind::turtle_ball; }
@@ -53,7 +54,7 @@ struct Event {
   std::uint32_t a = 0;
   std::uint32_t b = 0;
   std::uint32_t c = 0;      ///< the squeeze events' second obstacle (0 otherwise)
-  std::uint8_t flags = 0;   ///< the squeeze events: kTurtleA | kTurtleB | kTurtleC
+  std::uint8_t flags = 0;   ///< the squeeze events: kTurtleA | kTurtleB | kTurtleC | kBallB | kBallC
 };
 
 }  // namespace turtlegas::sim

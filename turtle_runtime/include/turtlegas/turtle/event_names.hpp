@@ -45,11 +45,12 @@ EventIds name_event(const sim::Event& e, const Names& names) {
     // The body, then the two obstacles it was held between (flags: which are turtles).
     case sim::EventKind::wedged:
     case sim::EventKind::crushed: {
-      auto body = [&](std::uint32_t i, std::uint8_t bit) -> std::string_view {
-        return (e.flags & bit) != 0 ? std::string_view(names.turtle(i)) : std::string_view(names.wall(i));
+      auto body = [&](std::uint32_t i, std::uint8_t turtle, std::uint8_t ball) -> std::string_view {
+        if ((e.flags & turtle) != 0) return std::string_view(names.turtle(i));
+        return (e.flags & ball) != 0 ? std::string_view(names.ball(i)) : std::string_view(names.wall(i));
       };
       return {(e.flags & sim::kTurtleA) != 0 ? std::string_view(names.turtle(e.a)) : std::string_view(names.ball(e.a)),
-              body(e.b, sim::kTurtleB), body(e.c, sim::kTurtleC)};
+              body(e.b, sim::kTurtleB, sim::kBallB), body(e.c, sim::kTurtleC, sim::kBallC)};
     }
     default: return {names.turtle(e.a), other_body(e.kind, e.b, names), std::nullopt};
   }
