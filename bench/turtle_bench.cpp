@@ -58,14 +58,19 @@ double switch_ns(std::size_t stack_bytes) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   int turtles = 10000;
   int steps = 300;
   std::string controller = "wander";
   sim::Mode mode = sim::Mode::exact;
   std::size_t stack_kib = 32;
-  for (int k = 1; k + 1 < argc; k += 2) {
-    const std::string a = argv[k], v = argv[k + 1];
+  for (int k = 1; k < argc; k += 2) {
+    const std::string a = argv[k];
+    if (k + 1 == argc) {
+      std::cerr << "turtle_bench: " << a << " needs a value\n";
+      return 2;
+    }
+    const std::string v = argv[k + 1];
     if (a == "--turtles") turtles = std::stoi(v);
     else if (a == "--steps") steps = std::stoi(v);
     else if (a == "--controller") controller = v;
@@ -120,4 +125,15 @@ int main(int argc, char** argv) {
       {"max_overlap_relative", server.world().measure_overlap().relative},
   };
   std::cout << out.dump() << "\n";
+  return 0;
+}
+
+// std::stoi and friends throw on a malformed number; say so rather than terminate.
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "turtle_bench: " << e.what() << "\n";
+    return 2;
+  }
 }

@@ -23,13 +23,18 @@
 
 using namespace turtlegas;
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   int turtles = 1000;
   double turtle_steps = 1e7;
   double check_every = 1e6;
   sim::Mode mode = sim::Mode::exact;
-  for (int k = 1; k + 1 < argc; k += 2) {
-    const std::string a = argv[k], v = argv[k + 1];
+  for (int k = 1; k < argc; k += 2) {
+    const std::string a = argv[k];
+    if (k + 1 == argc) {
+      std::cerr << "turtle_soak: " << a << " needs a value\n";
+      return 2;
+    }
+    const std::string v = argv[k + 1];
     if (a == "--turtles") turtles = std::stoi(v);
     else if (a == "--turtle-steps") turtle_steps = std::stod(v);
     else if (a == "--check-every") check_every = std::stod(v);
@@ -107,4 +112,14 @@ int main(int argc, char** argv) {
   };
   std::cout << summary.dump() << "\n";
   return ok && faults == 0 ? 0 : 1;
+}
+
+// std::stoi and friends throw on a malformed number; say so rather than terminate.
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "turtle_soak: " << e.what() << "\n";
+    return 2;
+  }
 }
