@@ -128,12 +128,4 @@ int run(int argc, char** argv) {
   return 0;
 }
 
-// std::stoi and friends throw on a malformed number; say so rather than terminate.
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "turtle_bench: " << e.what() << "\n";
-    return 2;
-  }
-}
+int main(int argc, char** argv) { return turtlegas::bench::run_with_exit_codes("turtle_bench", run, argc, argv); }

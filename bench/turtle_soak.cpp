@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_common.hpp"
 #include "turtle_lattice.hpp"
 #include "turtlegas/controllers/registry.hpp"
 #include "turtlegas/sim/mode_names.hpp"
@@ -114,12 +115,4 @@ int run(int argc, char** argv) {
   return ok && faults == 0 ? 0 : 1;
 }
 
-// std::stoi and friends throw on a malformed number; say so rather than terminate.
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "turtle_soak: " << e.what() << "\n";
-    return 2;
-  }
-}
+int main(int argc, char** argv) { return turtlegas::bench::run_with_exit_codes("turtle_soak", run, argc, argv); }
