@@ -51,6 +51,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -138,7 +139,9 @@ Options parse_options(int argc, char** argv) {
     } else if (arg == "--state-dir") {
       o.state_dir = value();
     } else if (arg == "-h" || arg == "--help") {
-      usage.error("accuracy_bench: accuracy against CPU time, exact and step mode");
+      std::cout << "accuracy_bench: accuracy against CPU time, exact and step mode\n";
+      usage.print(std::cout);
+      std::exit(0);  // (nothing is open yet)
     } else {
       usage.error("unknown argument '" + std::string(arg) + "'");
     }

@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -113,9 +114,7 @@ Options parse_options(int argc, char** argv) {
       return argv[++k];
     };
     if (arg == "--mode") {
-      const std::string m = value();
-      if (const auto mode = sim::mode_from_string(m)) o.mode = *mode;
-      else usage.error("--mode must be exact or step, got '" + m + "'");
+      o.mode = mode_option(usage, value());
     } else if (arg == "--collisions") {
       o.collisions = static_cast<std::uint64_t>(usage.positive(arg, value()));
     } else if (arg == "--sim-seconds") {
@@ -127,7 +126,9 @@ Options parse_options(int argc, char** argv) {
     } else if (arg == "--max-wall") {
       o.max_wall = usage.positive(arg, value());
     } else if (arg == "-h" || arg == "--help") {
-      usage.error("gas_bench: throughput and memory of one world file");
+      std::cout << "gas_bench: throughput and memory of one world file\n";
+      usage.print(std::cout);
+      std::exit(0);  // (nothing is open yet)
     } else if (!arg.empty() && arg[0] == '-') {
       usage.error("unknown option '" + std::string(arg) + "'");
     } else if (have_world) {

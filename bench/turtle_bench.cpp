@@ -64,23 +64,16 @@ int run(int argc, char** argv) {
   std::string controller = "wander";
   sim::Mode mode = sim::Mode::exact;
   std::size_t stack_kib = 32;
-  for (int k = 1; k < argc; k += 2) {
-    const std::string a = argv[k];
-    if (k + 1 == argc) {
-      std::cerr << "turtle_bench: " << a << " needs a value\n";
-      return 2;
-    }
-    const std::string v = argv[k + 1];
-    if (a == "--turtles") turtles = std::stoi(v);
-    else if (a == "--steps") steps = std::stoi(v);
+  const bench::Usage usage("turtle_bench [--turtles N] [--steps S] [--controller NAME] [--mode exact|step] [--stack-kib K]");
+  const bool go = bench::for_each_option(argc, argv, usage, [&](const std::string& a, const std::string& v) {
+    if (a == "--turtles") turtles = static_cast<int>(usage.whole(a, v, 1, 10000000));
+    else if (a == "--steps") steps = static_cast<int>(usage.whole(a, v, 1, 100000000));
     else if (a == "--controller") controller = v;
-    else if (a == "--mode") mode = sim::mode_from_string(v).value_or(sim::Mode::exact);
-    else if (a == "--stack-kib") stack_kib = std::stoul(v);
-    else {
-      std::cerr << "turtle_bench: unknown option " << a << "\n";
-      return 2;
-    }
-  }
+    else if (a == "--mode") mode = bench::mode_option(usage, v);
+    else if (a == "--stack-kib") stack_kib = static_cast<std::size_t>(usage.whole(a, v, 16, 1048576));
+    else usage.error("unknown option " + a);
+  });
+  if (!go) return 0;
   const long rss0 = status_kib("VmRSS");
 
   const auto [def, programs] = bench::turtle_lattice(turtles, "turtle bench", 1, controller);

@@ -29,22 +29,15 @@ int run(int argc, char** argv) {
   double turtle_steps = 1e7;
   double check_every = 1e6;
   sim::Mode mode = sim::Mode::exact;
-  for (int k = 1; k < argc; k += 2) {
-    const std::string a = argv[k];
-    if (k + 1 == argc) {
-      std::cerr << "turtle_soak: " << a << " needs a value\n";
-      return 2;
-    }
-    const std::string v = argv[k + 1];
-    if (a == "--turtles") turtles = std::stoi(v);
-    else if (a == "--turtle-steps") turtle_steps = std::stod(v);
-    else if (a == "--check-every") check_every = std::stod(v);
-    else if (a == "--mode") mode = sim::mode_from_string(v).value_or(sim::Mode::exact);
-    else {
-      std::cerr << "turtle_soak: unknown option " << a << "\n";
-      return 2;
-    }
-  }
+  const bench::Usage usage("turtle_soak [--turtles N] [--turtle-steps S] [--check-every K] [--mode exact|step]");
+  const bool go = bench::for_each_option(argc, argv, usage, [&](const std::string& a, const std::string& v) {
+    if (a == "--turtles") turtles = static_cast<int>(usage.whole(a, v, 1, 1000000));
+    else if (a == "--turtle-steps") turtle_steps = usage.positive(a, v);
+    else if (a == "--check-every") check_every = usage.positive(a, v);
+    else if (a == "--mode") mode = bench::mode_option(usage, v);
+    else usage.error("unknown option " + a);
+  });
+  if (!go) return 0;
   // Turtles of radius 5 on a lattice 30 apart, wandering with random turns; three interior bars.
   // (Not a structured binding: the check below captures def, which clang 14 cannot do with one.)
   const bench::TurtleLattice lattice = bench::turtle_lattice(turtles, "turtle soak", 17, "wander");
