@@ -28,7 +28,7 @@ constexpr bool kSanitized = true;
 constexpr bool kSanitized = false;
 #endif
 
-TurtleProgram program(std::string controller, std::string params = "{}") {
+TurtleProgram program(std::string controller, const std::string& params = "{}") {
   TurtleProgram p;
   p.controller = std::move(controller);
   p.params = nlohmann::json::parse(params);

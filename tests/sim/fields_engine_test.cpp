@@ -554,6 +554,7 @@ RefRun field_reference(const WorldDef& def, double t_end) {
   if (def.arena.boundary == Boundary::walls)
     for (auto& w : arena_walls(def.arena)) wall_defs.push_back(w);
   std::vector<Segment> walls;
+  walls.reserve(wall_defs.size());
   for (const auto& w : wall_defs) walls.push_back(make_segment(w.from, w.to));
   struct End {
     Vec2 p;

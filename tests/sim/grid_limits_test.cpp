@@ -262,6 +262,7 @@ TEST_CASE("the overlap measure finds the same pairs with narrow and wide cell in
   for (double origin : {0.0, 2.0 * 0x1p30 - 600.0, 2.0 * 0x1p30 + 600.0, 1e12}) {
     INFO("origin " << origin);
     std::vector<Vec2> pos;
+    pos.reserve(200);
     for (int k = 0; k < 200; ++k) {
       const int row = k / 20, col = k % 20;
       pos.push_back({origin + 3.0 * col, 3.0 * row});
