@@ -589,6 +589,7 @@ OnTerminal run_on_terminal(const fs::path& dir, const std::vector<std::string>& 
   if (pid == 0) {
     ::chdir(dir.c_str());
     std::vector<char*> argv;
+    argv.reserve(argv_s.size() + 1);
     for (std::string& a : argv_s) argv.push_back(a.data());
     argv.push_back(nullptr);
     ::execv(argv[0], argv.data());

@@ -16,7 +16,7 @@ using turtlegas::test::body;
 
 namespace {
 
-TurtleProgram script(std::string commands, bool builder = false) {
+TurtleProgram script(const std::string& commands, bool builder = false) {
   TurtleProgram p;
   p.params = nlohmann::json::parse(R"({"commands": )" + commands + "}");
   p.builder = builder;

@@ -20,7 +20,7 @@ using turtlegas::test::body;
 
 namespace {
 
-TurtleProgram script(std::string commands) {
+TurtleProgram script(const std::string& commands) {
   TurtleProgram p;
   p.controller = "script";
   p.params = nlohmann::json::parse(R"({"commands": )" + commands + "}");

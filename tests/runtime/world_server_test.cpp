@@ -28,7 +28,7 @@ constexpr bool kSanitized = true;
 constexpr bool kSanitized = false;
 #endif
 
-TurtleProgram program(std::string controller, std::string params = "{}") {
+TurtleProgram program(std::string controller, const std::string& params = "{}") {
   TurtleProgram p;
   p.controller = std::move(controller);
   p.params = nlohmann::json::parse(params);
@@ -342,8 +342,10 @@ TEST_CASE("where a run is cut into run_until calls does not change it", "[runtim
     sim::WorldDef d = arena();
     d.arena.width = d.arena.height = 1000;
     const Registry r = with_random_walk();
-    for (int k = 0; k < 400; ++k)
-      d.turtles.push_back(body("t" + std::to_string(k), {25.0 + 48 * (k % 20), 25.0 + 48 * (k / 20)}, 37.0 * k));
+    for (int k = 0; k < 400; ++k) {
+      const int row = k / 20, col = k % 20;
+      d.turtles.push_back(body("t" + std::to_string(k), {25.0 + 48 * col, 25.0 + 48 * row}, 37.0 * k));
+    }
     for (auto& t : d.turtles) t.radius = 8;
     std::vector<TurtleProgram> programs(d.turtles.size(), program("random_walk"));
     WorldServer s(d, programs, r);

@@ -18,7 +18,7 @@ namespace {
 constexpr std::uint64_t kSeed = 20261214;
 constexpr double kEps = 2.220446049250313e-16;
 
-double mp_dist(field_oracle::V2<Mp> a, Vec2 b) {
+double mp_dist(const field_oracle::V2<Mp>& a, Vec2 b) {
   const Mp dx = a.x - Mp(b.x), dy = a.y - Mp(b.y);
   return static_cast<double>(boost::multiprecision::sqrt(dx * dx + dy * dy));
 }

@@ -63,7 +63,7 @@ State<T> textbook(V2<T> x0, const FieldFlight& f, T t) {
 }
 
 // 50 digits. w == 0: the parabola.
-inline State<Mp> mp_state(Vec2 x0, const FieldFlight& f, Mp t) {
+inline State<Mp> mp_state(Vec2 x0, const FieldFlight& f, const Mp& t) {
   if (f.w == 0.0) {
     const V2<Mp> v0 = lift<Mp>(f.v), a = lift<Mp>(f.a);
     return {lift<Mp>(x0) + t * v0 + (t * t / 2) * a, v0 + t * a};

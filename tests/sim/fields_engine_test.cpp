@@ -252,9 +252,11 @@ TEST_CASE("a translating wall under B is met in its own frame (E' = E + u x B)",
   // A vertical wall sweeping right at 1 unit/s, then back, through a cloud of gyrating charges.
   d.walls.push_back(moving("piston", {20.0, 5.0}, {20.0, 95.0},
                            {{60.0, {80.0, 5.0}, {80.0, 95.0}}, {120.0, {20.0, 5.0}, {20.0, 95.0}}}));
-  for (int k = 0; k < 30; ++k)
-    d.balls.push_back(charged("p" + std::to_string(k), {30.0 + 5.0 * (k % 10), 20.0 + 25.0 * (k / 10)},
+  for (int k = 0; k < 30; ++k) {
+    const int row = k / 10, col = k % 10;
+    d.balls.push_back(charged("p" + std::to_string(k), {30.0 + 5.0 * col, 20.0 + 25.0 * row},
                               {std::cos(k * 1.3), std::sin(k * 1.3)}, 0.8, 1.0, 1.5));
+  }
   World world(d, Mode::exact);
   for (int s = 1; s <= 120; ++s) {
     world.advance_to(s);
@@ -552,6 +554,7 @@ RefRun field_reference(const WorldDef& def, double t_end) {
   if (def.arena.boundary == Boundary::walls)
     for (auto& w : arena_walls(def.arena)) wall_defs.push_back(w);
   std::vector<Segment> walls;
+  walls.reserve(wall_defs.size());
   for (const auto& w : wall_defs) walls.push_back(make_segment(w.from, w.to));
   struct End {
     Vec2 p;

@@ -262,7 +262,11 @@ TEST_CASE("the overlap measure finds the same pairs with narrow and wide cell in
   for (double origin : {0.0, 2.0 * 0x1p30 - 600.0, 2.0 * 0x1p30 + 600.0, 1e12}) {
     INFO("origin " << origin);
     std::vector<Vec2> pos;
-    for (int k = 0; k < 200; ++k) pos.push_back({origin + 3.0 * (k % 20), 3.0 * (k / 20)});
+    pos.reserve(200);
+    for (int k = 0; k < 200; ++k) {
+      const int row = k / 20, col = k % 20;
+      pos.push_back({origin + 3.0 * col, 3.0 * row});
+    }
     pos[137] = pos[136] + Vec2{1.75, 0.0};  // radius 1: overlap 0.25, moved left onto its neighbour
     detail::DiscView discs{pos.size(), [&](std::size_t i) { return pos[i]; }, [](std::size_t) { return 1.0; },
                            [](std::size_t) { return true; }};

@@ -56,7 +56,8 @@ TEST_CASE("touching pairs at 400 orientations, moving along their tangent, never
     };
     for (int n = 0; n < 400;) {
       const double th = 2 * 3.141592653589793 * uniform();
-      const Vec2 o{10 + (n / 20) * 20 + uniform(), 10 + (n % 20) * 20 + uniform()};
+      const int row = n / 20, col = n % 20;
+      const Vec2 o{10 + row * 20 + uniform(), 10 + col * 20 + uniform()};
       const Vec2 p{o.x + std::cos(th), o.y + std::sin(th)};
       if (norm2(p - o) < 1.0) continue;
       const Vec2 v{-2 * std::sin(th), 2 * std::cos(th)};

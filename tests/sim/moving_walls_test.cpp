@@ -41,7 +41,8 @@ TEST_CASE("a piston compressing a dilute gas heats it as the adiabatic law says 
   std::mt19937_64 rng(81);
   auto uniform = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
   for (int k = 0; k < 150; ++k) {
-    const Vec2 p{3 + (k % 15) * 6.3, 3 + (k / 15) * 9.5};
+    const int row = k / 15, col = k % 15;
+    const Vec2 p{3 + col * 6.3, 3 + row * 9.5};
     const double a = 2 * M_PI * uniform();
     d.balls.push_back(ball("g" + std::to_string(k), p, {10 * std::cos(a), 10 * std::sin(a)}, 0.3));
   }
@@ -122,9 +123,11 @@ TEST_CASE("moving walls in step mode: the memo's loop with the wall moving insid
   g.walls.push_back({"bottom", {0, 0}, {120, 0}});
   g.walls.push_back({"top", {0, 100}, {120, 100}});
   g.walls.push_back(moving("piston", {100, 0}, {100, 100}, {{100.0, {70, 0}, {70, 100}}}));
-  for (int k = 0; k < 60; ++k)
-    g.balls.push_back(ball("g" + std::to_string(k), {4 + (k % 10) * 9.0, 5 + (k / 10) * 15.0},
+  for (int k = 0; k < 60; ++k) {
+    const int row = k / 10, col = k % 10;
+    g.balls.push_back(ball("g" + std::to_string(k), {4 + col * 9.0, 5 + row * 15.0},
                            {10 * std::cos(k * 2.4), 10 * std::sin(k * 2.4)}, 0.3));
+  }
   World exact(g, Mode::exact), step(g, Mode::step);
   exact.advance_to(100.0);
   step.advance_to(100.0);

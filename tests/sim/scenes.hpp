@@ -61,7 +61,8 @@ inline WorldDef random_gas(int n, double phi, double radius, double speed, std::
   const double pitch = side / per_row;
   const double slack = std::max(0.0, pitch - 2.0 * radius) * 0.49;
   for (int i = 0; i < n; ++i) {
-    const Vec2 centre{(i % per_row + 0.5) * pitch, (i / per_row + 0.5) * pitch};
+    const int row = i / per_row, col = i % per_row;
+    const Vec2 centre{(col + 0.5) * pitch, (row + 0.5) * pitch};
     const Vec2 jitter{(2 * uniform() - 1) * slack, (2 * uniform() - 1) * slack};
     const double a = 2 * M_PI * uniform();
     d.balls.push_back(ball("g" + std::to_string(i), centre + jitter, {speed * std::cos(a), speed * std::sin(a)}, radius));

@@ -274,7 +274,8 @@ TEST_CASE("a hundred turtles driven at random stay apart and inside", "[turtle][
     d.walls.push_back({"x2", {700, 100}, {650, 700}});
     d.walls.push_back({"x3", {300, 800}, {600, 650}});
     for (int k = 0; k < 100; ++k) {
-      const double x = 50 + 90 * (k % 10) + 20, y = 50 + 90 * (k / 10) + 15;
+      const int row = k / 10, col = k % 10;
+      const double x = 50 + 90 * col + 20, y = 50 + 90 * row + 15;
       d.turtles.push_back(turtle("t" + std::to_string(k), {x, y}, 0, 6, 40));
     }
     // Keep only turtles clear of the walls.

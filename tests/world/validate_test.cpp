@@ -106,7 +106,7 @@ TEST_CASE("walls") {
 }
 
 TEST_CASE("balls: numbers, radius, mass") {
-  auto check = [](sim::BallDef b, const char* field, const char* text) {
+  auto check = [](const sim::BallDef& b, const char* field, const char* text) {
     INFO(field);
     sim::WorldDef def = scene();
     def.balls.push_back(ball("first", {10, 10}));

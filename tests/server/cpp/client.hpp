@@ -49,6 +49,7 @@ class ServeProcess {
       std::vector<std::string> a = {bin, "serve", world, "--port", "0"};
       a.insert(a.end(), args.begin(), args.end());
       std::vector<char*> argv;
+      argv.reserve(a.size() + 1);
       for (auto& s : a) argv.push_back(s.data());
       argv.push_back(nullptr);
       execv(bin.c_str(), argv.data());

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <functional>
 #include <string>
 #include <vector>
@@ -19,7 +20,9 @@
 
 using namespace turtlegas::test;
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   if (argc < 4) {
     std::fprintf(stderr, "usage: server_latency LINE_PORT HTTP_PORT COUNT\n");
     return 2;
@@ -59,4 +62,16 @@ int main(int argc, char** argv) {
     c->request({{"type", "release"}, {"turtle", "t1"}});
   }
   return 0;
+}
+
+}  // namespace
+
+// A server that cannot be reached, or that answers with an error, ends the run with its message.
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "server_latency: %s\n", e.what());
+    return 1;
+  }
 }
