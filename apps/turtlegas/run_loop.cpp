@@ -10,8 +10,27 @@
 
 namespace turtlegas::apps {
 
-Progress::Progress(double until)
-    : until_(until), total_(until), start_(Clock::now()), enabled_(::isatty(STDERR_FILENO) != 0) {}
+StatusLine::StatusLine(bool enabled) : start_(Clock::now()), enabled_(enabled && ::isatty(STDERR_FILENO) != 0) {}
+
+bool StatusLine::due() const {
+  if (!enabled_) return false;
+  const auto now = Clock::now();
+  return now - start_ >= std::chrono::seconds(2) && now - last_ >= std::chrono::milliseconds(200);
+}
+
+void StatusLine::show(const std::string& text) {
+  last_ = Clock::now();
+  std::fprintf(stderr, "\r\033[K  %s ", text.c_str());
+  std::fflush(stderr);
+  shown_ = true;
+}
+
+void StatusLine::clear() {
+  if (shown_) std::fputs("\r\033[K", stderr), std::fflush(stderr);
+  shown_ = false;
+}
+
+Progress::Progress(double until) : until_(until), total_(until) {}
 
 void Progress::set_part(double until, double offset, double total) {
   until_ = until;
@@ -19,28 +38,24 @@ void Progress::set_part(double until, double offset, double total) {
   total_ = total;
 }
 
+std::string eta_text(double done, double total, double seconds) {
+  const double sim_rate = seconds > 0.0 ? done / seconds : 0.0;
+  return "ETA " + (sim_rate > 0.0 ? human_duration((total - done) / sim_rate) : std::string("unknown"));
+}
+
 void Progress::update(double t, std::uint64_t events, const std::string& doing) {
-  if (!enabled_) return;
+  if (!line_.due()) return;
   const auto now = Clock::now();
-  const double elapsed = std::chrono::duration<double>(now - start_).count();
-  if (elapsed < 2.0 || now - last_ < std::chrono::milliseconds(200)) return;
   const double done = offset_ + t;
-  if (!shown_) done0_ = done, events0_ = events, since_ = now;  // rates from the first line on
-  last_ = now;
+  if (!line_.shown()) done0_ = done, events0_ = events, since_ = now;  // rates from the first line on
   const double span = std::chrono::duration<double>(now - since_).count();
   const double pct = total_ > 0.0 ? 100.0 * done / total_ : 100.0;
   const double rate = span > 0.0 ? static_cast<double>(events - events0_) / span : 0.0;
-  const double sim_rate = span > 0.0 ? (done - done0_) / span : 0.0;
-  const std::string eta = sim_rate > 0.0 ? human_duration((total_ - done) / sim_rate) : std::string("unknown");
-  std::fprintf(stderr, "\r\033[K  %st = %.6g / %.6g s  %5.1f%%  %.3g events/s  ETA %s ", doing.c_str(), t, until_, pct,
-               rate, eta.c_str());
-  std::fflush(stderr);
-  shown_ = true;
-}
-
-void Progress::clear() {
-  if (shown_) std::fputs("\r\033[K", stderr), std::fflush(stderr);
-  shown_ = false;
+  const std::string eta = eta_text(done - done0_, total_ - done0_, span);
+  char text[512];
+  std::snprintf(text, sizeof text, "%st = %.6g / %.6g s  %5.1f%%  %.3g events/s  %s", doing.c_str(), t, until_, pct,
+                rate, eta.c_str());
+  line_.show(text);
 }
 
 Pace first_pace(SceneScales scales, const sim::World& world, double natural) {
@@ -65,13 +80,14 @@ int exit_code_for(Stopped s) {
   return s.first == Stop::signal ? exit_code_for(s.second) : exit_limit;
 }
 
-void LimitOptions::add_to(CLI::App& cmd, const std::string& what, const std::string& written) {
-  wall_option = cmd.add_option("--max-wall-seconds", max_wall_seconds,
-                               "Stop " + what + " cleanly after this much wall-clock time, " + written + " (exit 3)")
+void LimitOptions::add_to(CLI::App& cmd, const std::string& what, const std::string& written, const std::string& ends) {
+  wall_option = cmd.add_option(
+                       "--max-wall-seconds", max_wall_seconds,
+                       "Stop " + what + " cleanly after this much wall-clock time, " + written + " (" + ends + ")")
                     ->check(real_in(0, 1e9, "seconds", true));
   events_option = cmd.add_option("--max-events", max_events,
                                  "Stop " + what + " cleanly once the engine has taken this many events, " + written +
-                                     " (exit 3)")
+                                     " (" + ends + ")")
                       ->check(integer_in(1, std::numeric_limits<std::int64_t>::max(), "events"));
 }
 

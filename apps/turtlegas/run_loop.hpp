@@ -29,31 +29,53 @@ inline double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// A line on stderr, refreshed in place, only on a terminal and only once a run has taken long
-/// enough for it to help: what is being done ("round 3 of 20: "), the simulated time of this part
-/// of the work, events per second, and when all of it will be done.
+/// A line on stderr rewritten in place, only on a terminal and only once the work has taken 2 s,
+/// at most five times a second: every command's progress line (Progress; test's and sweep's list
+/// of what runs). clear() it before writing anything else on the terminal.
+class StatusLine {
+ public:
+  /// `enabled` false: never shown (sweep --quiet).
+  explicit StatusLine(bool enabled = true);
+  StatusLine(const StatusLine&) = delete;
+  StatusLine& operator=(const StatusLine&) = delete;
+  ~StatusLine() { clear(); }
+
+  /// Whether a line is due now; show() it if so.
+  bool due() const;
+  void show(const std::string& text);
+  void clear();
+  bool shown() const { return shown_; }
+
+ private:
+  Clock::time_point start_, last_{};
+  bool enabled_;
+  bool shown_ = false;
+};
+
+/// A run's progress line (a StatusLine): what is being done ("round 3 of 20: "), the simulated
+/// time of this part of the work, events per second, and when all of it will be done.
 class Progress {
  public:
   /// Work of `until` simulated seconds, shown as t / until.
   explicit Progress(double until);
-  Progress(const Progress&) = delete;
-  Progress& operator=(const Progress&) = delete;
-  ~Progress() { clear(); }
 
   /// Work made of parts (a tournament's rounds, a render's frames): t / until is shown for the
   /// part, and the percentage and the ETA count `offset + t` of `total` simulated seconds.
   void set_part(double until, double offset, double total);
   void update(double t, std::uint64_t events, const std::string& doing);
-  void clear();
+  void clear() { line_.clear(); }
 
  private:
   double until_, offset_ = 0.0, total_;
-  Clock::time_point start_, since_{}, last_{};
+  Clock::time_point since_{};
   double done0_ = 0.0;
   std::uint64_t events0_ = 0;
-  bool enabled_;
-  bool shown_ = false;
+  StatusLine line_;
 };
+
+/// "ETA 3 min", from `done` of `total` simulated seconds made in `seconds` of wall clock: "ETA
+/// unknown" before any is done.
+std::string eta_text(double done, double total, double seconds);
 
 /// Why the chunk loop ended.
 enum class Stop { until, signal, max_wall_seconds, max_events };
@@ -69,12 +91,13 @@ int exit_code_for(Stopped s);
 constexpr int exit_limit = 3;
 
 /// --max-wall-seconds and --max-events, one definition with one range for every command that
-/// takes them; `what` is "the run", "the tournament", ...; `written` what is written on a stop.
+/// takes them; `what` is "the run", "the tournament", ...; `written` what is written on a stop,
+/// `ends` how the command ends then.
 struct LimitOptions {
   double max_wall_seconds = 0.0;
   std::uint64_t max_events = 0;
   CLI::Option *wall_option = nullptr, *events_option = nullptr;
-  void add_to(CLI::App& cmd, const std::string& what, const std::string& written);
+  void add_to(CLI::App& cmd, const std::string& what, const std::string& written, const std::string& ends = "exit 3");
   std::optional<double> wall_seconds() const;
   std::optional<std::uint64_t> events() const;
 };

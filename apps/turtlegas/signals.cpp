@@ -17,6 +17,9 @@ namespace turtlegas::apps {
 namespace {
 
 volatile sig_atomic_t g_stop = 0;
+const char* g_stop_doing = "stopping at the next control step and writing the outputs";
+constexpr std::size_t max_child_groups = 1024;  // test's and sweep's --jobs are at most 1024
+std::atomic<pid_t> g_child_groups[max_child_groups];
 char g_world[512] = "";
 std::atomic<double> g_run_time{0.0};
 
@@ -86,18 +89,24 @@ class Line {
   std::size_t n_ = 0;
 };
 
+/// SIGKILL to every noted child group: async-signal-safe (kill only).
+void kill_child_groups() {
+  for (std::atomic<pid_t>& g : g_child_groups)
+    if (const pid_t group = g.load(std::memory_order_relaxed); group > 0) ::kill(-group, SIGKILL);
+}
+
 void on_stop(int sig) {
   if (g_stop != 0) {
     // The second one: the run did not get to a consistent point soon enough for the user.
+    kill_child_groups();
     remove_temporaries();
-    Line() << "turtlegas: " << signal_name(sig) << " again: stopping at once; outputs are not written\n";
+    (Line() << "turtlegas: " << signal_name(sig) << " again: stopping at once; outputs are not written\n").write();
     ::signal(sig, SIG_DFL);
     ::raise(sig);
     return;
   }
   g_stop = sig;
-  Line() << "turtlegas: " << signal_name(sig)
-         << ": stopping at the next control step and writing the outputs (again to quit at once)\n";
+  (Line() << "turtlegas: " << signal_name(sig) << ": " << g_stop_doing << " (again to quit at once)\n").write();
 }
 
 /// "in the program of turtle 't1' (controller 'wander') at t = 12.5 s" or "at t = 12.5 s (no
@@ -131,6 +140,7 @@ void on_fatal(int sig) {
   line << "turtlegas: " << signal_name(sig) << ", " << describe(sig);
   where(line) << ", world " << g_world << "; the run is lost: no outputs were written\n";
   line.write();
+  kill_child_groups();
   remove_temporaries();
   // The default action, as if we had not been here: the process dies of the signal. Returning
   // re-runs the faulting instruction (SIGSEGV) or, for a raised signal, delivers it now.
@@ -150,7 +160,8 @@ void on_exit() {
 
 }  // namespace
 
-void install_stop_signals() {
+void install_stop_signals(const char* doing) {
+  if (doing != nullptr) g_stop_doing = doing;
   struct sigaction sa{};
   sa.sa_handler = on_stop;
   sigemptyset(&sa.sa_mask);
@@ -193,6 +204,20 @@ void install_crash_report(const std::string& world) {
   for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) sigaction(sig, &sa, nullptr);
   static bool once = [] { return std::atexit(on_exit) == 0; }();
   (void)once;
+}
+
+void note_child_group(pid_t group) {
+  for (std::atomic<pid_t>& g : g_child_groups) {
+    pid_t empty = 0;
+    if (g.compare_exchange_strong(empty, group)) return;
+  }
+}
+
+void forget_child_group(pid_t group) {
+  for (std::atomic<pid_t>& g : g_child_groups) {
+    pid_t same = group;
+    if (g.compare_exchange_strong(same, 0)) return;
+  }
 }
 
 void note_run_time(double t) { g_run_time.store(t, std::memory_order_relaxed); }

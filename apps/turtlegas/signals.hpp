@@ -3,14 +3,18 @@
 // fatal signal (or an exit()) inside a controller's code is reported, naming what died.
 #pragma once
 
+#include <sys/types.h>
+
 #include <string>
 
 namespace turtlegas::apps {
 
 /// From now on SIGINT and SIGTERM do not end the process: they are noted, for the run to see at
 /// its next consistent point (stop_signal()), and a line on stderr says so. A second one ends the
-/// process at once (its temporary files removed), for a run that cannot reach that point.
-void install_stop_signals();
+/// process at once (its temporary files removed, its child processes killed), for a run that
+/// cannot reach that point. `doing` ends the line: "stopping at the next control step and writing
+/// the outputs", the default.
+void install_stop_signals(const char* doing = nullptr);
 /// The first SIGINT or SIGTERM received since install_stop_signals(), or 0.
 int stop_signal();
 /// The exit code of a run stopped by `sig`: 128 + sig (130 for SIGINT, 143 for SIGTERM), as a
@@ -18,6 +22,12 @@ int stop_signal();
 int exit_code_for(int sig);
 /// "SIGINT", "SIGTERM", ...
 const char* signal_name(int sig);
+
+/// A child process group (child_processes.hpp) that a second SIGINT or SIGTERM, or a fatal signal,
+/// kills before this process dies: the children are in groups of their own, which a terminal's
+/// Ctrl-C does not reach, and would otherwise run on as orphans. Up to 1024 at once.
+void note_child_group(pid_t group);
+void forget_child_group(pid_t group);
 
 /// From now on a fatal signal (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT) prints one line on stderr
 /// naming the world file, the turtle whose program was running and its controller (or that none

@@ -15,9 +15,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "output_file.hpp"
 #include "child_processes.hpp"
 #include "cli_common.hpp"
+#include "output_file.hpp"
+#include "run_loop.hpp"
+#include "signals.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/expect.hpp"
 #include "turtlegas/world/scenario.hpp"
@@ -27,23 +29,86 @@ namespace turtlegas::apps {
 namespace {
 
 namespace tw = turtlegas::world;
-using Clock = std::chrono::steady_clock;
 using nlohmann::json;
+
+constexpr int progress_fd = 4;  // the child's progress lines (child_processes.hpp)
 
 const char* mode_name(sim::Mode m) { return sim::to_string(m).data(); }
 
 /// One world's outcome, as the child reports it and the parent prints it.
 struct Outcome {
-  enum class Status { pass, fail, error } status = Status::error;
+  /// not_run: the suite was stopped (SIGINT, SIGTERM) before the world ended.
+  enum class Status { pass, fail, error, not_run } status = Status::error;
   std::string message;  ///< what failed, or why it could not run; for a pass, "(3 assertions, 0.01 s)"
   std::size_t assertions = 0;
   double seconds = 0.0;
   std::string log;      ///< the child's stdout and stderr
-  std::string type = "expect";  ///< JUnit's failure type: expect, crash or timeout
+  std::string type = "expect";  ///< JUnit's failure type: expect, crash, timeout or limit
 };
 
 const char* status_word(Outcome::Status s) {
   return s == Outcome::Status::pass ? "pass" : s == Outcome::Status::fail ? "fail" : "error";
+}
+
+/// How far a world's process has got: the line it writes on descriptor 4 now and then.
+struct WorldProgress {
+  double t = 0.0, until = 0.0;
+  std::size_t part = 0, parts = 1;  ///< the mode being run (exact, then step), of how many
+  std::string mode;
+
+  std::string line() const {
+    return json{{"t", t}, {"until", until}, {"part", part}, {"parts", parts}, {"mode", mode}}.dump() + "\n";
+  }
+  /// nullopt when there is none yet.
+  static std::optional<WorldProgress> parse(const std::string& line) {
+    const json j = json::parse(line, nullptr, false);
+    if (j.is_discarded() || !j.is_object()) return std::nullopt;
+    WorldProgress p;
+    p.t = j.value("t", 0.0);
+    p.until = j.value("until", 0.0);
+    p.part = j.value("part", std::size_t{0});
+    p.parts = std::max<std::size_t>(1, j.value("parts", std::size_t{1}));
+    p.mode = j.value("mode", "");
+    return p;
+  }
+  /// "t = 31.4 / 1e+12 s", "step mode, t = 2 / 10 s" when the world runs in both.
+  std::string text() const {
+    char b[128];
+    std::snprintf(b, sizeof b, "%s%st = %.6g / %.6g s", parts > 1 ? mode.c_str() : "", parts > 1 ? " mode, " : "", t,
+                  until);
+    return b;
+  }
+  /// Simulated seconds done and to do, over every mode.
+  double done() const { return static_cast<double>(part) * until + t; }
+  double total() const { return static_cast<double>(parts) * until; }
+};
+
+/// The child's side of the progress: a WorldProgress line on descriptor 4 at most five times a
+/// second, never waiting for the parent (a line the pipe has no room for is dropped).
+class ProgressReports {
+ public:
+  ProgressReports() : open_(::fcntl(progress_fd, F_GETFD) != -1) {
+    if (open_) ::fcntl(progress_fd, F_SETFL, ::fcntl(progress_fd, F_GETFL) | O_NONBLOCK);
+  }
+  void report(const WorldProgress& p) {
+    if (!open_ || Clock::now() - last_ < std::chrono::milliseconds(200)) return;
+    last_ = Clock::now();
+    const std::string line = p.line();  // shorter than PIPE_BUF: written whole or not at all
+    [[maybe_unused]] const ssize_t n = ::write(progress_fd, line.data(), line.size());
+  }
+
+ private:
+  bool open_;
+  Clock::time_point last_{};
+};
+
+/// A world stopped by --max-wall-seconds or --max-events: it fails, as type "limit".
+Outcome stopped_by_limit(const std::string& limit, const WorldProgress& at, std::uint64_t events) {
+  Outcome o;
+  o.status = Outcome::Status::fail;
+  o.type = "limit";
+  o.message = "stopped by " + limit + " at " + at.text() + " (" + std::to_string(events) + " events)";
+  return o;
 }
 
 /// Runs one world in this process: the child's whole job.
@@ -73,15 +138,42 @@ Outcome test_one(const std::string& file, const TestOptions& options, const turt
   server_options.program_budget = options.program_budget;
   server_options.stack_bytes = options.stack_kib * 1024;
   const auto start = Clock::now();
+  Limits limits;
+  limits.max_wall_seconds = options.limits.wall_seconds();
+  limits.max_events = options.limits.events();
+  ProgressReports reports;
+  WorldProgress at;
+  at.until = *expect.until;
+  at.parts = modes.size();
+  std::uint64_t events_before = 0;  // of the modes run before this one: --max-events counts the world's
   std::string failures;
   for (sim::Mode mode : modes) {
+    std::uint64_t events = 0;
+    at.mode = mode_name(mode);
+    at.t = 0.0;
+    tw::ExpectHooks hooks;
+    hooks.on_start = [&](turtle::WorldServer& server) { stop_inside_steps(server, limits, start, events_before); };
+    hooks.on_step = [&](const turtle::WorldServer& server) {
+      at.t = server.time();
+      events = server.world().stats().events;
+      // Also here, not only every 4096 events: a world may take many steps for few events.
+      if (limits.max_wall_seconds && seconds_since(start) >= *limits.max_wall_seconds)
+        throw sim::StopRequested("--max-wall-seconds");
+      reports.report(at);
+    };
     tw::ExpectResult r;
     try {
-      r = tw::run_expectations(scene, registry, mode, server_options);
+      r = tw::run_expectations(scene, registry, mode, server_options, hooks);
     } catch (const std::invalid_argument& e) {
       o.message = file + ": " + mode_name(mode) + " mode: " + e.what();
       return o;
+    } catch (const sim::StopRequested&) {
+      return stopped_by_limit("--max-wall-seconds " + fmt(*limits.max_wall_seconds), at, events_before + events);
+    } catch (const sim::EventLimitReached&) {
+      return stopped_by_limit("--max-events " + std::to_string(*limits.max_events), at, *limits.max_events);
     }
+    events_before += events;
+    ++at.part;
     o.assertions += r.assertions;
     for (const std::string& f : r.failures) {
       failures += failures.empty() ? "" : "; ";
@@ -110,7 +202,7 @@ int child_main(const TestOptions& options, const turtle::Registry& registry) {
   Outcome o = test_one(options.worlds.front(), options, registry);
   const std::string line =
       json{{"status", status_word(o.status)}, {"message", o.message}, {"assertions", o.assertions},
-           {"seconds", o.seconds}}
+           {"seconds", o.seconds}, {"type", o.type}}
           .dump() +
       "\n";
   std::fflush(stdout);
@@ -122,17 +214,47 @@ int child_main(const TestOptions& options, const turtle::Registry& registry) {
   return o.status == Outcome::Status::pass ? exit_ok : o.status == Outcome::Status::fail ? exit_failure : exit_bad_input;
 }
 
+std::string seconds_text(double s) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3f", s);
+  return b;
+}
+
+/// A world that has not stopped itself this long after its --max-wall-seconds is killed.
+constexpr double grace_seconds = 10.0;
+
+/// Wall-clock seconds a world's process gets before the parent kills it (0: no end): --timeout,
+/// or --max-wall-seconds and the grace when that comes first.
+double kill_after(const TestOptions& options) {
+  const std::optional<double> wall = options.limits.wall_seconds();
+  const double backstop = wall ? *wall + grace_seconds : 0.0;
+  if (options.timeout > 0.0 && (backstop == 0.0 || options.timeout <= backstop)) return options.timeout;
+  return backstop;
+}
+
+std::string timeout_text(const TestOptions& options) {
+  if (options.timeout > 0.0 && kill_after(options) == options.timeout)
+    return "--timeout " + fmt(options.timeout) + " s";
+  return fmt(kill_after(options)) + " s (--max-wall-seconds and " + fmt(grace_seconds) + " s more)";
+}
+
 /// The parent's reading of how a child ended.
 Outcome outcome_of(const std::string& file, const TestOptions& options, ChildResult&& r) {
   Outcome o;
   o.seconds = r.seconds;
   o.log = std::move(r.out);
   o.log += r.err;
+  const std::optional<WorldProgress> at = WorldProgress::parse(r.status);
+  const std::string where = at ? " at " + at->text() : std::string();
+  if (r.stopped) {
+    o.status = Outcome::Status::not_run;
+    o.message = std::string("stopped by ") + signal_name(stop_signal()) + " after " + seconds_text(r.seconds) + " s" +
+                where + ", before it ended";
+    return o;
+  }
   if (r.timed_out) {
-    char msg[200];
-    std::snprintf(msg, sizeof msg, "still running after --timeout %g s; killed", options.timeout);
     o.status = Outcome::Status::fail;
-    o.message = msg;
+    o.message = "still running after " + timeout_text(options) + where + "; killed";
     o.type = "timeout";
     return o;
   }
@@ -142,6 +264,7 @@ Outcome outcome_of(const std::string& file, const TestOptions& options, ChildRes
     o.status = s == "pass" ? Outcome::Status::pass : s == "fail" ? Outcome::Status::fail : Outcome::Status::error;
     o.message = j.at("message").get<std::string>();
     o.assertions = j.at("assertions").get<std::size_t>();
+    o.type = j.value("type", o.type);
     return o;
   } catch (const json::exception&) {
     // No report: the world's process crashed, or a program ended it (exit, abort).
@@ -193,26 +316,23 @@ std::string capped(const std::string& log) {
          log.substr(log.size() - cap / 2);
 }
 
-std::string seconds_text(double s) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3f", s);
-  return b;
-}
-
 /// JUnit XML as Jenkins, GitLab and the GitHub test-report actions read it: one <testsuite>, one
 /// <testcase> per world (name: the file as given), <failure> for a failed world, <error> for one
-/// that could not run, its log in <system-err>.
+/// that could not run, <skipped> for one that a stopped suite did not finish, its log in
+/// <system-err>.
 std::string junit_xml(const std::vector<std::string>& files, const std::vector<Outcome>& outcomes, double seconds) {
-  std::size_t failures = 0, errors = 0;
+  std::size_t failures = 0, errors = 0, skipped = 0;
   for (const Outcome& o : outcomes) {
     failures += o.status == Outcome::Status::fail ? 1 : 0;
     errors += o.status == Outcome::Status::error ? 1 : 0;
+    skipped += o.status == Outcome::Status::not_run ? 1 : 0;
   }
   const std::string counts = "tests=\"" + std::to_string(files.size()) + "\" failures=\"" + std::to_string(failures) +
                              "\" errors=\"" + std::to_string(errors) + "\"";
   std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   x += "<testsuites name=\"turtlegas test\" " + counts + " time=\"" + seconds_text(seconds) + "\">\n";
-  x += "  <testsuite name=\"turtlegas test\" " + counts + " skipped=\"0\" time=\"" + seconds_text(seconds) + "\">\n";
+  x += "  <testsuite name=\"turtlegas test\" " + counts + " skipped=\"" + std::to_string(skipped) + "\" time=\"" +
+       seconds_text(seconds) + "\">\n";
   for (std::size_t i = 0; i < files.size(); ++i) {
     const Outcome& o = outcomes[i];
     x += "    <testcase classname=\"turtlegas.test\" name=\"" + xml_text(files[i]) + "\" file=\"" + xml_text(files[i]) +
@@ -222,7 +342,9 @@ std::string junit_xml(const std::vector<std::string>& files, const std::vector<O
       continue;
     }
     x += ">\n";
-    if (o.status != Outcome::Status::pass) {
+    if (o.status == Outcome::Status::not_run) {
+      x += "      <skipped message=\"" + xml_text(o.message) + "\"/>\n";
+    } else if (o.status != Outcome::Status::pass) {
       const char* tag = o.status == Outcome::Status::fail ? "failure" : "error";
       x += std::string("      <") + tag + " message=\"" + xml_text(o.message) + "\" type=\"" +
            (o.status == Outcome::Status::fail ? o.type : std::string("bad-input")) + "\">" + xml_text(o.message) + "</" + tag +
@@ -240,6 +362,8 @@ std::string yaml_string(const std::string& s) { return json(s).dump(-1, ' ', fal
 
 std::string tap_line(std::size_t n, const std::string& file, const Outcome& o) {
   if (o.status == Outcome::Status::pass) return "ok " + std::to_string(n) + " - " + file + " " + o.message + "\n";
+  if (o.status == Outcome::Status::not_run)
+    return "ok " + std::to_string(n) + " - " + file + " # SKIP " + o.message + "\n";
   std::string s = "not ok " + std::to_string(n) + " - " + file + "\n";
   s += "  ---\n";
   s += "  message: " + yaml_string(o.message) + "\n";
@@ -254,6 +378,7 @@ std::string result_line(const std::string& file, const Outcome& o) {
     case Outcome::Status::pass: return "PASS " + file + " " + o.message + "\n";
     case Outcome::Status::fail: return "FAIL " + file + ": " + o.message + "\n";
     case Outcome::Status::error: return "ERROR " + o.message + "\n";  // the message names the file
+    case Outcome::Status::not_run: return "NOT RUN " + file + ": " + o.message + "\n";
   }
   return {};
 }
@@ -273,9 +398,10 @@ CLI::App* add_test_command(CLI::App& app, TestOptions& options) {
       ->capture_default_str()
       ->check(integer_in(1, 1024, "processes"));
   cmd->add_option("--timeout", options.timeout,
-                  "Wall-clock seconds a world may take before it is killed and fails (0: no limit)")
+                  "Wall-clock seconds a world's process may take before it is killed and fails (0: no limit)")
       ->capture_default_str()
       ->check(real_in(0, 1e9, "seconds"));
+  options.limits.add_to(*cmd, "each world", "saying how far it got", "it fails as type \"limit\"");
   cmd->add_option("--junit", options.junit, "Write a JUnit XML report here (for CI)");
   cmd->add_flag("--tap", options.tap, "Print TAP 13 on stdout instead of PASS/FAIL lines");
   cmd->add_flag("--quiet,-q", options.quiet, "Leave out the worlds' log lines; print only the results");
@@ -290,12 +416,15 @@ int test_command(const TestOptions& options, const turtle::Registry& registry, c
   // Opened first, so that a bad path costs nothing; renamed into place when written whole.
   std::optional<OutputFile> junit;
   if (!options.junit.empty()) junit.emplace(options.junit, "--junit");
+  install_stop_signals("stopping the worlds that run and writing what they did");
 
   std::vector<std::vector<std::string>> args;
   for (const std::string& file : options.worlds) {
     std::vector<std::string> a = {"test", file, "--child", "--program-budget", json(options.program_budget).dump(),
                                   "--stack-kib", std::to_string(options.stack_kib)};
     if (options.mode) a.insert(a.end(), {"--mode", *options.mode});
+    if (const auto wall = options.limits.wall_seconds()) a.insert(a.end(), {"--max-wall-seconds", json(*wall).dump()});
+    if (const auto events = options.limits.events()) a.insert(a.end(), {"--max-events", std::to_string(*events)});
     for (const std::string& p : plugins) a.insert(a.end(), {"--plugin", p});
     args.push_back(std::move(a));
   }
@@ -305,14 +434,16 @@ int test_command(const TestOptions& options, const turtle::Registry& registry, c
   if (options.tap) std::printf("TAP version 13\n1..%zu\n", n);
   std::fflush(stdout);
   std::vector<std::optional<Outcome>> done(n);
-  std::size_t printed = 0;
-  std::size_t passed = 0, failed = 0, bad = 0;
-  run_children(args, options.jobs, options.timeout, [&](std::size_t i, ChildResult&& r) {
-    done[i] = outcome_of(options.worlds[i], options, std::move(r));
-    // In the order given, whatever order they end in.
+  std::size_t printed = 0, finished = 0;
+  std::size_t passed = 0, failed = 0, bad = 0, not_run = 0;
+  StatusLine status;
+  // Prints the outcomes from `printed` on in the order given, whatever order they end in, up to
+  // the first not there yet.
+  auto print = [&] {
     for (; printed < n && done[printed]; ++printed) {
       const Outcome& o = *done[printed];
       const std::string& file = options.worlds[printed];
+      status.clear();
       if (!options.quiet && !o.log.empty()) {
         std::fputs(o.log.c_str(), stderr);
         if (o.log.back() != '\n') std::fputc('\n', stderr);
@@ -321,12 +452,53 @@ int test_command(const TestOptions& options, const turtle::Registry& registry, c
       const std::string line = options.tap ? tap_line(printed + 1, file, o) : result_line(file, o);
       std::fputs(line.c_str(), stdout);
       std::fflush(stdout);
-      (o.status == Outcome::Status::pass ? passed : o.status == Outcome::Status::fail ? failed : bad) += 1;
+      (o.status == Outcome::Status::pass   ? passed
+       : o.status == Outcome::Status::fail ? failed
+       : o.status == Outcome::Status::error ? bad
+                                            : not_run) += 1;
     }
-  });
-  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  if (n > 1 || options.tap)
-    std::printf("%s%zu passed, %zu failed, %zu could not run\n", options.tap ? "# " : "", passed, failed, bad);
+  };
+  // "2 of 5 worlds done; running: a.json 12 s, t = 31 / 1e+12 s, ETA 9.2 years; b.json 3 s".
+  auto show = [&](const std::vector<RunningChild>& running) {
+    if (!status.due()) return;
+    std::string text = std::to_string(finished) + " of " + std::to_string(n) + " worlds done; running:";
+    for (std::size_t k = 0; k < running.size(); ++k) {
+      if (k == 3) {
+        text += " and " + std::to_string(running.size() - k) + " more";
+        break;
+      }
+      const RunningChild& c = running[k];
+      text += (k > 0 ? "; " : " ") + options.worlds[c.index] + " " + human_duration(c.seconds);
+      if (const auto at = WorldProgress::parse(c.status))
+        text += ", " + at->text() + ", " + eta_text(at->done(), at->total(), c.seconds);
+    }
+    status.show(text);
+  };
+  const int stopped_by = run_children(args, options.jobs, kill_after(options),
+                                      {[&](std::size_t i, ChildResult&& r) {
+                                         done[i] = outcome_of(options.worlds[i], options, std::move(r));
+                                         ++finished;
+                                         print();
+                                       },
+                                       show});
+  status.clear();
+  if (stopped_by != 0) {
+    for (std::optional<Outcome>& o : done) {
+      if (o) continue;
+      o.emplace();
+      o->status = Outcome::Status::not_run;
+      o->message = std::string("not started: the suite was stopped by ") + signal_name(stopped_by);
+    }
+    print();
+  }
+  const double seconds = seconds_since(start);
+  if (n > 1 || options.tap || stopped_by != 0) {
+    std::printf("%s%zu passed, %zu failed, %zu could not run", options.tap ? "# " : "", passed, failed, bad);
+    if (stopped_by != 0) std::printf(", %zu not run: stopped by %s", not_run, signal_name(stopped_by));
+    std::printf("\n");
+  }
+  if (options.tap && stopped_by != 0) std::printf("Bail out! stopped by %s\n", signal_name(stopped_by));
+  std::fflush(stdout);
   if (junit) {
     std::vector<Outcome> outcomes;
     outcomes.reserve(done.size());
@@ -334,6 +506,7 @@ int test_command(const TestOptions& options, const turtle::Registry& registry, c
     junit->stream() << junit_xml(options.worlds, outcomes, seconds);
     junit->commit();
   }
+  if (stopped_by != 0) return exit_code_for(stopped_by);
   // Bad input outranks a failure: a world that cannot run is a broken test, not a result.
   return bad > 0 ? exit_bad_input : failed > 0 ? exit_failure : exit_ok;
 }

@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "run_loop.hpp"
 #include "turtlegas/turtle/registry.hpp"
 
 namespace turtlegas::apps {
@@ -22,6 +23,7 @@ struct TestOptions {
   std::size_t stack_kib = 32;       ///< each turtle program's stack
   std::size_t jobs = 1;             ///< worlds run at once, each in its own process
   double timeout = 0.0;             ///< wall-clock seconds a world may take before it is killed; 0: none
+  LimitOptions limits;              ///< --max-wall-seconds, --max-events: each world stops itself cleanly
   std::string junit;                ///< write a JUnit XML report here
   bool tap = false;                 ///< stdout in TAP 13 instead of PASS/FAIL lines
   bool quiet = false;               ///< drop the worlds' log lines (their stderr), keep the results
@@ -34,9 +36,11 @@ CLI::App* add_test_command(CLI::App& app, TestOptions& options);
 /// Prints one line per world (PASS, or FAIL with what failed, or ERROR when it cannot run) on
 /// stdout, in the order given, and a count when there are several. Each world runs in a child
 /// process (this program again, with `plugins` loaded); its log lines go to stderr before its
-/// result unless --quiet. Returns 0 when every world passes, 1 when one fails (crashes and
-/// timeouts included), 2 when one cannot be run (bad file, no `expect`, no `until`) or the options
-/// are bad.
+/// result unless --quiet. On a terminal, a progress line on stderr says which worlds run, for how
+/// long, how far each has got and when it will be done. Returns 0 when every world passes, 1 when
+/// one fails (crashes, timeouts and limits included), 2 when one cannot be run (bad file, no
+/// `expect`, no `until`) or the options are bad, 130 or 143 when SIGINT or SIGTERM stopped the
+/// suite (the worlds running killed, the report written with the rest marked not run).
 int test_command(const TestOptions& options, const turtle::Registry& registry, const std::vector<std::string>& plugins);
 
 }  // namespace turtlegas::apps

@@ -154,7 +154,10 @@ TEST_CASE("test: --timeout kills a hung world; --quiet drops the log lines; --ta
   INFO(r.out << r.err);
   CHECK(r.code == 1);
   CHECK(r.out.rfind("TAP version 13\n1..2\n", 0) == 0);
-  CHECK(contains(r.out, "not ok 1 - " + spin.string() + "\n  ---\n  message: \"still running after --timeout 1 s; killed\""));
+  // It says how far the world got: its last progress line (t = the last control step reached).
+  CHECK(contains(r.out,
+                 "not ok 1 - " + spin.string() + "\n  ---\n  message: \"still running after --timeout 1 s at t = "));
+  CHECK(contains(r.out, " / 5 s; killed\"\n"));
   CHECK(contains(r.out, "  severity: fail\n"));
   CHECK(contains(r.out, "ok 2 - " + chatty.string() + " (1 assertion"));
   CHECK(contains(r.out, "# 1 passed, 1 failed, 0 could not run"));

@@ -16,7 +16,7 @@ std::string num(double v) { return sim::format_number(v); }
 }  // namespace
 
 ExpectResult run_expectations(const Scene& scene, const turtle::Registry& registry, sim::Mode mode,
-                              turtle::ServerOptions options) {
+                              turtle::ServerOptions options, const ExpectHooks& hooks) {
   const sim::WorldDef& def = scene.def;
   const Expectations& expect = scene.expect;
   if (!expect.until) throw std::invalid_argument("the scene's expect list has no {\"until\": T}");
@@ -28,6 +28,7 @@ ExpectResult run_expectations(const Scene& scene, const turtle::Registry& regist
   std::vector<turtle::LogEvent> log;
   server.set_event_log(&log);
   const RunView view(server, def);
+  if (hooks.on_start) hooks.on_start(server);
 
   std::vector<std::unique_ptr<Check>> checks;
   // The times to stop at: every assertion's sample time and every control step boundary (k dt,
@@ -52,6 +53,7 @@ ExpectResult run_expectations(const Scene& scene, const turtle::Registry& regist
         for (auto& c : checks) c->on_event(e, view);
       log.clear();
       for (auto& c : checks) c->on_step(view);
+      if (hooks.on_step) hooks.on_step(server);
     };
     std::size_t next_sample = 0;
     for (std::uint64_t k = 1; until > 0.0; ++k) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -19,11 +20,21 @@ struct ExpectResult {
   bool passed() const { return failures.empty(); }
 };
 
+/// What a caller of run_expectations may add to the run (`turtlegas test`: its limits and progress).
+struct ExpectHooks {
+  /// Called once the server is made, before the first step: bounds on the run (set_event_limit,
+  /// set_stop_poll), whose exceptions then come out of run_expectations.
+  std::function<void(turtle::WorldServer&)> on_start;
+  /// Called after every stop of the run (each control step and sample time); may throw to end the
+  /// run, the exception passing through run_expectations.
+  std::function<void(const turtle::WorldServer&)> on_step;
+};
+
 /// Runs a scene in `mode` through a WorldServer until its {"until": T}, stopping at every control
 /// step (and at the times assertions ask for) to feed the checks. A program fault is not an error
 /// here: it is a `fault` event (assert {"no_event": "fault"}); a busy loop ends the run as a failure.
 /// Throws std::invalid_argument when the server rejects the scene or it has no `until`.
 ExpectResult run_expectations(const Scene& scene, const turtle::Registry& registry, sim::Mode mode,
-                              turtle::ServerOptions options = {});
+                              turtle::ServerOptions options = {}, const ExpectHooks& hooks = {});
 
 }  // namespace turtlegas::world
