@@ -672,3 +672,38 @@ TEST_CASE("a piston pressing discs onto a disc held in a V crushes them against 
     }
   }
 }
+
+TEST_CASE("three discs pressed onto the held disc, or any at e = 1, are crushed where the room closes", "[squeeze]") {
+  // The room the piston and the V leave the centres is a triangle; it can hold two discs (16
+  // apart) until its side is 16, at (246 - 16 cos 30°) / 27 s, and one until it closes to a point
+  // at 246 / 27 s (docs/physics.md, rule 3). Discs that slip past the piston's ends before it is
+  // 240.7 units along escape. Before: a chain of four touching discs served round-off contacts at
+  // t = 7.3348 s for ever (three between, e = 0.5), and at e = 1 the discs' speeds grew to 1e26
+  // before 8.598 s (the event limit).
+  const double corner = (290 - 16 - 16 * std::cos(M_PI / 6) - 8 - 20) / 27.0;
+  for (Mode mode : kModes) {
+    for (auto [between, e] : {std::pair{1, 1.0}, {2, 1.0}, {3, 1.0}, {3, 0.5}}) {
+      INFO("mode " << (mode == Mode::exact ? "exact" : "step") << ", discs between " << between << ", e " << e);
+      World w(held_pile_scene(between, e), mode);
+      Run run;
+      double worst = 0.0;
+      w.set_event_log(&run.log);
+      w.set_event_limit(kLimit);
+      for (int k = 1; k <= 120; ++k) {
+        REQUIRE_NOTHROW(w.advance_to(0.1 * k));
+        worst = std::max(worst, w.measure_overlap().relative);
+      }
+      CHECK(worst <= 1e-9);
+      CHECK(w.max_contact_overlap().relative <= 1e-9);
+      CHECK(w.stats().events < 3000);
+      CHECK(std::isfinite(w.energy()));
+      CHECK(w.energy() < 1e4);  // a sanity bound: the runaway reached 1e13
+      std::vector<double> crushed;
+      for (const Event& ev : run.log)
+        if (ev.kind == EventKind::crushed) crushed.push_back(ev.t);
+      REQUIRE(crushed.size() >= 2);
+      for (std::size_t k = 0; k + 1 < crushed.size(); ++k) CHECK(crushed[k] == Approx(corner).epsilon(1e-9));
+      CHECK(crushed.back() == Approx(246.0 / 27.0).epsilon(1e-12));
+    }
+  }
+}

@@ -232,6 +232,64 @@ inline bool stays_on_axis(Vec2 x, Vec2 v, const Side& s, Vec2 n, double tau) {
   return std::abs(cross(rel_then, n)) <= kParallel * norm(rel_then);
 }
 
+/// A certain crush in a closing triangle (docs/physics.md, "Wedged and crushed bodies", rule 3):
+/// body i, flying straight, between the interiors of walls A and B (not parallel) and a third
+/// wall C whose three inward normals positively span the plane (lambda_A n_A + lambda_B n_B +
+/// lambda_C n_C = 0 with every lambda > 0). Then sum lambda_k g_k, with g_k the free room towards
+/// wall k, is the same wherever the centre is (n_k . x cancels), and it falls at the rate
+/// sum lambda_k (u_k . n_k) as the walls move: the room for the centre, a triangle, shrinks to a
+/// point at t* = now + sum lambda g / sum lambda c. If no wall recedes (each half-plane only
+/// shrinks), the walls are translating and no keyframe comes before t*, and every point of the
+/// triangle now lies over each wall's interior at now and at t* (so no end or gap lets the body
+/// out), its crush is certain, whatever it meets in between. On true, v is the straight ride to
+/// that point (every room falls linearly to 0 at t*), c the third wall's side.
+template <Flight Fl, bool kStep, bool kExtras>
+bool closing_triangle(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, const Side& A, const Side& B, Vec2& v,
+                      Side& c) {
+  if (p.schedule.movers.empty() || !A.interior || !B.interior || A.point || B.point) return false;
+  const Body& body = p.bodies.body[i];
+  auto translating = [&](const Side& s) { return s.mover == kNone || p.schedule.movers[s.mover].rigid(); };
+  if (!translating(A) || !translating(B)) return false;
+  const std::uint32_t walls = static_cast<std::uint32_t>(p.walls.segments.size());
+  for (std::uint32_t k = 0; k < walls; ++k) {
+    if (k == A.name || k == B.name) continue;
+    if constexpr (kExtras)
+      if (!p.bodies.layers[i].collides_with(p.walls.layers[k])) continue;
+    const Side C = side_of(p, i, LastPartner::of(Partner::wall, k));
+    if (!C.ok || !C.interior || !translating(C) || (A.mover == kNone && B.mover == kNone && C.mover == kNone)) continue;
+    double la = cross(B.n, C.n), lb = cross(C.n, A.n), lc = cross(A.n, B.n);
+    if (lc < 0.0) la = -la, lb = -lb, lc = -lc;
+    if (!(la > kParallel && lb > kParallel && lc > kParallel)) continue;
+    const double ca = dot(A.u, A.n), cb = dot(B.u, B.n), cc = dot(C.u, C.n);
+    if (ca < 0.0 || cb < 0.0 || cc < 0.0) continue;  // a receding wall could let the room grow
+    const double rate = la * ca + lb * cb + lc * cc;
+    const double room = la * A.gap + lb * B.gap + lc * C.gap;
+    if (!(rate > 0.0) || room < 0.0) continue;
+    const double tau = room / rate;
+    if (!(p.now + tau < p.schedule.next_key)) continue;
+    // The triangle's corners now, relative to the centre (n_j . y = -g_j on two of its sides).
+    auto corner = [](const Side& s, double gs, const Side& t, double gt) {
+      const double det = cross(s.n, t.n);
+      return Vec2{(-gs * t.n.y + gt * s.n.y) / det, (-gt * s.n.x + gs * t.n.x) / det};
+    };
+    const Vec2 corners[3] = {corner(A, A.gap, B, B.gap), corner(B, B.gap, C, C.gap), corner(C, C.gap, A, A.gap)};
+    bool over = true;
+    for (const Side* s : {&A, &B, &C})
+      for (const Vec2 y : corners)
+        for (const double when : {0.0, tau}) {
+          const double foot = dot(body.x + y - (s->seg.p1 + when * s->u), s->seg.u);
+          over = over && foot > 0.0 && foot < s->seg.len;
+        }
+    if (!over) continue;
+    // The point the triangle closes on: n_k . y = c_k tau - g_k for A and B (C follows).
+    const Vec2 target = corner(A, A.gap - ca * tau, B, B.gap - cb * tau);
+    v = target / tau;
+    c = C;
+    return true;
+  }
+  return false;
+}
+
 /// The squeeze rule for body i, which has just been answered at a contact with `b` (its velocity
 /// already set by the response); `a` is the partner of its contact before that one. Returns what
 /// the rule did; on `wedged` the body's velocity has been changed and the event logged; on
@@ -320,7 +378,15 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
     // interior and a wall end or turtle the body is exactly in line with (head on: a piston
     // driving it onto the end of a wall), which it cannot slide off when it does not move across
     // the axis.
-    if (!parallel || !closes || !p.motion.straight(i)) return Squeeze::none;
+    if (!p.motion.straight(i)) return Squeeze::none;
+    if (!parallel) {
+      // 3. Three walls closing on the body from every side: a certain crush at a point.
+      Side C;
+      if (!closing_triangle(p, i, A, B, v, C)) return Squeeze::none;
+      held = false;
+      goto done;
+    }
+    if (!closes) return Squeeze::none;
     if (!(A.interior || A.point) || !(B.interior || B.point) || (A.point && B.point)) return Squeeze::none;
     const double tau = A.gap / closing;
     if (!(p.now + tau < p.schedule.next_key)) return Squeeze::none;
