@@ -191,6 +191,24 @@ std::optional<DefProblem> check_placement(const Discs& d, std::size_t k) {
   return std::nullopt;
 }
 
+/// The times of impact of two discs square their relative speed times their distance ((r x v)^2
+/// and sigma^2 v^2 in toi_disc_disc); above sqrt(DBL_MAX) = 1.34e154 those overflow, the root is
+/// NaN, and the pair passes through each other without a word. A relative speed is at most twice
+/// the fastest body's, a distance at most the arena's diagonal (a uniform field changes no
+/// relative velocity of two balls), so 2 |v| diagonal must stay below this, a quarter under.
+constexpr double kSpeedTimesSize = 1e154;
+
+std::optional<DefProblem> check_speed(const WorldDef& def, Where where, std::size_t i, const std::string& name,
+                                      const char* key, double speed) {
+  const double diagonal = std::hypot(def.arena.width, def.arena.height);
+  if (2.0 * speed * diagonal < kSpeedTimesSize) return std::nullopt;
+  return problem(where, i, key,
+                 name + ": a speed of " + num(speed) + " units/s is beyond what the engine can time in this arena (the " +
+                     "times of impact square twice the speed times the arena's diagonal, " + num(diagonal) +
+                     ", and must stay below " + num(kSpeedTimesSize) + "): at most " +
+                     num(kSpeedTimesSize / (2.0 * diagonal)) + " units/s here");
+}
+
 std::optional<DefProblem> check_balls(const WorldDef& def) {
   const Discs d{def};
   for (std::size_t i = 0; i < def.balls.size(); ++i) {
@@ -205,6 +223,7 @@ std::optional<DefProblem> check_balls(const WorldDef& def) {
       return problem(Where::ball, i, "mass", ball_name(b, i) + ": mass must be > 0 (got " + num(b.mass) + ")");
     if (!std::isfinite(b.charge))
       return problem(Where::ball, i, "charge", ball_name(b, i) + ": charge must be finite (got " + num(b.charge) + ")");
+    if (auto p = check_speed(def, Where::ball, i, ball_name(b, i), "vel", std::hypot(b.vel.x, b.vel.y))) return p;
     if (auto p = check_placement(d, i)) return p;
   }
   return std::nullopt;
@@ -247,6 +266,7 @@ std::optional<DefProblem> check_turtles(const WorldDef& def) {
       return problem(Where::turtle, i, "radius", name + ": radius must be > 0 (got " + num(t.radius) + ")");
     if (!std::isfinite(t.speed) || t.speed <= 0.0)
       return problem(Where::turtle, i, "speed", name + ": speed must be > 0 units/s (got " + num(t.speed) + ")");
+    if (auto p = check_speed(def, Where::turtle, i, name, "speed", t.speed)) return p;
     if (!std::isfinite(t.turn_rate) || t.turn_rate <= 0.0)
       return problem(Where::turtle, i, "turn_rate", name + ": turn_rate must be > 0 (got " + num(t.turn_rate) + " rad/s)");
     if (!std::isfinite(t.bounce) || t.bounce > 1.0)

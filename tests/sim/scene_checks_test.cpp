@@ -130,3 +130,44 @@ TEST_CASE("a wall added while a periodic world runs must lie inside it too", "[w
   }
   CHECK(w.add_wall(wall("fits", {90, 10}, {100, 10})) == 0);
 }
+
+TEST_CASE("a speed the times of impact cannot square in this arena is a problem of that body", "[validate][hard]") {
+  // Two discs in a 1000 x 1000 box, one at 1e160 units/s off-centre towards the other: the pair's
+  // time of impact squares (r x v) ~ 1e162 to infinity, the root is NaN and the fast disc passed
+  // through the still one without a collision (0 ball-ball, exit 0) before this check.
+  WorldDef d;
+  d.arena.width = 1000;
+  d.arena.height = 1000;
+  d.arena.boundary = Boundary::walls;
+  BallDef fast, still;
+  fast.id = "fast";
+  fast.pos = {100, 500};
+  fast.vel = {1e160, 0};
+  still.id = "still";
+  still.pos = {200, 501};
+  d.balls = {still, fast};
+  auto p = validate(d);
+  REQUIRE(p);
+  CHECK(p->where == DefProblem::Where::ball);
+  CHECK(p->index == 1);
+  CHECK(p->field == "vel");
+  CHECK(p->message.find("ball 'fast': a speed of 1e+160 units/s is beyond what the engine can time") == 0);
+  CHECK(p->message.find("at most 3.5355339") != std::string::npos);  // 1e154 / (2 * 1414.2) units/s
+  CHECK(construction_error(d) == p->message);
+
+  // Just under the limit is a scene (the CLI's runaway tests run 1e150 in a 100 x 100 box).
+  d.balls[1].vel = {3.5e150, 0};
+  CHECK_FALSE(validate(d));
+
+  // A turtle's speed the same way.
+  d.balls.pop_back();
+  TurtleDef t;
+  t.id = "t";
+  t.pos = {500, 500};
+  t.speed = 1e155;
+  d.turtles.push_back(t);
+  p = validate(d);
+  REQUIRE(p);
+  CHECK(p->where == DefProblem::Where::turtle);
+  CHECK(p->field == "speed");
+}
