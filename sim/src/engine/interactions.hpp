@@ -40,9 +40,13 @@ struct Changed {
 /// each other (a buckling chain a piston drives into a disc held in a V), each contact answered
 /// at one instant left its neighbours "touching and approaching" by round-off (1e-13 of their
 /// speed), and the chain served those contacts at that instant for ever.
+/// It runs for every winning candidate of a straight pair, so it is squared: (r x w)^2 against
+/// (sigma - 1e-14 r_min)^2 |w|^2, no root and no division (both sides >= 0: the same comparison).
+/// The squares are the ones toi_disc_disc takes, finite for every pair whose time it found
+/// (validate.cpp keeps speed times distance below 1e154).
 inline bool grazes(Vec2 r, Vec2 w, double sigma, double r_min) {
-  const double speed = norm(w);
-  return speed > 0.0 && std::abs(cross(r, w)) / speed >= sigma - 1e-14 * r_min;
+  const double c = cross(r, w), s = sigma - 1e-14 * r_min;
+  return c * c >= s * s * norm2(w) && norm2(w) > 0.0;
 }
 
 /// Ball i (at its own time, now) and ball j seen through `shift` (a periodic image).
