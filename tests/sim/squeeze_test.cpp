@@ -422,6 +422,38 @@ TEST_CASE("40 discs poured into a 10-degree V under gravity settle, in step mode
   CHECK(w.energy() <= e_settled + 40 * std::pow(10.0 / 30.0, 2));
 }
 
+TEST_CASE("40 discs poured into a 10-degree V settle in exact mode within an event budget (open)", "[.][open][squeeze][rest]") {
+  // Hidden: no rule meets it yet (docs/physics.md, "Why the settled V pour costs what it does").
+  // The acceptance test for one: the step-mode scene above, event-driven. The pour costs 2.1e4
+  // events to t = 6 s; the settled pile then costs 1.5e7 events a simulated second today, because
+  // its weight is carried by impulses at the t_c scale. Today it reaches the budget at t ~ 9.
+  const double h = 5.0 * M_PI / 180.0;
+  const Vec2 apex{100, 10};
+  const double len = 380 / std::cos(h);
+  WorldDef d = box(200, 400);
+  d.walls.push_back({"l", apex, apex + len * Vec2{-std::sin(h), std::cos(h)}});
+  d.walls.push_back({"r", apex, apex + len * Vec2{std::sin(h), std::cos(h)}});
+  d.effects.gravity = {0, -10};
+  d.effects.restitution = 0.8;
+  for (int k = 0; k < 40; ++k)
+    d.balls.push_back(ball("b" + std::to_string(k), {100 + ((k % 3) - 1) * 2.5 + 0.01 * k, 150 + 3.0 * k}, {0, 0}, 1));
+  World w(d, Mode::exact);
+  w.set_event_limit(3000000);
+  const double e0 = w.energy();
+  double worst = 0.0, e_settled = 0.0;
+  for (int k = 1; k <= 100; ++k) {
+    INFO("t = " << 0.2 * k << ", events " << w.stats().events);
+    REQUIRE_NOTHROW(w.advance_to(0.2 * k));
+    worst = std::max(worst, w.measure_overlap().relative);
+    if (k == 75) e_settled = w.energy();
+    CHECK(w.energy() <= e0 * (1.0 + 1e-12));
+  }
+  CHECK(worst <= 1e-9);
+  for (std::size_t i = 0; i < w.ball_count(); ++i) CHECK(w.ball(i).alive);
+  CHECK(w.energy() < 0.5 * e0);
+  CHECK(w.energy() <= e_settled * (1.0 + 1e-12));
+}
+
 namespace {
 
 /// Runs w to `until` one control step at a time, as a program that drives on whenever it is
