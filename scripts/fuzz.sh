@@ -8,6 +8,7 @@
 #   HARNESSES="cli_fuzz protocol_fuzz" scripts/fuzz.sh 1800   # only these
 # A finding (crash-*, timeout-*, oom-*) becomes a regression test: reproduce it with
 #   build/fuzz/fuzz/NAME build/fuzz/findings/NAME/crash-...
+# and, once fixed, keep it in fuzz/regressions/NAME/, which every run replays first.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD  # absolute paths: the cli and protocol harnesses work in a temporary directory of their own
@@ -31,6 +32,16 @@ for h in "${harnesses[@]}"; do
       # and nothing the small ones do not reach).
       find worlds controllers/examples -name '*.json' -not -path 'worlds/bench/*' -exec cp {} "$corpus/" \;
     fi
+  fi
+done
+
+# Earlier findings (fuzz/regressions/NAME/, one file each) run once first, with the same timeout:
+# a finding that comes back stops the script before any fuzzing.
+for h in "${harnesses[@]}"; do
+  if [ -d "fuzz/regressions/$h" ]; then
+    "build/fuzz/fuzz/$h" -timeout=10 -rss_limit_mb=2048 fuzz/regressions/"$h"/* >"build/fuzz/findings/$h/regressions.log" 2>&1 ||
+      { echo "$h: an earlier finding is back (build/fuzz/findings/$h/regressions.log)" >&2; exit 1; }
+    echo "$h: $(find "fuzz/regressions/$h" -type f | wc -l) earlier findings pass"
   fi
 done
 

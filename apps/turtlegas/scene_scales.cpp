@@ -45,6 +45,17 @@ SceneScales predict_scales(const sim::WorldDef& def, sim::Mode mode) {
       s.by_fields = false;
     }
   }
+  if (mode == sim::Mode::exact && def.effects.magnetic != 0.0) {
+    for (const sim::BallDef& b : def.balls) {
+      if (b.charge == 0.0 || !(b.mass > 0.0)) continue;
+      const double turns = std::abs(b.charge * def.effects.magnetic / b.mass) / (2.0 * M_PI);
+      s.replans_per_second += turns / 8.0;
+      if (!(turns <= s.turns_per_second)) {
+        s.turns_per_second = turns;
+        s.gyrating_id = b.id;
+      }
+    }
+  }
   const double per_step = 1.0 / def.dt;
   if (mode == sim::Mode::step) {
     s.steps_per_second = per_step;
@@ -59,8 +70,12 @@ SceneScales predict_scales(const sim::WorldDef& def, sim::Mode mode) {
 
 void SceneScales::set_cell(double cell) {
   if (!(cell > 0.0)) return;
-  events_per_second = speed_sum / cell;
-  if (!fastest_id.empty())
+  const double crossings = speed_sum / cell;
+  events_per_second = crossings + replans_per_second;
+  if (!(replans_per_second <= crossings))
+    events_why = "'" + gyrating_id + "' gyrates " + num(turns_per_second) +
+                 " times a second in the magnetic field, and exact mode re-plans a circle every 8 turns";
+  else if (!fastest_id.empty())
     events_why = "'" + fastest_id + "' may reach speed " + num(fastest) +
                  (by_fields ? " (the fields accelerate it across the arena)" : "") + ", crossing a cell of " + num(cell) +
                  " every " + num(cell / fastest) + " s";

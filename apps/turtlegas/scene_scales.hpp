@@ -29,6 +29,12 @@ struct SceneScales {
   double fastest = 0.0;       ///< units/s, the largest speed bound
   std::string fastest_id;
   bool by_fields = false;     ///< the fields give the fastest body most of its speed
+  /// Exact mode's re-plans of charged balls gyrating in the magnetic field, per simulated second:
+  /// a circle re-plans at most every 8 turns (docs/physics.md, "Horizons"), |q Bz / m| / (16 pi)
+  /// for each; the most frequent one and its id.
+  double replans_per_second = 0.0;
+  double turns_per_second = 0.0;
+  std::string gyrating_id;
   /// The event rate and its cause for cells of this side (the engine's cell_size()).
   void set_cell(double cell);
 };

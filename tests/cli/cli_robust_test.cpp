@@ -351,6 +351,13 @@ TEST_CASE("robust: check warns, with numbers, about scenes whose scales predict 
       {R"({"format": "turtlegas-world/1", "arena": {"width": 100, "height": 100, "boundary": "walls"},
           "effects": {"gravity": [0, -1e300]}, "balls": [{"id": "b", "pos": [50, 50], "radius": 1}]})",
        "the fields accelerate it"},
+      // An ion gyrating 2e36 times a second (q = 2.56e37, Bz = 0.5): exact mode re-plans its circle
+      // every 8 turns. A fuzzed scene (fuzz/regressions/world_fuzz/ions-charge-2.6e37.json); check
+      // was silent about it, and a run makes 8.4e36 events a second.
+      {R"({"format": "turtlegas-world/1", "arena": {"width": 100, "height": 100, "boundary": "walls"},
+          "effects": {"magnetic": 0.5}, "balls": [{"id": "ion", "pos": [50, 50], "vel": [30, 0], "radius": 1,
+          "charge": 2.56e37}, {"id": "other", "pos": [20, 20], "vel": [0, 3], "radius": 1, "charge": 1}]})",
+       "'ion' gyrates 2.04e+36 times a second"},
       {R"({"format": "turtlegas-world/1", "dt": 1e-300, "arena": {"width": 100, "height": 100},
           "turtles": [{"id": "t", "pos": [50, 50], "controller": "wander"}]})",
        "steps"},
