@@ -387,10 +387,11 @@ TEST_CASE("a piston crushing a ball against a wall end or a standing turtle, hea
   }
 }
 
-TEST_CASE("40 discs poured into a 10-degree V under gravity settle, in step mode, without a hang", "[squeeze][rest]") {
-  // Discs squeezed by discs: the first disc wedges at the apex (held by the rule), the next presses
-  // onto it, and the two exchanged round-off velocities (1e-19) with the walls for ever at one
-  // instant (t = 6.19 s). A held disc pushed into both its holders now counts as heavy as they are.
+namespace {
+
+/// 40 discs of radius 1 above a V of 10 degrees (half-angle 5, apex (100, 10)) in a 200 x 400 box,
+/// under gravity, e = 0.8: they fall and pile up in the V.
+WorldDef v_pour() {
   const double h = 5.0 * M_PI / 180.0;
   const Vec2 apex{100, 10};
   const double len = 380 / std::cos(h);
@@ -401,7 +402,16 @@ TEST_CASE("40 discs poured into a 10-degree V under gravity settle, in step mode
   d.effects.restitution = 0.8;
   for (int k = 0; k < 40; ++k)
     d.balls.push_back(ball("b" + std::to_string(k), {100 + ((k % 3) - 1) * 2.5 + 0.01 * k, 150 + 3.0 * k}, {0, 0}, 1));
-  World w(d, Mode::step);
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("40 discs poured into a 10-degree V under gravity settle, in step mode, without a hang", "[squeeze][rest]") {
+  // Discs squeezed by discs: the first disc wedges at the apex (held by the rule), the next presses
+  // onto it, and the two exchanged round-off velocities (1e-19) with the walls for ever at one
+  // instant (t = 6.19 s). A held disc pushed into both its holders now counts as heavy as they are.
+  World w(v_pour(), Mode::step);
   Run run;
   w.set_event_log(nullptr);
   w.set_event_limit(3000000);
@@ -427,17 +437,7 @@ TEST_CASE("40 discs poured into a 10-degree V settle in exact mode within an eve
   // The acceptance test for one: the step-mode scene above, event-driven. The pour costs 2.1e4
   // events to t = 6 s; the settled pile then costs 1.5e7 events a simulated second today, because
   // its weight is carried by impulses at the t_c scale. Today it reaches the budget at t ~ 9.
-  const double h = 5.0 * M_PI / 180.0;
-  const Vec2 apex{100, 10};
-  const double len = 380 / std::cos(h);
-  WorldDef d = box(200, 400);
-  d.walls.push_back({"l", apex, apex + len * Vec2{-std::sin(h), std::cos(h)}});
-  d.walls.push_back({"r", apex, apex + len * Vec2{std::sin(h), std::cos(h)}});
-  d.effects.gravity = {0, -10};
-  d.effects.restitution = 0.8;
-  for (int k = 0; k < 40; ++k)
-    d.balls.push_back(ball("b" + std::to_string(k), {100 + ((k % 3) - 1) * 2.5 + 0.01 * k, 150 + 3.0 * k}, {0, 0}, 1));
-  World w(d, Mode::exact);
+  World w(v_pour(), Mode::exact);
   w.set_event_limit(3000000);
   const double e0 = w.energy();
   double worst = 0.0, e_settled = 0.0;
