@@ -45,8 +45,8 @@ struct Changed {
 /// The squares are the ones toi_disc_disc takes, finite for every pair whose time it found
 /// (validate.cpp keeps speed times distance below 1e154).
 inline bool grazes(Vec2 r, Vec2 w, double sigma, double r_min) {
-  const double c = cross(r, w), s = sigma - 1e-14 * r_min;
-  return c * c >= s * s * norm2(w) && norm2(w) > 0.0;
+  const double c = cross(r, w), s = sigma - 1e-14 * r_min, w2 = norm2(w);
+  return c * c >= s * s * w2 && w2 > 0.0;  // (w2 > 0 tested first cost 0.6 % more)
 }
 
 /// Ball i (at its own time, now) and ball j seen through `shift` (a periodic image).
