@@ -175,7 +175,7 @@ nlohmann::json Observer::result() const {
   const double across = opt_.axis == 'x' ? height_ : width_;
   double total_length = 0.0;
   for (double l : wall_length_) total_length += l;
-  std::vector<double> kT, speed, rate, wall_rate, mfp, p_walls, p_virial, z_virial, density;
+  std::vector<double> kT, speed, rate, wall_rate, mfp, p_walls, p_virial, z_virial, p_canonical, z_canonical, density;
   std::vector<std::vector<double>> per_wall(wall_length_.size());
   nlohmann::json windows = nlohmann::json::array();
   for (const Window& w : done_) {
@@ -205,8 +205,18 @@ nlohmann::json Observer::result() const {
       const double P = (w.kinetic / s + w.virial / (2.0 * dt)) / area;
       p_virial.push_back(P);
       z_virial.push_back(n * T > 0.0 ? P * area / (n * T) : 0.0);
+      // The canonical (Monte Carlo, NVT) pressure of the same N and area: a momentum-conserving run
+      // has d(N - 1) kinetic degrees of freedom, a canonical one d N, so its ideal part is N kT / A
+      // where ours is (N - 1) kT / A. The collisional part is the same at the same kT: hard discs'
+      // configurations are equally likely in both ensembles, and at fixed total momentum the pair's
+      // relative velocity still has <(v_i - v_j)_a^2> = kT / m_red exactly (docs/physics.md, "Gas
+      // observables"). So P_canonical = P + kT / A and Z_canonical = Z + 1 / N.
+      p_canonical.push_back(P + T / area);
+      z_canonical.push_back(n > 0.0 ? z_virial.back() + 1.0 / n : 0.0);
       row["pressure_virial"] = P;
       row["Z_virial"] = z_virial.back();
+      row["pressure_canonical"] = p_canonical.back();
+      row["Z_canonical"] = z_canonical.back();
     }
     windows.push_back(row);
   }
@@ -220,6 +230,8 @@ nlohmann::json Observer::result() const {
   if (periodic) {
     summary["pressure_virial"] = block(p_virial);
     summary["Z_virial"] = block(z_virial);
+    summary["pressure_canonical"] = block(p_canonical);
+    summary["Z_canonical"] = block(z_canonical);
   }
   // Histograms: per window, normalised, then block-averaged bin by bin.
   const double bw = speed_max_ / opt_.speed_bins;
