@@ -28,6 +28,7 @@ nlohmann::json stats_json(const RunFigures& run, const sim::World& world) {
       {"exits", st.exits},
       {"wedged", st.wedged},
       {"crushed", st.crushed},
+      {"folded", st.folded},
       {"turtle_wall", st.turtle_wall},
       {"turtle_wall_end", st.turtle_wall_end},
       {"turtle_turtle", st.turtle_turtle},

@@ -21,6 +21,10 @@ enum class EventKind : std::uint8_t {
   // which of a, b, c are turtles).
   wedged,   ///< the body's velocity along the squeeze was taken away; it stays in the scene
   crushed,  ///< two obstacles closing on the body left it no room: it is removed
+  /// An elastic ball touching two walls (or wall ends) b and c at one instant, reflected by each in
+  /// turn until it leaves both, served at once in closed form (docs/physics.md, "The elastic
+  /// wedge"); energy kept. Stats::ball_wall / ball_wall_end count each reflection.
+  folded,
 };
 
 /// Event::flags bits: which of a, b and c index turtles (the squeeze events only), and which of
@@ -43,6 +47,7 @@ constexpr std::string_view to_string(EventKind k) {
     case EventKind::turtle_ball: return "turtle-ball";
     case EventKind::wedged: return "wedged";
     case EventKind::crushed: return "crushed";
+    case EventKind::folded: return "folded";
   }
   return "?";
 }

@@ -21,6 +21,7 @@ struct Stats {
   std::uint64_t exits = 0;
   std::uint64_t wedged = 0;   ///< the squeeze rule took a body's velocity (docs/physics.md)
   std::uint64_t crushed = 0;  ///< bodies removed by the squeeze rule
+  std::uint64_t folded = 0;   ///< elastic wedges served in closed form (their reflections count as ball_wall*)
   std::uint64_t turtle_wall = 0;
   std::uint64_t turtle_wall_end = 0;
   std::uint64_t turtle_turtle = 0;

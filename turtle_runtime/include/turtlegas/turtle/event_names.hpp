@@ -52,6 +52,8 @@ EventIds name_event(const sim::Event& e, const Names& names) {
       return {(e.flags & sim::kTurtleA) != 0 ? std::string_view(names.turtle(e.a)) : std::string_view(names.ball(e.a)),
               body(e.b, sim::kTurtleB, sim::kBallB), body(e.c, sim::kTurtleC, sim::kBallC)};
     }
+    // The ball and the two walls (or the walls owning the ends) it was folded between.
+    case sim::EventKind::folded: return {names.ball(e.a), names.wall(e.b), names.wall(e.c)};
     default: return {names.turtle(e.a), other_body(e.kind, e.b, names), std::nullopt};
   }
 }
