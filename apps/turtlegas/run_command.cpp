@@ -50,7 +50,6 @@ struct RunTotals {
   double energy_start = 0.0;
   std::uint64_t touches = 0;
   std::uint64_t faults = 0;
-  std::size_t turtles_finished = 0;
 };
 
 /// How many times a run measures the deepest overlap when --overlap-samples does not say: at every
@@ -494,7 +493,6 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   progress.clear();
   if (server) {
     server->set_event_log(nullptr);
-    for (std::size_t i = 0; i < server->turtle_count(); ++i) totals.turtles_finished += server->turtle(i).finished ? 1 : 0;
   } else {
     bare->set_event_log(nullptr);
     if (observer) observer->detach();
@@ -506,7 +504,6 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   }
   const std::string stopped = stop_name(end);
 
-  const sim::Overlap now = world.measure_overlap(), seen = world.max_contact_overlap();
   formats::RunFigures run;
   run.world = opt.world;
   run.name = def.name;
@@ -517,17 +514,13 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   run.dt = def.dt;
   run.seed = def.seed;
   run.balls = ball_count;
-  for (std::size_t i = 0; i < world.ball_count(); ++i) run.balls_alive += world.ball(i).alive ? 1 : 0;
   run.turtles = def.turtles.size();
-  run.turtles_finished = totals.turtles_finished;
   run.touches = totals.touches;
   run.faults = totals.faults;
   run.wall_seconds = seconds_since(start);
   run.energy_start = totals.energy_start;
-  run.energy_end = world.energy();
-  run.max_overlap = std::max({now.depth, seen.depth, sampled.depth});
-  run.max_overlap_relative = std::max({now.relative, seen.relative, sampled.relative});
   run.overlap_samples = samples;
+  finish_run(run, world, server.get(), sampled);
 
   if (events_file) events_file->commit();
   if (recorder) {
