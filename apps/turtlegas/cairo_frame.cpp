@@ -203,7 +203,7 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
   }
   cairo_surface_flush(surface.get());
   if (cairo_surface_write_to_png_stream(surface.get(), write_to_stream, &out) != CAIRO_STATUS_SUCCESS)
-    throw std::runtime_error("could not encode the PNG");
+    throw std::runtime_error(!out ? "could not write the PNG" : "could not encode the PNG");  // the stream says why
 }
 
 }  // namespace turtlegas::apps

@@ -20,7 +20,8 @@ struct Window {
 
 /// Draws `snap` as a PNG on `out`: the window `win`, its longer side width_px pixels; `it` the tag
 /// game's "it" (ringed in red; "" for none); `layers` what to draw (turtle/view.hpp's kLayer*).
-/// Throws std::runtime_error when the PNG cannot be encoded or written (saying why: a full disk).
+/// Throws std::runtime_error when the PNG cannot be encoded, or written (`out` refused a write:
+/// its OutputFile's failure() says why, a full disk say).
 void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& win, double width_px,
                const std::string& it, std::uint32_t layers);
 

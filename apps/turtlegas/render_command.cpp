@@ -155,9 +155,14 @@ class Renderer {
     else {
       std::uint32_t layers = 0;
       const Window win = window(layers);
-      write_png(out.stream(), snap, win, opt_.width, it(), layers);
+      try {
+        write_png(out.stream(), snap, win, opt_.width, it(), layers);
+      } catch (const std::runtime_error& e) {
+        const std::string why = out.failure();  // "No space left on device"
+        throw std::runtime_error(option + " " + path + ": " + e.what() + (why.empty() ? "" : ": " + why));
+      }
     }
-    out.commit();
+    out.commit();  // says why a write failed (a full disk), naming the file
   }
 
  private:
