@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
+#include "output_file.hpp"
 #include "sweep/sweep.hpp"
 
 namespace turtlegas::apps {
@@ -37,14 +38,18 @@ CLI::App* add_sweep_command(CLI::App& app, SweepOptions& options) {
   add_program_budget_option(*cmd, options.program_budget, "its run fails");
   cmd->add_flag("--quiet,-q", options.quiet, "No progress lines");
   cmd->add_option("--run", options.child_run, "(internal) run this one run here, report on descriptor 3")->group("");
+  cmd->add_option("--inputs-fd", options.inputs_fd, "(internal) the spec and world the parent read, on this descriptor")
+      ->group("");
   return cmd;
 }
 int sweep_command(const SweepOptions& options, const turtle::Registry& registry, const std::vector<std::string>& plugins) {
-  const sweep::Spec spec = sweep::parse_spec(options.spec);
-  const std::string out = options.out.empty() ? sweep::default_out(options.spec) : options.out;
-
   if (options.child_run) {
-    if (::fcntl(3, F_GETFD) == -1 || *options.child_run >= spec.runs)
+    // The spec and world the parent read, not the files as they are now (sweep/sweep.hpp, Inputs).
+    if (::fcntl(3, F_GETFD) == -1 || !options.inputs_fd || ::fcntl(*options.inputs_fd, F_GETFD) == -1)
+      throw BadInput("sweep --run is for turtlegas itself: it runs one run of the sweep and reports on descriptor 3");
+    const sweep::Inputs given = sweep::read_inputs(*options.inputs_fd);
+    const sweep::Spec spec = sweep::parse_spec(options.spec, &given);
+    if (*options.child_run >= spec.runs)
       throw BadInput("sweep --run is for turtlegas itself: it runs one run of the sweep and reports on descriptor 3");
     const std::string line = sweep::run_one(spec, *options.child_run, registry, sweep::server_options(options)).dump() + "\n";
     for (std::size_t done = 0; done < line.size();) {
@@ -54,6 +59,13 @@ int sweep_command(const SweepOptions& options, const turtle::Registry& registry,
     }
     return exit_ok;
   }
+
+  const sweep::Spec spec = sweep::parse_spec(options.spec);
+  const std::string out = options.out.empty() ? sweep::default_out(options.spec) : options.out;
+  // The results and the journal beside them must not be the spec or the world they come from.
+  std::vector<NamedPath> inputs{{spec.file, "the sweep spec"}, {spec.world_file, "the world file"}};
+  for (const std::string& p : plugins) inputs.push_back({p, "--plugin"});
+  check_outputs({{out, "--out"}, {out + ".partial", "--out's journal (" + out + ".partial)"}}, inputs);
 
   return sweep::run_launched(options, registry, plugins, spec, out);
 }

@@ -1,18 +1,53 @@
 // SPDX-License-Identifier: MIT
-// `turtlegas sweep`: the journal that makes a sweep resumable.
+// `turtlegas sweep`: the journal that makes a sweep resumable. Every write is checked: a failed one
+// (a full disk) says what failed and where, and leaves the journal with the lines that were whole.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
+
+#include <spdlog/spdlog.h>
 
 #include "checkpoint.hpp"
 #include "cli_common.hpp"
 #include "sweep/sweep.hpp"
 
 namespace turtlegas::apps::sweep {
+namespace {
 
 namespace fs = std::filesystem;
+
+/// Writes all of `text` at the end of fd; on failure, strerror (the file keeps what it had).
+std::string append_all(int fd, const std::string& text) {
+  const off_t before = ::lseek(fd, 0, SEEK_END);
+  for (std::size_t done = 0; done < text.size();) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const std::string why = n < 0 ? std::strerror(errno) : "the write made no progress";
+      if (before >= 0 && ::ftruncate(fd, before) != 0) return why + " (and a part of the line may be left)";
+      return why;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return {};
+}
+
+/// Whether j is a result line of run k as run_one writes it: k's seed and overrides, and stats.
+bool is_result_of(const Spec& spec, std::size_t k, const json& j) {
+  const auto [idx, seed] = decompose(spec, k);
+  return j.is_object() && j.value("seed", json()) == json(seed) && j.value("overrides", json()) == overrides_of(spec, idx) &&
+         j.contains("stats") && j["stats"].is_object();
+}
+
+}  // namespace
 
 std::string fingerprint(const Spec& spec) {
   char b[32];
@@ -24,6 +59,7 @@ std::string fingerprint(const Spec& spec) {
 Journal::Journal(const std::string& out, const Spec& spec, Results& results) : path_(out + ".partial") {
   const std::string fp = fingerprint(spec);
   std::vector<std::string> good;
+  std::size_t untrusted = 0;
   if (fs::exists(path_)) {
     std::ifstream in(path_);
     std::string line;
@@ -38,32 +74,59 @@ Journal::Journal(const std::string& out, const Spec& spec, Results& results) : p
       }
       if (j.is_discarded() || !j.contains("run") || !j["run"].is_number_unsigned() || in.eof()) continue;
       const std::size_t k = j["run"].get<std::size_t>();
+      if (k < spec.runs && !results.count(k) && !is_result_of(spec, k, j)) {
+        ++untrusted;
+        continue;
+      }
       if (k < spec.runs && !results.count(k)) {
         results[k] = line;
         good.push_back(line);
       }
     }
   }
-  // Rewritten whole (a cut line gone), then appended to.
-  {
-    std::ofstream rewrite(path_ + ".tmp", std::ios::trunc);
-    rewrite << json{{"fingerprint", fp}, {"spec", spec.file}}.dump() << '\n';
-    for (const std::string& l : good) rewrite << l << '\n';
-    if (!rewrite) throw BadInput(path_ + ": cannot write the sweep's journal here");
+  if (untrusted > 0)
+    spdlog::warn("{}: {} line(s) are not a result of this sweep's run they name (its seed, overrides and stats); "
+                 "those runs run again",
+                 path_, untrusted);
+  // Rewritten whole (a cut line gone) under another name and renamed, then appended to.
+  const std::string tmp = path_ + ".tmp";
+  std::string text = json{{"fingerprint", fp}, {"spec", spec.file}}.dump() + "\n";
+  for (const std::string& l : good) text += l + "\n";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw BadInput(path_ + ": cannot write the sweep's journal here (" + std::strerror(errno) + ")");
+  std::string why = append_all(fd, text);
+  if (::close(fd) != 0 && why.empty()) why = std::strerror(errno);
+  std::error_code ec;
+  if (why.empty()) fs::rename(tmp, path_, ec);
+  if (!why.empty() || ec) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error(path_ + ": cannot write the sweep's journal: " + (why.empty() ? ec.message() : why) +
+                             (fs::exists(path_) ? "; it is left as it was" : ""));
   }
-  fs::rename(path_ + ".tmp", path_);
-  out_.open(path_, std::ios::app);
-  if (!out_) throw BadInput(path_ + ": cannot write the sweep's journal here");
+  recorded_ = good.size();
+  fd_ = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  if (fd_ < 0) throw std::runtime_error(path_ + ": cannot append to the sweep's journal: " + std::strerror(errno));
+}
+
+Journal::~Journal() {
+  if (fd_ >= 0) ::close(fd_);
 }
 
 void Journal::record(const std::string& line) {
-  out_ << line << '\n';
-  out_.flush();
+  const std::string why = append_all(fd_, line + "\n");
+  if (!why.empty())
+    throw std::runtime_error(path_ + ": cannot append a finished run to the sweep's journal: " + why + "; the " +
+                             std::to_string(recorded_) +
+                             " runs recorded before are kept whole there: make room and run the same command again "
+                             "to go on");
+  ++recorded_;
 }
 
 void Journal::remove() {
-  out_.close();
-  fs::remove(path_);
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  std::error_code ec;
+  fs::remove(path_, ec);
 }
 
 }  // namespace turtlegas::apps::sweep

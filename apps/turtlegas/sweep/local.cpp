@@ -1,6 +1,14 @@
 // SPDX-License-Identifier: MIT
 // `turtlegas sweep`: the runs as child processes of this machine, --jobs at once.
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <spdlog/spdlog.h>
@@ -13,6 +21,48 @@
 
 namespace turtlegas::apps::sweep {
 
+namespace {
+
+constexpr std::string_view inputs_magic = "turtlegas-sweep-inputs/1\n";
+
+}  // namespace
+
+int share_inputs(const Inputs& inputs) {
+  const int fd = ::memfd_create("turtlegas-sweep-inputs", 0);
+  if (fd < 0) throw std::runtime_error(std::string("sweep: cannot hand the spec to its runs: ") + std::strerror(errno));
+  const std::string text = std::string(inputs_magic) + std::to_string(inputs.spec.size()) + "\n" + inputs.spec + inputs.world;
+  for (std::size_t done = 0; done < text.size();) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw std::runtime_error(std::string("sweep: cannot hand the spec to its runs: ") + std::strerror(errno));
+    done += static_cast<std::size_t>(n);
+  }
+  // Above the descriptors a child is given (0-4, child_processes.hpp), and inherited: no O_CLOEXEC.
+  const int high = ::fcntl(fd, F_DUPFD, 10);
+  ::close(fd);
+  if (high < 0) throw std::runtime_error(std::string("sweep: cannot hand the spec to its runs: ") + std::strerror(errno));
+  return high;
+}
+
+Inputs read_inputs(int fd) {
+  std::string text;
+  char buf[65536];
+  for (off_t at = 0;;) {  // pread: the children share the descriptor's offset
+    const ssize_t n = ::pread(fd, buf, sizeof buf, at);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw BadInput("sweep --inputs-fd: cannot read descriptor " + std::to_string(fd) + ": " + std::strerror(errno));
+    if (n == 0) break;
+    text.append(buf, static_cast<std::size_t>(n));
+    at += n;
+  }
+  const std::size_t eol = text.find('\n', inputs_magic.size());
+  if (text.rfind(inputs_magic, 0) != 0 || eol == std::string::npos)
+    throw BadInput("sweep --inputs-fd is for turtlegas itself: the spec and world its parent read");
+  const std::size_t size = std::stoull(text.substr(inputs_magic.size(), eol - inputs_magic.size()));
+  if (size > text.size() - eol - 1) throw BadInput("sweep --inputs-fd: the spec handed over is cut short");
+  return {text.substr(eol + 1, size), text.substr(eol + 1 + size)};
+}
+
 int run_local(const SweepOptions& options, const std::vector<std::string>& plugins, const Spec& spec,
               const std::string& out) {
   Results results;
@@ -22,10 +72,13 @@ int run_local(const SweepOptions& options, const std::vector<std::string>& plugi
     if (!results.count(k)) pending.push_back(k);
   if (!results.empty() && !options.quiet)
     spdlog::info("sweep: resuming: {} of {} runs already recorded in {}.partial", results.size(), spec.runs, out);
+  // Every run is of the bytes read here, not of the files as they may be by the time it starts.
+  const int inputs_fd = share_inputs(spec.bytes);
   std::vector<std::vector<std::string>> args;
   for (std::size_t k : pending) {
-    std::vector<std::string> a = {"sweep", spec.file, "--run", std::to_string(k), "--stack-kib",
-                                  std::to_string(options.stack_kib), "--program-budget", json(options.program_budget).dump()};
+    std::vector<std::string> a = {"sweep", spec.file, "--run", std::to_string(k), "--inputs-fd", std::to_string(inputs_fd),
+                                  "--stack-kib", std::to_string(options.stack_kib), "--program-budget",
+                                  json(options.program_budget).dump()};
     for (const std::string& p : plugins) a.insert(a.end(), {"--plugin", p});
     args.push_back(std::move(a));
   }
@@ -60,6 +113,7 @@ int run_local(const SweepOptions& options, const std::vector<std::string>& plugi
   };
   install_stop_signals("stopping the runs; the results so far are kept for the next sweep");
   const int stopped_by = run_children(args, options.jobs, options.timeout, {on_done, on_tick});
+  ::close(inputs_fd);
   status.clear();
   if (stopped_by != 0) {
     // The journal holds every run that ended, each line whole: the same command goes on from there.

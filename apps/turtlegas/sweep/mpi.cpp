@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `turtlegas sweep` under mpirun: rank 0 hands out runs one at a time and gathers their lines;
 // without MPI in this build, the sweep runs on this machine and says how to get MPI.
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
@@ -70,6 +71,28 @@ int mpi_master(const SweepOptions& options, const Spec& spec, const std::string&
   return finish(out, spec, results, journal, failed);
 }
 
+/// The bytes rank 0 read, sent to every rank (each read the files itself at its start, and one
+/// edited meanwhile must not give one results file of two worlds).
+Inputs g_rank0_inputs;
+
+void share_rank0_inputs(int rank, const Spec& spec) {
+  auto broadcast = [](std::string& s) {
+    unsigned long long n = s.size();
+    MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+    s.resize(static_cast<std::size_t>(n));
+    for (std::size_t at = 0; at < s.size();) {  // MPI counts are int: in pieces under 2^30
+      const int piece = static_cast<int>(std::min<std::size_t>(s.size() - at, std::size_t{1} << 30));
+      MPI_Bcast(s.data() + at, piece, MPI_CHAR, 0, MPI_COMM_WORLD);
+      at += static_cast<std::size_t>(piece);
+    }
+  };
+  if (rank == 0) g_rank0_inputs = spec.bytes;
+  broadcast(g_rank0_inputs.spec);
+  broadcast(g_rank0_inputs.world);
+}
+
+Spec rank0_spec(const Spec& spec) { return parse_spec(spec.file, &g_rank0_inputs); }
+
 /// Ranks 1 ... K-1: ask for a run, run it here, send its line, until told to stop.
 int mpi_worker(const SweepOptions& options, const Spec& spec, const turtle::Registry& registry) {
   std::string msg;
@@ -102,13 +125,14 @@ int run_launched(const SweepOptions& options, const turtle::Registry& registry, 
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     int rc = exit_ok;
+    if (size > 1) share_rank0_inputs(rank, spec);
     if (size == 1) {
       rc = run_local(options, plugins, spec, out);
     } else if (rank == 0) {
       if (!options.quiet) spdlog::info("sweep: {} runs over {} MPI ranks (rank 0 hands them out)", spec.runs, size);
       rc = mpi_master(options, spec, out, size);
     } else {
-      rc = mpi_worker(options, spec, registry);
+      rc = mpi_worker(options, rank0_spec(spec), registry);
     }
     MPI_Finalize();
     return rank == 0 ? rc : exit_ok;

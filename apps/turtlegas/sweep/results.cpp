@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <spdlog/spdlog.h>
+
 #include "cli_common.hpp"
 #include "output_file.hpp"
 #include "sweep/sweep.hpp"
@@ -100,16 +102,37 @@ std::string summary_table(const Spec& spec, const Results& results) {
 std::string default_out(const std::string& spec) {
   return fs::path(spec).stem().string() + ".results.jsonl";
 }
+std::vector<std::string> summary_not_found(const Spec& spec, const Results& results) {
+  std::vector<std::string> missing;
+  for (const std::string& p : spec.summary) {
+    const json::json_pointer ptr(p);
+    bool found = false;
+    for (auto it = results.begin(); it != results.end() && !found; ++it) {
+      const json j = json::parse(it->second, nullptr, false);
+      found = !j.is_discarded() && j.contains(ptr);
+    }
+    if (!found) missing.push_back(p);
+  }
+  return missing;
+}
+
 int finish(const std::string& out, const Spec& spec, Results& results, Journal& journal, std::size_t failed) {
   std::fputs(summary_table(spec, results).c_str(), stdout);
+  // A summary pointer that no result line has is a misspelling, not a column of "-".
+  const std::vector<std::string> missing = results.empty() ? std::vector<std::string>{} : summary_not_found(spec, results);
+  for (const std::string& p : missing)
+    spdlog::error("{}: /summary: \"{}\" is in no result line (misspelt? a line has /run, /seed, /overrides, "
+                  "/stats/... as docs/sweeps.md lists, /tag with a game, /expect with an expect list)",
+                  spec.file, p);
   if (results.size() == spec.runs) {
     write_results(out, spec, results);
     journal.remove();
     std::printf("%zu runs; results in %s\n", spec.runs, out.c_str());
-    return exit_ok;
+    return missing.empty() ? exit_ok : exit_bad_input;
   }
   std::printf("%zu of %zu runs have results (%zu failed); run the same command again to retry the rest\n",
               results.size(), spec.runs, failed);
   return exit_failure;
 }
+
 }  // namespace turtlegas::apps::sweep

@@ -17,30 +17,23 @@ namespace {
 
 namespace fs = std::filesystem;
 
-json read_json_file(const std::string& file, const std::string& what) {
-  std::ifstream in(file);
+std::string read_bytes(const std::string& file, const std::string& what) {
+  std::ifstream in(file, std::ios::binary);
   if (!in) throw BadInput(file + ": no such file (" + what + ")");
   std::stringstream s;
   s << in.rdbuf();
-  json j = json::parse(s.str(), nullptr, false);
-  if (j.is_discarded()) throw BadInput(file + ": invalid JSON (" + what + ")");
-  return j;
+  return std::move(s).str();
 }
 
 }  // namespace
 
-Spec parse_spec(const std::string& file) {
+Spec parse_spec(const std::string& file, const Inputs* given) {
   Spec spec;
   spec.file = file;
   // The spec's own keys keep their order (grid axes are expanded in the order written).
-  {
-    std::ifstream in(file);
-    if (!in) throw BadInput(file + ": no such file (the sweep spec)");
-    std::stringstream s;
-    s << in.rdbuf();
-    spec.text = nlohmann::ordered_json::parse(s.str(), nullptr, false);
-    if (spec.text.is_discarded()) throw BadInput(file + ": invalid JSON (the sweep spec)");
-  }
+  spec.bytes.spec = given ? given->spec : read_bytes(file, "the sweep spec");
+  spec.text = nlohmann::ordered_json::parse(spec.bytes.spec, nullptr, false);
+  if (spec.text.is_discarded()) throw BadInput(file + ": invalid JSON (the sweep spec)");
   const nlohmann::ordered_json& ordered = spec.text;
   auto bad = [&](const std::string& path, const std::string& what) { return BadInput(file + ": " + path + ": " + what); };
   if (!ordered.is_object()) throw bad("/", "a sweep spec is a JSON object");
@@ -53,7 +46,9 @@ Spec parse_spec(const std::string& file) {
     throw bad("/world", "the world file to sweep, relative to this file");
   const fs::path world_path = fs::path(ordered["world"].get<std::string>());
   spec.world_file = (world_path.is_absolute() ? world_path : fs::path(file).parent_path() / world_path).lexically_normal().string();
-  spec.world = read_json_file(spec.world_file, "the world of sweep " + file);
+  spec.bytes.world = given ? given->world : read_bytes(spec.world_file, "the world of sweep " + file);
+  spec.world = json::parse(spec.bytes.world, nullptr, false);
+  if (spec.world.is_discarded()) throw BadInput(spec.world_file + ": invalid JSON (the world of sweep " + file + ")");
   if (!ordered.contains("until") || !ordered["until"].is_number() || !std::isfinite(ordered["until"].get<double>()) ||
       ordered["until"].get<double>() <= 0.0)
     throw bad("/until", "simulated seconds per run, a number > 0");

@@ -11,7 +11,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <fstream>
 #include <map>
 #include <string>
 #include <utility>
@@ -30,8 +29,17 @@ using nlohmann::json;
 
 constexpr std::size_t max_runs = 10'000'000;
 
+/// The bytes a sweep read: its spec and its world file, as they were when it began. Its runs (child
+/// processes, MPI ranks) are handed these rather than read the files again, so that a file edited
+/// while the sweep goes on cannot give one results file of two worlds.
+struct Inputs {
+  std::string spec;
+  std::string world;
+};
+
 /// A sweep specification (docs/sweeps.md).
 struct Spec {
+  Inputs bytes;             ///< the files as read
   std::string file;         ///< the spec, as given
   nlohmann::ordered_json text;  ///< the spec as read, in its order (the results' first line)
   std::string world_file;   ///< resolved against the spec's folder
@@ -44,8 +52,15 @@ struct Spec {
   std::size_t runs = 0;
 };
 
-/// Reads and checks a spec and its world file; BadInput naming the key for one that is not right.
-Spec parse_spec(const std::string& file);
+/// Reads and checks a spec and its world file (or, given, the bytes the sweep read at its start);
+/// BadInput naming the key for one that is not right.
+Spec parse_spec(const std::string& file, const Inputs* given = nullptr);
+
+/// Hands `inputs` to child processes: a memory file whose descriptor (returned, >= 10) the children
+/// inherit. read_inputs(fd) in the child reads it back.
+int share_inputs(const Inputs& inputs);
+/// The inputs a parent shared (share_inputs); BadInput when the descriptor holds none.
+Inputs read_inputs(int fd);
 
 /// Run k's grid point (one value index per axis, the first axis slowest) and seed.
 std::pair<std::vector<std::size_t>, std::uint64_t> decompose(const Spec& spec, std::size_t k);
@@ -71,22 +86,30 @@ class Journal {
   /// Reads the runs a journal of this spec already holds into `results` and rewrites it whole
   /// (a cut line gone); BadInput for a journal of another spec or world.
   Journal(const std::string& out, const Spec& spec, Results& results);
-  /// Appends a run's line.
+  Journal(const Journal&) = delete;
+  Journal& operator=(const Journal&) = delete;
+  ~Journal();
+  /// Appends a run's line; std::runtime_error saying what failed and where when it cannot be
+  /// written whole (a full disk), the journal then holding the lines that were.
   void record(const std::string& line);
   /// The sweep is done: the journal goes.
   void remove();
 
  private:
   std::string path_;
-  std::ofstream out_;
+  int fd_ = -1;
+  std::size_t recorded_ = 0;  ///< runs in the journal
 };
 
 /// Per grid point, the mean and 95 % t-interval of each summary pointer over the seeds.
 std::string summary_table(const Spec& spec, const Results& results);
 /// <spec's stem>.results.jsonl, here.
 std::string default_out(const std::string& spec);
+/// The summary pointers that no result line has (misspelt).
+std::vector<std::string> summary_not_found(const Spec& spec, const Results& results);
 /// The end of a sweep: the summary table, and the results file when every run has a result (the
-/// journal then removed). exit_ok, or exit_failure when runs are missing.
+/// journal then removed). exit_ok; exit_failure when runs are missing; exit_bad_input when a
+/// summary pointer is in no result line (the results are written all the same).
 int finish(const std::string& out, const Spec& spec, Results& results, Journal& journal, std::size_t failed);
 
 /// Runs the sweep's runs as child processes of this machine, --jobs at once.
