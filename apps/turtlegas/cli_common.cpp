@@ -47,16 +47,6 @@ world::Scene load(const std::string& file, const turtle::Registry& registry, std
   }
 }
 
-nlohmann::ordered_json read_world_json(const std::string& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw BadInput(file + ": cannot read it");
-  try {
-    return nlohmann::ordered_json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw BadInput(file + ": not JSON (" + std::string(e.what()) + ")");
-  }
-}
-
 std::unique_ptr<turtle::WorldServer> make_server(const world::Scene& scene, const turtle::Registry& registry,
                                                  const turtle::ServerOptions& options, const std::string& file) {
   try {
