@@ -10,6 +10,7 @@
   after a periodic checkpoint does not report "no outputs were written";
 - a sweep's runs all run the spec and world the sweep read at its start, whatever is edited on
   disk meanwhile;
+- a journal whose first (header) line is damaged keeps its runs: the header is written twice;
 - a journal line that names a run but is not its result (another seed, no overrides) is not
   taken as one: that run runs again;
 - a sweep summary pointer that no result line has is an error (exit 2), not a column of "-";
@@ -225,6 +226,23 @@ def check_sweep_journal_forged():
     assert [l.get("seed") for l in lines] == [1, 2] and all("forged" not in l["stats"] for l in lines), lines
 
 
+def check_sweep_journal_damaged_header():
+    gas_world("jh_world.json")
+    spec = path("jh_spec.json")
+    write(spec, json.dumps({"format": "turtlegas-sweep/1", "world": "jh_world.json", "until": 0.2, "seeds": [1, 2, 3]}))
+    whole = path("jh_whole.jsonl")
+    run("sweep", spec, "--out", whole, "--quiet", ok=(0,))
+    out = path("jh.jsonl")
+    run("sweep", spec, "--out", out, "--quiet", "--timeout", "0.000001", ok=(1,))  # a journal, its header only
+    head = read(out + ".partial").splitlines()
+    runs = read(whole).splitlines()[1:3]  # runs 0 and 1, as a journal holds them
+    write(out + ".partial", b'{"fingerpr\n' + b"\n".join(head[1:] + runs) + b"\n")  # the first line damaged
+    p = run("sweep", spec, "--out", out)
+    assert p.returncode == 0, "a journal with one damaged header line was refused: %s" % p.stderr
+    assert b"resuming: 2 of 3" in p.stderr, p.stderr
+    assert read(out) == read(whole)
+
+
 # ---- 4. outputs that are inputs -------------------------------------------------------------------
 
 def check_outputs_that_are_inputs():
@@ -345,6 +363,7 @@ CASES = {
     "sweep_edited": check_sweep_world_edited,
     "sweep_summary": check_sweep_summary_misspelt,
     "sweep_journal_forged": check_sweep_journal_forged,
+    "sweep_journal_header": check_sweep_journal_damaged_header,
     "outputs_inputs": check_outputs_that_are_inputs,
     "full_journal": check_full_disk_journal,
     "full_render": check_full_disk_render,

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <spdlog/spdlog.h>
@@ -61,28 +62,38 @@ Journal::Journal(const std::string& out, const Spec& spec, Results& results) : p
   std::vector<std::string> good;
   std::size_t untrusted = 0;
   if (fs::exists(path_)) {
+    // The header is written twice (lines 1 and 2): one damaged header line does not cost the runs.
     std::ifstream in(path_);
     std::string line;
-    bool first = true;
+    std::size_t n = 0;
+    bool any = false, ours = false, theirs = false;
+    std::vector<std::pair<std::size_t, std::string>> runs;
     while (std::getline(in, line)) {
+      any = true;
       const json j = json::parse(line, nullptr, false);
-      if (first) {
-        first = false;
-        if (j.is_discarded() || j.value("fingerprint", "") != fp)
-          throw BadInput(path_ + ": a partial sweep of another spec or world (delete it, or choose another --out)");
+      if (++n <= 2 && (n == 1 || j.is_discarded() || j.contains("fingerprint"))) {
+        if (!j.is_discarded() && j.contains("fingerprint")) (j.value("fingerprint", "") == fp ? ours : theirs) = true;
         continue;
       }
       if (j.is_discarded() || !j.contains("run") || !j["run"].is_number_unsigned() || in.eof()) continue;
       const std::size_t k = j["run"].get<std::size_t>();
-      if (k < spec.runs && !results.count(k) && !is_result_of(spec, k, j)) {
+      if (k >= spec.runs) continue;
+      if (!is_result_of(spec, k, j)) {
         ++untrusted;
         continue;
       }
-      if (k < spec.runs && !results.count(k)) {
-        results[k] = line;
-        good.push_back(line);
-      }
+      runs.emplace_back(k, line);
     }
+    if (any && (theirs || !ours))
+      throw BadInput(path_ + (theirs ? ": a partial sweep of another spec or world"
+                                     : ": its header (the spec's fingerprint) is damaged, so its runs cannot be told "
+                                       "from another spec's") +
+                     " (delete it, or choose another --out)");
+    for (auto& [k, l] : runs)
+      if (!results.count(k)) {
+        results[k] = l;
+        good.push_back(std::move(l));
+      }
   }
   if (untrusted > 0)
     spdlog::warn("{}: {} line(s) are not a result of this sweep's run they name (its seed, overrides and stats); "
@@ -90,7 +101,8 @@ Journal::Journal(const std::string& out, const Spec& spec, Results& results) : p
                  path_, untrusted);
   // Rewritten whole (a cut line gone) under another name and renamed, then appended to.
   const std::string tmp = path_ + ".tmp";
-  std::string text = json{{"fingerprint", fp}, {"spec", spec.file}}.dump() + "\n";
+  const std::string header = json{{"fingerprint", fp}, {"spec", spec.file}}.dump() + "\n";
+  std::string text = header + header;
   for (const std::string& l : good) text += l + "\n";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd < 0) throw BadInput(path_ + ": cannot write the sweep's journal here (" + std::strerror(errno) + ")");
