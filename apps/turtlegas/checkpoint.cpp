@@ -42,7 +42,7 @@ std::uint64_t file_hash(const std::string& path, const std::string& what) {
 }
 
 void write_checkpoint(std::ostream& out, const Checkpoint& c) {
-  const nlohmann::json j = {
+  nlohmann::json j = {
       {"format", checkpoint_format},
       {"world", c.world},
       {"world_fnv1a", hex(c.world_hash)},
@@ -55,6 +55,8 @@ void write_checkpoint(std::ostream& out, const Checkpoint& c) {
       {"resume", "turtlegas run " + c.world + " --resume THIS_FILE --until T: replays the run to t without outputs, "
                                               "checks the state there, and goes on"},
   };
+  // Its own hash: a checkpoint edited or cut is told from a run that does not replay.
+  j["fnv1a"] = hex(fnv1a64(j.dump()));
   out << j.dump(2) << '\n';
 }
 
@@ -71,6 +73,13 @@ Checkpoint read_checkpoint(const std::string& path) {
   if (!j.is_object() || j.value("format", std::string()) != checkpoint_format)
     throw BadInput(where + "not a checkpoint: /format must be \"" + checkpoint_format +
                    "\" (write one with run --checkpoint F)");
+  if (j.contains("fnv1a")) {  // checkpoints before it have none
+    nlohmann::json body = j;
+    body.erase("fnv1a");
+    if (!j["fnv1a"].is_string() || j["fnv1a"].get<std::string>() != hex(fnv1a64(body.dump())))
+      throw BadInput(where + "the checkpoint is damaged: its contents do not match its own hash (/fnv1a); it was "
+                     "edited or cut. Resume from an undamaged copy, or rerun from the start");
+  }
   Checkpoint c;
   auto field = [&](const char* key) -> const nlohmann::json& {
     if (!j.contains(key)) throw BadInput(where + "/" + key + ": missing; the checkpoint is damaged");

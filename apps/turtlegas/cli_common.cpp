@@ -4,12 +4,17 @@
 #include <algorithm>
 #include <array>
 #include <charconv>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <system_error>
 #include <vector>
 
+#include "turtlegas/world/file_error.hpp"
 #include "turtlegas/world/world_file.hpp"
 
 namespace turtlegas::apps {
@@ -22,13 +27,23 @@ world::Scene load(const std::string& file, const turtle::Registry& registry) {
   }
 }
 
-nlohmann::ordered_json read_world_json(const std::string& file) {
+world::Scene load(const std::string& file, const turtle::Registry& registry, std::string& bytes) {
+  // The messages of world::load_scene, which reads the file itself.
+  auto bad = [&](const std::string& what) { return BadInput(world::WorldFileError(file, "", what).what()); };
+  std::error_code ec;
+  const auto status = std::filesystem::status(file, ec);
+  if (!std::filesystem::exists(status)) throw bad("no such file; check the path");
+  if (std::filesystem::is_directory(status)) throw bad("is a directory, not a world file");
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw BadInput(file + ": cannot read it");
+  if (!in) throw bad(std::string("cannot open: ") + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw bad(std::string("cannot read: ") + std::strerror(errno));
+  bytes = std::move(text).str();
   try {
-    return nlohmann::ordered_json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw BadInput(file + ": not JSON (" + std::string(e.what()) + ")");
+    return world::parse_scene(bytes, file, registry);
+  } catch (const world::WorldFileError& e) {
+    throw BadInput(e.what());
   }
 }
 

@@ -35,10 +35,10 @@ struct BadInput : std::runtime_error {
 
 /// The scene of a world file; a bad file is BadInput.
 world::Scene load(const std::string& file, const turtle::Registry& registry);
+/// As load, and the file's bytes, read once: what a command loads is what it records and hashes,
+/// even when the file is edited while it runs.
+world::Scene load(const std::string& file, const turtle::Registry& registry, std::string& bytes);
 
-/// The world file's JSON, its keys in the file's order (for a recording's header); BadInput when it
-/// cannot be read. Call after load(), which has checked it.
-nlohmann::ordered_json read_world_json(const std::string& file);
 
 /// As make_world, for a scene with turtles: the server also checks controllers and sensors.
 std::unique_ptr<turtle::WorldServer> make_server(const world::Scene& scene, const turtle::Registry& registry,

@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
+#include <cstring>
 #include <atomic>
 #include <iostream>
 #include <stdexcept>
@@ -23,6 +25,7 @@ namespace {
 // The temporary files being written, for remove_temporaries(): fixed slots of plain pointers, so
 // that a signal handler can walk them without locks or allocation.
 std::array<std::atomic<const char*>, 32> g_temporaries{};
+std::atomic<bool> g_committed{false};  // any_output_committed()
 
 void register_temporary(const char* path) {
   for (auto& slot : g_temporaries) {
@@ -64,6 +67,31 @@ bool same_file(const std::string& a, const std::string& b) {
 
 }  // namespace
 
+namespace detail {
+
+CheckedFileBuf::int_type CheckedFileBuf::overflow(int_type c) {
+  errno = 0;
+  const int_type r = std::filebuf::overflow(c);
+  if (traits_type::eq_int_type(r, traits_type::eof()) && error == 0) error = errno != 0 ? errno : EIO;
+  return r;
+}
+
+std::streamsize CheckedFileBuf::xsputn(const char* s, std::streamsize n) {
+  errno = 0;
+  const std::streamsize r = std::filebuf::xsputn(s, n);
+  if (r < n && error == 0) error = errno != 0 ? errno : EIO;
+  return r;
+}
+
+int CheckedFileBuf::sync() {
+  errno = 0;
+  const int r = std::filebuf::sync();
+  if (r != 0 && error == 0) error = errno != 0 ? errno : EIO;
+  return r;
+}
+
+}  // namespace detail
+
 OutputFile::OutputFile(const std::string& path, std::string_view option, Write how) : path_(path), option_(option) {
   const std::string opt(option);
   if (path == "-") {
@@ -79,33 +107,47 @@ OutputFile::OutputFile(const std::string& path, std::string_view option, Write h
     // A terminal, a pipe, a device: there is nothing to replace, and renaming over it would put a
     // regular file in its place (as root, over /dev/stdout). Written as it goes.
     kind_ = Kind::direct;
-    out_.open(target_, std::ios::binary | std::ios::out);
-    if (!out_) throw BadInput(opt + ": cannot open '" + path + "' for writing; check its permissions");
+    buf_.open(target_, std::ios::binary | std::ios::out);
+    if (!buf_.is_open()) throw BadInput(opt + ": cannot open '" + path + "' for writing; check its permissions");
     return;
   }
   const fs::path dir = target_.parent_path().empty() ? fs::path(".") : target_.parent_path();
   if (!fs::is_directory(dir, ec))
     throw BadInput(opt + ": directory '" + dir.string() + "' does not exist; create it first");
   if (how == Write::growing) {
-    kind_ = Kind::direct;
-    out_.open(target_, std::ios::binary | std::ios::trunc);
-    if (!out_) throw BadInput(opt + ": cannot write '" + path + "'; check the permissions of it and its directory");
+    // Not registered as a temporary: what a killed run recorded stays readable (docs/recording.md).
+    kind_ = Kind::growing;
+    tmp_ = target_.string() + ".partial";
+    buf_.open(tmp_, std::ios::binary | std::ios::out | std::ios::trunc);
+    if (!buf_.is_open()) throw BadInput(opt + ": cannot write '" + tmp_.string() + "'; check the permissions of its directory");
+    if (fs::is_regular_file(st)) fs::permissions(tmp_, st.permissions(), ec);
     return;
   }
   tmp_ = dir / ("." + target_.filename().string() + ".tmp-" + std::to_string(::getpid()));
-  out_.open(tmp_, std::ios::binary | std::ios::trunc);
-  if (!out_) throw BadInput(opt + ": cannot write in '" + dir.string() + "'; check its permissions");
+  buf_.open(tmp_, std::ios::binary | std::ios::out | std::ios::trunc);
+  if (!buf_.is_open()) throw BadInput(opt + ": cannot write in '" + dir.string() + "'; check its permissions");
   register_temporary(tmp_.c_str());
   // The replacement keeps the permissions of the file it replaces.
   if (fs::is_regular_file(st)) fs::permissions(tmp_, st.permissions(), ec);
 }
 
 OutputFile::~OutputFile() {
-  if (kind_ != Kind::replaced || committed_) return;
+  if (kind_ != Kind::replaced || committed_) return;  // a growing file's .partial stays
   unregister_temporary(tmp_.c_str());
-  out_.close();
+  buf_.close();
   std::error_code ec;
   fs::remove(tmp_, ec);
+}
+
+std::string OutputFile::failure() const {
+  if (buf_.error != 0) return std::strerror(buf_.error);
+  return out_.fail() && kind_ != Kind::standard_output ? "a write failed" : "";
+}
+
+std::string OutputFile::close() {
+  out_.flush();
+  if (!buf_.close()) out_.setstate(std::ios::failbit);
+  return failure();
 }
 
 std::ostream& OutputFile::stream() { return kind_ == Kind::standard_output ? std::cout : out_; }
@@ -119,25 +161,32 @@ void OutputFile::commit() {
     case Kind::standard_output:
       std::cout.flush();
       if (!std::cout) throw std::runtime_error(option_ + ": could not finish writing to standard output");
+      g_committed = true;
       return;
     case Kind::direct:
-      out_.close();
-      if (out_.fail()) throw std::runtime_error(option_ + ": could not finish writing '" + path_ + "'");
+      if (const std::string why = close(); !why.empty())
+        throw std::runtime_error(option_ + ": could not finish writing '" + path_ + "': " + why);
+      g_committed = true;
       return;
+    case Kind::growing:
     case Kind::replaced: break;
   }
-  out_.close();
+  const std::string why = close();
   unregister_temporary(tmp_.c_str());
   std::error_code ec;
-  if (out_.fail()) {
+  if (!why.empty()) {
+    if (kind_ == Kind::growing)
+      throw std::runtime_error(option_ + ": could not finish writing '" + tmp_.string() + "': " + why + "; '" + path_ +
+                               "' is left as it was, and the recording so far is in '" + tmp_.string() + "'");
     fs::remove(tmp_, ec);
-    throw std::runtime_error(option_ + ": could not finish writing '" + path_ + "' (disk full?); it is left as it was");
+    throw std::runtime_error(option_ + ": could not finish writing '" + path_ + "': " + why + "; it is left as it was");
   }
   fs::rename(tmp_, target_, ec);
   if (ec) {
     fs::remove(tmp_, ec);
     throw std::runtime_error(option_ + ": could not put '" + path_ + "' in place: " + ec.message());
   }
+  g_committed = true;
 }
 
 void check_outputs(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs) {
@@ -166,6 +215,8 @@ void check_outputs(const std::vector<NamedPath>& outputs, const std::vector<Name
       }
   }
 }
+
+bool any_output_committed() noexcept { return g_committed.load(); }
 
 void remove_temporaries() noexcept {
   for (auto& slot : g_temporaries)

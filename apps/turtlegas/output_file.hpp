@@ -5,12 +5,27 @@
 
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <iosfwd>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace turtlegas::apps {
+
+namespace detail {
+/// A file buffer that keeps why its first failed write failed (errno at that write), which an
+/// ofstream forgets.
+class CheckedFileBuf : public std::filebuf {
+ public:
+  int error = 0;  ///< errno of the first failed write (0: none, or one errno did not name)
+
+ protected:
+  int_type overflow(int_type c) override;
+  std::streamsize xsputn(const char* s, std::streamsize n) override;
+  int sync() override;
+};
+}  // namespace detail
 
 /// An output file named on the command line (`option` names it in messages):
 /// - "-" is standard output;
@@ -24,10 +39,11 @@ namespace turtlegas::apps {
 /// one that cannot be written in), so a bad path costs nothing. The temporary file is removed by
 /// the destructor unless committed, and by a fatal signal or exit() (remove_temporaries()).
 ///
-/// A growing output (a recording, docs/recording.md) is instead written in place under its own
-/// name from the start, and left as far as it got when the run dies: such a file marks its own
-/// end, and its reader says how much of an unfinished one it recovered, so a cut file is never
-/// taken for a whole one.
+/// A growing output (a recording, docs/recording.md) is written under the name `<path>.partial`
+/// beside the target, flushed as it goes, and renamed over the target by commit(). A run killed on
+/// the way (SIGKILL, a crash, a full disk) leaves the target as it was and the `.partial` file
+/// readable up to where it got (such a file marks its own end, and its reader says how much of an
+/// unfinished one it recovered); it is never removed by the program.
 class OutputFile {
  public:
   enum class Write { replace, growing };
@@ -40,22 +56,28 @@ class OutputFile {
   /// Hands what has been written so far on to the target (a reader of a pipe or of standard
   /// output sees it at once; a replaced file's temporary has it on disk).
   void flush();
-  /// Finishes the file: closes it and, for a replaced file, renames it over the target. Throws
-  /// std::runtime_error when a write failed (a full disk, say), leaving the target as it was.
+  /// Finishes the file: closes it and, for a replaced or growing file, renames it over the
+  /// target. Throws std::runtime_error when a write failed, saying why (strerror: "No space left on
+  /// device") and leaving the target as it was.
   void commit();
 
   const std::string& path() const { return path_; }
+  /// Why a write failed ("No space left on device"), or "" when none has.
+  std::string failure() const;
   bool to_stdout() const { return kind_ == Kind::standard_output; }
 
  private:
-  enum class Kind { standard_output, direct, replaced };
+  enum class Kind { standard_output, direct, replaced, growing };
   std::string path_;
   std::string option_;
   Kind kind_ = Kind::replaced;
   std::filesystem::path target_;  // the file replaced (a symlink's target) or written directly
   std::filesystem::path tmp_;
-  std::ofstream out_;
+  detail::CheckedFileBuf buf_;
+  std::ostream out_{&buf_};
   bool committed_ = false;
+  /// Closes the file: "" or why it is not whole.
+  std::string close();
 };
 
 /// A file named on the command line, and the option that named it ("--events"; the world file's
@@ -69,6 +91,10 @@ struct NamedPath {
 /// name or link: `--svg w.json` would overwrite the world), two outputs that are the same file,
 /// and two outputs on standard output. Empty paths are ignored.
 void check_outputs(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs);
+
+/// Whether an output has been put in place (committed) by this process: async-signal-safe, for
+/// the crash report.
+bool any_output_committed() noexcept;
 
 /// Removes every OutputFile's temporary file now: async-signal-safe (unlink only), for a fatal
 /// signal's handler and for exit() (crash_report.hpp).

@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -17,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include <cairo.h>
 #include <spdlog/spdlog.h>
 
+#include "cairo_frame.hpp"
 #include "cli_common.hpp"
 #include "output_file.hpp"
 #include "run_loop.hpp"
@@ -76,236 +75,6 @@ Source load_source(const std::string& path, const turtle::Registry& registry) {
   s.mode = sim::mode_from_string(rec.header.mode).value_or(sim::Mode::exact);
   s.end = rec.end;
   return s;
-}
-
-// ---- drawing: the SVG snapshot's look (formats/src/svg_snapshot.cpp), through cairo ----------------
-
-constexpr std::array<std::array<int, 3>, 5> palette = {{{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
-constexpr std::array<std::array<int, 3>, 10> turtle_colours = {{{0x4e, 0x79, 0xa7}, {0xf2, 0x8e, 0x2b}, {0xe1, 0x57, 0x59},
-                                                                {0x76, 0xb7, 0xb2}, {0x59, 0xa1, 0x4f}, {0xed, 0xc9, 0x48},
-                                                                {0xb0, 0x7a, 0xa1}, {0xff, 0x9d, 0xa7}, {0x9c, 0x75, 0x5f},
-                                                                {0xba, 0xb0, 0xac}}};
-
-void set_rgb(cairo_t* cr, const std::array<int, 3>& c, double alpha = 1.0) {
-  cairo_set_source_rgba(cr, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, alpha);
-}
-void set_grey(cairo_t* cr, int v) { cairo_set_source_rgb(cr, v / 255.0, v / 255.0, v / 255.0); }
-
-std::array<int, 3> speed_colour(double u) {
-  u = std::clamp(u, 0.0, 1.0) * (palette.size() - 1);
-  const auto k = std::min(static_cast<std::size_t>(u), palette.size() - 2);
-  const double f = u - static_cast<double>(k);
-  std::array<int, 3> rgb{};
-  for (int c = 0; c < 3; ++c) rgb[c] = static_cast<int>(std::lround(palette[k][c] + f * (palette[k + 1][c] - palette[k][c])));
-  return rgb;
-}
-
-/// A stroke `px` pixels wide whatever the world-to-pixel scale.
-void stroke_px(cairo_t* cr, double px) {
-  cairo_save(cr);
-  cairo_identity_matrix(cr);
-  cairo_set_line_width(cr, px);
-  cairo_stroke(cr);
-  cairo_restore(cr);
-}
-
-/// The window of the world a picture shows: the rectangle of size w x h centred on (cx, cy),
-/// turned by `angle` (radians, Logo convention: the picture's up is that heading).
-struct Window {
-  double cx = 0.0, cy = 0.0, w = 0.0, h = 0.0, angle = 0.0;
-};
-
-/// The layout of write_svg: margins, a title line, the window scaled so that its longer side is
-/// width_px, and a legend column on the right when there are balls.
-struct Layout {
-  double scale = 1.0, margin = 12.0, title_h = 30.0, legend_w = 90.0, top = 42.0;
-  int width = 0, height = 0;
-};
-
-Layout layout_for(const Window& win, double width_px) {
-  Layout l;
-  l.scale = width_px / std::max(win.w, win.h);
-  l.top = l.title_h + l.margin;
-  l.width = static_cast<int>(std::ceil(win.w * l.scale + 2 * l.margin + l.legend_w));
-  l.height = static_cast<int>(std::ceil(std::max(win.h * l.scale, 160.0) + l.title_h + 2 * l.margin));
-  return l;
-}
-
-cairo_status_t write_to_stream(void* closure, const unsigned char* data, unsigned int length) {
-  auto* out = static_cast<std::ostream*>(closure);
-  out->write(reinterpret_cast<const char*>(data), length);
-  return *out ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
-}
-
-void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& win, double width_px,
-               const std::string& it, std::uint32_t layers) {
-  const bool walls = layers & turtle::kLayerWalls, balls = layers & turtle::kLayerBalls,
-             turtles = layers & turtle::kLayerTurtles, trails = layers & turtle::kLayerTrails,
-             roles = layers & turtle::kLayerRoles;
-  const Layout l = layout_for(win, width_px);
-  std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface(
-      cairo_image_surface_create(CAIRO_FORMAT_RGB24, l.width, l.height), cairo_surface_destroy);
-  std::unique_ptr<cairo_t, decltype(&cairo_destroy)> ctx(cairo_create(surface.get()), cairo_destroy);
-  cairo_t* cr = ctx.get();
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_paint(cr);
-
-  // Colours span 0 to the 99th-percentile speed, as in the SVG.
-  std::vector<double> speeds;
-  speeds.reserve(snap.balls.size());
-  for (const auto& b : snap.balls) speeds.push_back(sim::norm(b.vel));
-  double v_max = 0.0;
-  if (!speeds.empty()) {
-    std::vector<double> sorted = speeds;
-    const auto k = static_cast<std::ptrdiff_t>((sorted.size() - 1) * 99 / 100);
-    std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-    v_max = sorted[static_cast<std::size_t>(k)];
-  }
-  const double v_scale = v_max > 0.0 ? v_max : 1.0;
-
-  // The title.
-  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, 16);
-  set_grey(cr, 0);
-  char title[512];
-  std::snprintf(title, sizeof title, "%s - t = %.6g s, %zu balls", snap.title.c_str(), snap.time, snap.balls.size());
-  std::string text = title;
-  if (!snap.turtles.empty())
-    text += ", " + std::to_string(snap.turtles.size()) + (snap.turtles.size() == 1 ? " turtle" : " turtles");
-  // A title wider than the picture is set smaller until it fits (it was cut at the right edge).
-  cairo_text_extents_t ext;
-  cairo_text_extents(cr, text.c_str(), &ext);
-  const double room = l.width - 2 * l.margin;
-  if (ext.x_advance > room && ext.x_advance > 0.0) cairo_set_font_size(cr, std::max(6.0, 16.0 * room / ext.x_advance));
-  cairo_move_to(cr, l.margin, l.margin + 14);
-  cairo_show_text(cr, text.c_str());
-
-  // The world inside the window: +y up, clipped to the window's rectangle.
-  cairo_save(cr);
-  cairo_rectangle(cr, l.margin, l.top, win.w * l.scale, win.h * l.scale);
-  cairo_clip(cr);
-  cairo_translate(cr, l.margin + win.w * l.scale / 2, l.top + win.h * l.scale / 2);
-  cairo_scale(cr, l.scale, -l.scale);
-  cairo_rotate(cr, win.angle);  // a heading of `angle` points up
-  cairo_translate(cr, -win.cx, -win.cy);
-
-  cairo_rectangle(cr, 0, 0, snap.arena.width, snap.arena.height);
-  cairo_set_source_rgb(cr, 0xf7 / 255.0, 0xf7 / 255.0, 0xf7 / 255.0);
-  cairo_fill_preserve(cr);
-  set_grey(cr, 0x99);
-  stroke_px(cr, 1);
-  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
-  for (const auto& wall : snap.walls) {
-    if (!walls) break;
-    const sim::WallKey pose = sim::wall_pose(wall, snap.time);
-    const bool there = sim::wall_visible(wall, snap.time);
-    cairo_move_to(cr, pose.from.x, pose.from.y);
-    cairo_line_to(cr, pose.to.x, pose.to.y);
-    if (there) {
-      set_grey(cr, 0x22);
-    } else {
-      set_grey(cr, 0xbb);
-      const double dash[2] = {4, 3};
-      cairo_set_dash(cr, dash, 2, 0);
-    }
-    stroke_px(cr, 2);
-    cairo_set_dash(cr, nullptr, 0, 0);
-  }
-  for (std::size_t i = 0; i < snap.balls.size() && balls; ++i) {
-    const auto& b = snap.balls[i];
-    cairo_arc(cr, b.pos.x, b.pos.y, b.radius, 0, 2 * M_PI);
-    set_rgb(cr, speed_colour(speeds[i] / v_scale));
-    cairo_fill(cr);
-  }
-  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
-    const auto& t = snap.turtles[i];
-    if (t.trail.size() < 2 || !trails) continue;
-    bool gap = true;  // a break between strokes (the pen lifted, or a teleport)
-    for (const sim::Vec2 p : t.trail) {
-      if (turtle::is_trail_break(p)) {
-        gap = true;
-        continue;
-      }
-      if (gap) cairo_move_to(cr, p.x, p.y);
-      else cairo_line_to(cr, p.x, p.y);
-      gap = false;
-    }
-    set_rgb(cr, turtle_colours[i % turtle_colours.size()]);
-    stroke_px(cr, 1.5);
-  }
-  for (std::size_t i = 0; i < snap.turtles.size() && turtles; ++i) {
-    const auto& t = snap.turtles[i];
-    if (t.id == it && roles) {  // the tag game's "it": a red ring around it
-      cairo_arc(cr, t.pos.x, t.pos.y, t.radius * 1.6, 0, 2 * M_PI);
-      cairo_set_source_rgb(cr, 0.85, 0.1, 0.1);
-      stroke_px(cr, 3);
-    }
-    cairo_arc(cr, t.pos.x, t.pos.y, t.radius, 0, 2 * M_PI);
-    set_rgb(cr, turtle_colours[i % turtle_colours.size()], 0.8);
-    cairo_fill_preserve(cr);
-    set_grey(cr, 0x22);
-    stroke_px(cr, 1);
-    const sim::Vec2 tip = t.pos + t.radius * sim::heading_unit(t.heading);
-    cairo_move_to(cr, t.pos.x, t.pos.y);
-    cairo_line_to(cr, tip.x, tip.y);
-    stroke_px(cr, 2);
-    if (t.fault) {
-      const double d = t.radius * 0.7;
-      cairo_move_to(cr, t.pos.x - d, t.pos.y - d);
-      cairo_line_to(cr, t.pos.x + d, t.pos.y + d);
-      cairo_move_to(cr, t.pos.x - d, t.pos.y + d);
-      cairo_line_to(cr, t.pos.x + d, t.pos.y - d);
-      cairo_set_source_rgb(cr, 0.8, 0, 0);
-      stroke_px(cr, 2);
-    }
-  }
-  // Ids beside each turtle's upper right, upright.
-  cairo_set_font_size(cr, 11 / l.scale);
-  for (const auto& t : snap.turtles) {
-    if (!turtles) break;
-    cairo_save(cr);
-    cairo_translate(cr, t.pos.x, t.pos.y);
-    cairo_rotate(cr, -win.angle);
-    cairo_move_to(cr, t.radius + 2 / l.scale, t.radius);
-    cairo_scale(cr, 1, -1);
-    set_grey(cr, 0);
-    cairo_show_text(cr, t.id.c_str());
-    cairo_restore(cr);
-  }
-  cairo_restore(cr);
-
-  // The legend: a colour bar from 0 (bottom) to v_max (top), when there are balls.
-  if (!snap.balls.empty() && balls) {
-    const double lx = l.margin + win.w * l.scale + 24.0, ly = l.top + 16.0, lh = 120.0;
-    cairo_pattern_t* g = cairo_pattern_create_linear(0, ly + lh, 0, ly);
-    for (std::size_t k = 0; k < palette.size(); ++k) {
-      const double u = static_cast<double>(k) / (palette.size() - 1);
-      const auto c = speed_colour(u);
-      cairo_pattern_add_color_stop_rgb(g, u, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
-    }
-    cairo_rectangle(cr, lx, ly, 14, lh);
-    cairo_set_source(cr, g);
-    cairo_fill_preserve(cr);
-    cairo_pattern_destroy(g);
-    set_grey(cr, 0x99);
-    cairo_set_line_width(cr, 1);
-    cairo_stroke(cr);
-    set_grey(cr, 0);
-    cairo_set_font_size(cr, 12);
-    cairo_move_to(cr, lx - 8, ly - 6);
-    cairo_show_text(cr, "speed");
-    cairo_set_font_size(cr, 11);
-    char vmax[64];
-    std::snprintf(vmax, sizeof vmax, ">= %.6g", v_max);
-    cairo_move_to(cr, lx + 18, ly + 10);
-    cairo_show_text(cr, vmax);
-    cairo_move_to(cr, lx + 18, ly + lh);
-    cairo_show_text(cr, "0");
-  }
-  cairo_surface_flush(surface.get());
-  if (cairo_surface_write_to_png_stream(surface.get(), write_to_stream, &out) != CAIRO_STATUS_SUCCESS)
-    throw std::runtime_error("could not encode the PNG");
 }
 
 /// Runs the scene forward and draws it at the times asked for.
@@ -386,9 +155,14 @@ class Renderer {
     else {
       std::uint32_t layers = 0;
       const Window win = window(layers);
-      write_png(out.stream(), snap, win, opt_.width, it(), layers);
+      try {
+        write_png(out.stream(), snap, win, opt_.width, it(), layers);
+      } catch (const std::runtime_error& e) {
+        const std::string why = out.failure();  // "No space left on device"
+        throw std::runtime_error(option + " " + path + ": " + e.what() + (why.empty() ? "" : ": " + why));
+      }
     }
-    out.commit();
+    out.commit();  // says why a write failed (a full disk), naming the file
   }
 
  private:

@@ -50,7 +50,6 @@ struct RunTotals {
   double energy_start = 0.0;
   std::uint64_t touches = 0;
   std::uint64_t faults = 0;
-  std::size_t turtles_finished = 0;
 };
 
 /// How many times a run measures the deepest overlap when --overlap-samples does not say: at every
@@ -112,12 +111,12 @@ std::uint64_t state_hash(const sim::World& world, const formats::RunNames& names
   return fnv1a64(s.str());
 }
 
-/// The checks a resumed run makes before it starts: the same world, mode and dt, and programs
-/// that replay.
-void check_resumable(const Checkpoint& c, const RunOptions& opt, const world::Scene& scene,
+/// The checks a resumed run makes before it starts: the same world (`world_hash`, of the bytes
+/// loaded), mode and dt, and programs that replay.
+void check_resumable(const Checkpoint& c, const RunOptions& opt, std::uint64_t world_hash, const world::Scene& scene,
                      const turtle::Registry& registry) {
   const std::string where = "--resume " + opt.resume + ": ";
-  if (file_hash(opt.world, "the world file") != c.world_hash)
+  if (world_hash != c.world_hash)
     throw BadInput(where + "the world file " + opt.world + " is not the one the checkpoint was written for (" + c.world +
                    ", whose bytes hash differently): resume with that world, unchanged");
   if (opt.mode && sim::mode_from_string(*opt.mode) != c.mode)
@@ -257,13 +256,18 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   if (!opt.stats_json.empty()) stats_file.emplace(opt.stats_json, "--stats-json");
   if (!opt.svg.empty()) svg_file.emplace(opt.svg, "--svg");
   if (!opt.checkpoint.empty()) OutputFile probe(opt.checkpoint, "--checkpoint");  // checks the path only
+  // The recording is opened last, once the world is loaded and every option checked (it is written
+  // as R.partial and renamed over R when whole: a refused run leaves an existing R as it was).
   std::optional<OutputFile> record_file;
-  if (!opt.record.empty()) record_file.emplace(opt.record, "--record", OutputFile::Write::growing);
 
-  world::Scene scene = load(opt.world, registry);
+  // The world's bytes are read once: the run, its recording and its checkpoints are of these, even
+  // if the file is edited while the run goes on.
+  std::string world_bytes;
+  world::Scene scene = load(opt.world, registry, world_bytes);
+  const std::uint64_t world_hash = fnv1a64(world_bytes);
   sim::WorldDef& def = scene.def;
   if (resume) {
-    check_resumable(*resume, opt, scene, registry);
+    check_resumable(*resume, opt, world_hash, scene, registry);
     def.dt = resume->dt;
   } else if (opt.dt) {
     def.dt = *opt.dt;
@@ -284,7 +288,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   limits.max_wall_seconds = opt.max_wall_seconds;
   limits.max_events = opt.max_events;
   limits.checkpoint_every = opt.checkpoint_every;
-  if (record_file && opt.keyframe_seconds > 0.0) limits.keyframe_every = opt.keyframe_seconds;
+  if (!opt.record.empty() && opt.keyframe_seconds > 0.0) limits.keyframe_every = opt.keyframe_seconds;
   // The deepest overlap is measured at evenly spaced instants of the run (overlap_samples), not
   // only at contacts and at its end: an overlap the engine does not see (a body sinking without
   // an event, a wall that appears through it) shows in --stats all the same.
@@ -295,17 +299,6 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   if (samples > 0 && opt.until > 0.0) limits.sample_every = opt.until / static_cast<double>(samples);
   sim::Overlap sampled;
   std::optional<formats::RecordingWriter> recorder;
-  if (record_file) {
-    formats::RecordingHeader h;
-    h.command = "run";
-    h.world_file = opt.world;
-    h.world = read_world_json(opt.world);
-    h.mode = sim::to_string(mode);
-    h.dt = def.dt;
-    h.until = opt.until;
-    h.keyframes = {opt.keyframe_seconds, opt.keyframe_events};
-    recorder.emplace(record_file->stream(), h);
-  }
   // Exactly one of these runs the scene: the bare engine, or the world server when there are
   // turtles (which then owns the engine).
   std::optional<sim::World> bare;
@@ -427,6 +420,18 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     };
   }
   const sim::World& world = server ? server->world() : *bare;
+  if (!opt.record.empty()) {
+    record_file.emplace(opt.record, "--record", OutputFile::Write::growing);
+    formats::RecordingHeader h;
+    h.command = "run";
+    h.world_file = opt.world;
+    h.world = nlohmann::ordered_json::parse(world_bytes);  // loaded above: JSON
+    h.mode = sim::to_string(mode);
+    h.dt = def.dt;
+    h.until = opt.until;
+    h.keyframes = {opt.keyframe_seconds, opt.keyframe_events};
+    recorder.emplace(record_file->stream(), h);
+  }
   // Ids by index. With the world server, its scene: bodies spawned by an input log are in it
   // (after the scene's own); their ball ids are packed when they are first needed.
   formats::IdTable spawned_ids;
@@ -447,7 +452,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   auto write_checkpoint_at = [&](double t, const std::string& why) {
     Checkpoint c;
     c.world = opt.world;
-    c.world_hash = file_hash(opt.world, "the world file");
+    c.world_hash = world_hash;
     c.mode = mode;
     c.dt = def.dt;
     c.t = t;
@@ -460,6 +465,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   };
 
   Stopped end{Stop::until, 0};
+  std::string checkpoint_failed;  // why a periodic checkpoint could not be written
   if (resume) {
     // The replay: the same run to the checkpoint's time, its events dropped, then the proof that
     // it is the same run.
@@ -481,7 +487,18 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   if (end.first == Stop::until) {
     limits.until = opt.until;
     end = run_in_chunks(world.time(), world.stats().events, limits, pace, start, progress, "", advance, [&] { flush(true); },
-                        [&](double t, const std::string& why) { write_checkpoint_at(t, why); },
+                        [&](double t, const std::string& why) {
+                          // A checkpoint that cannot be written (a full disk) stops the checkpoints,
+                          // not the run: its other outputs are written whole, and it exits 1.
+                          if (!checkpoint_failed.empty()) return;
+                          try {
+                            write_checkpoint_at(t, why);
+                          } catch (const std::runtime_error& e) {
+                            checkpoint_failed = e.what();
+                            spdlog::error("{}; the run goes on without checkpoints, its other outputs are written",
+                                          checkpoint_failed);
+                          }
+                        },
                         [&](double, std::uint64_t events, bool at_key, bool at_sample) {
                           if (recorder && (at_key || recorder->keyframe_due(events))) recorder->keyframe(world, current_names());
                           if (at_sample) {
@@ -494,7 +511,6 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   progress.clear();
   if (server) {
     server->set_event_log(nullptr);
-    for (std::size_t i = 0; i < server->turtle_count(); ++i) totals.turtles_finished += server->turtle(i).finished ? 1 : 0;
   } else {
     bare->set_event_log(nullptr);
     if (observer) observer->detach();
@@ -506,7 +522,6 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   }
   const std::string stopped = stop_name(end);
 
-  const sim::Overlap now = world.measure_overlap(), seen = world.max_contact_overlap();
   formats::RunFigures run;
   run.world = opt.world;
   run.name = def.name;
@@ -517,17 +532,13 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   run.dt = def.dt;
   run.seed = def.seed;
   run.balls = ball_count;
-  for (std::size_t i = 0; i < world.ball_count(); ++i) run.balls_alive += world.ball(i).alive ? 1 : 0;
   run.turtles = def.turtles.size();
-  run.turtles_finished = totals.turtles_finished;
   run.touches = totals.touches;
   run.faults = totals.faults;
   run.wall_seconds = seconds_since(start);
   run.energy_start = totals.energy_start;
-  run.energy_end = world.energy();
-  run.max_overlap = std::max({now.depth, seen.depth, sampled.depth});
-  run.max_overlap_relative = std::max({now.relative, seen.relative, sampled.relative});
   run.overlap_samples = samples;
+  finish_run(run, world, server.get(), sampled);
 
   if (events_file) events_file->commit();
   if (recorder) {
@@ -556,9 +567,17 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   // A resumed run stopped while it was still replaying has got no further than its checkpoint:
   // the checkpoint (perhaps the very file resumed from) is left as it was.
   const bool short_of_resume = resume && world.time() < resume->t;
-  if (!opt.checkpoint.empty() && !short_of_resume)
-    write_checkpoint_at(world.time(), stopped.empty() ? "the end of the run" : stopped);
+  if (!opt.checkpoint.empty() && !short_of_resume) {
+    try {
+      write_checkpoint_at(world.time(), stopped.empty() ? "the end of the run" : stopped);
+      checkpoint_failed.clear();  // the last one is whole
+    } catch (const std::runtime_error& e) {
+      checkpoint_failed = e.what();
+      spdlog::error("{}; the run's other outputs are written whole", checkpoint_failed);
+    }
+  }
   if (opt.stats) print_summary(run, world, scene, server.get());
+  if (!checkpoint_failed.empty()) return exit_failure;
   if (end.first == Stop::until) return exit_ok;
   spdlog::warn("{}: stopped at t = {} s of {} ({}); the outputs are written up to there{}", opt.world,
                fmt(world.time()), fmt(opt.until), stopped,

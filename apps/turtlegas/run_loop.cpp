@@ -65,6 +65,17 @@ Pace first_pace(SceneScales scales, const sim::World& world, double natural) {
   return {std::max(first, std::numeric_limits<double>::denorm_min())};
 }
 
+void finish_run(formats::RunFigures& run, const sim::World& world, const turtle::WorldServer* server,
+                const sim::Overlap& sampled) {
+  if (server)
+    for (std::size_t i = 0; i < server->turtle_count(); ++i) run.turtles_finished += server->turtle(i).finished ? 1 : 0;
+  for (std::size_t i = 0; i < world.ball_count(); ++i) run.balls_alive += world.ball(i).alive ? 1 : 0;
+  run.energy_end = world.energy();
+  const sim::Overlap now = world.measure_overlap(), seen = world.max_contact_overlap();
+  run.max_overlap = std::max({now.depth, seen.depth, sampled.depth});
+  run.max_overlap_relative = std::max({now.relative, seen.relative, sampled.relative});
+}
+
 const char* stop_name(Stopped s) {
   switch (s.first) {
     case Stop::until: return "";

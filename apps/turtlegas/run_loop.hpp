@@ -19,7 +19,9 @@
 #include "cli_common.hpp"
 #include "scene_scales.hpp"
 #include "signals.hpp"
+#include "turtlegas/formats/stats_file.hpp"
 #include "turtlegas/sim/world.hpp"
+#include "turtlegas/turtle/world_server.hpp"
 
 namespace turtlegas::apps {
 
@@ -76,6 +78,12 @@ class Progress {
 /// "ETA 3 min", from `done` of `total` simulated seconds made in `seconds` of wall clock: "ETA
 /// unknown" before any is done.
 std::string eta_text(double done, double total, double seconds);
+
+/// The figures of a run's end, one definition for `run` and `sweep`: the balls still in, the energy
+/// at the end, the deepest overlap (now, the deepest met at a contact, and `sampled`, the deepest of
+/// the run's own samples), and, for a run by the world server, the turtles whose programs finished.
+void finish_run(formats::RunFigures& run, const sim::World& world, const turtle::WorldServer* server = nullptr,
+                const sim::Overlap& sampled = {});
 
 /// Why the chunk loop ended.
 enum class Stop { until, signal, max_wall_seconds, max_events };

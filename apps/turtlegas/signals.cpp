@@ -135,10 +135,18 @@ const char* describe(int sig) {
   return "a fatal signal";
 }
 
+/// What a lost run leaves: nothing, or the outputs put in place before (a periodic checkpoint,
+/// render's frames), which are whole.
+const char* outputs_so_far() {
+  return any_output_committed() ? "the outputs put in place before now (a periodic --checkpoint, frames) are whole, "
+                                  "the others were not written"
+                                : "no outputs were written";
+}
+
 void on_fatal(int sig) {
   Line line;
   line << "turtlegas: " << signal_name(sig) << ", " << describe(sig);
-  where(line) << ", world " << g_world << "; the run is lost: no outputs were written\n";
+  where(line) << ", world " << g_world << "; the run is lost: " << outputs_so_far() << "\n";
   line.write();
   kill_child_groups();
   remove_temporaries();
@@ -152,7 +160,7 @@ void on_exit() {
   if (turtle::program_in_flight().turtle == nullptr) return;  // turtlegas's own exit
   Line line;
   line << "turtlegas: exit() was called";
-  where(line) << ", world " << g_world << "; the run is lost: no outputs were written\n";
+  where(line) << ", world " << g_world << "; the run is lost: " << outputs_so_far() << "\n";
   line.write();
   remove_temporaries();
   ::_exit(1);

@@ -25,6 +25,7 @@ struct SweepOptions {
   double program_budget = 2.0;
   bool quiet = false;          ///< no progress lines
   std::optional<std::size_t> child_run;  ///< hidden: run this one and report on descriptor 3
+  std::optional<int> inputs_fd;          ///< hidden: the spec and world the parent read (sweep/sweep.hpp)
 };
 
 CLI::App* add_sweep_command(CLI::App& app, SweepOptions& options);

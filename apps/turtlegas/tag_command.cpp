@@ -78,6 +78,7 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
   // Opened before the rounds are played, so a bad path costs nothing; renamed into place only
   // when written whole.
   std::optional<OutputFile> json_file;
+  check_outputs({{options.json_out, "--json"}}, {{options.world, "the world file"}});
   if (!options.json_out.empty()) json_file.emplace(options.json_out, "--json");
   const world::Scene scene = load(options.world, registry);
   install_stop_signals();  // before the warnings: once they are out, Ctrl-C stops cleanly

@@ -415,6 +415,10 @@ int test_command(const TestOptions& options, const turtle::Registry& registry, c
 
   // Opened first, so that a bad path costs nothing; renamed into place when written whole.
   std::optional<OutputFile> junit;
+  std::vector<NamedPath> inputs;
+  for (const std::string& w : options.worlds) inputs.push_back({w, "a world file"});
+  for (const std::string& p : plugins) inputs.push_back({p, "--plugin"});
+  check_outputs({{options.junit, "--junit"}}, inputs);
   if (!options.junit.empty()) junit.emplace(options.junit, "--junit");
   install_stop_signals("stopping the worlds that run and writing what they did");
 

@@ -2,7 +2,10 @@
 #include "turtlegas/formats/input_log.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 #include <utility>
 
 #include <nlohmann/json.hpp>
@@ -13,9 +16,30 @@
 namespace turtlegas::formats {
 namespace {
 
-void append_step(std::string& out, std::uint64_t step) {
-  out += "{\"step\": ";
+/// One input line: `{"step": N, MEMBERS}` and a newline, MEMBERS being JSON object members
+/// (`"key": value, ...`). Every input_*_line is one.
+std::string line(std::uint64_t step, std::string_view members) {
+  std::string out = "{\"step\": ";
   out += std::to_string(step);
+  out += ", ";
+  out += members;
+  out += "}\n";
+  return out;
+}
+
+/// `{"step": N, "KEY": VALUE}`, VALUE being JSON text.
+std::string line(std::uint64_t step, std::string_view key, std::string_view value) {
+  std::string members;
+  append_json_string(members, key);
+  members += ": ";
+  members += value;
+  return line(step, members);
+}
+
+std::string json_string(std::string_view s) {
+  std::string out;
+  append_json_string(out, s);
+  return out;
 }
 
 void append_point(std::string& out, sim::Vec2 p) {
@@ -40,93 +64,72 @@ std::string input_header_line(std::string_view world_name, double dt) {
 }
 
 std::string input_command_line(std::uint64_t step, std::string_view turtle, const turtle::RemoteCommand& c) {
-  std::string out;
-  append_step(out, step);
-  out += ", \"turtle\": ";
-  append_json_string(out, turtle);
-  out += ", \"command\": ";
-  append_json_string(out, turtle::to_string(c.kind));
+  std::string members = "\"turtle\": ";
+  append_json_string(members, turtle);
+  members += ", \"command\": ";
+  append_json_string(members, turtle::to_string(c.kind));
   if (turtle::takes_amount(c.kind)) {
-    out += ", \"amount\": ";
-    append_number(out, c.amount);
+    members += ", \"amount\": ";
+    append_number(members, c.amount);
   }
   if (c.kind == turtle::RemoteCommand::Kind::pen_down)
-    out += c.pen == turtle::PenMode::wall ? ", \"mode\": \"wall\"" : ", \"mode\": \"line\"";
-  out += "}\n";
-  return out;
+    members += c.pen == turtle::PenMode::wall ? ", \"mode\": \"wall\"" : ", \"mode\": \"line\"";
+  return line(step, members);
 }
 
 std::string input_takeover_line(std::uint64_t step, std::string_view turtle) {
-  std::string out;
-  append_step(out, step);
-  out += ", \"takeover\": ";
-  append_json_string(out, turtle);
-  out += "}\n";
-  return out;
+  return line(step, "takeover", json_string(turtle));
 }
 
 std::string input_wall_line(std::uint64_t step, const sim::WallDef& wall) {
-  std::string out;
-  append_step(out, step);
-  out += ", \"add_wall\": {\"id\": ";
-  append_json_string(out, wall.id);
-  out += ", \"from\": ";
-  append_point(out, wall.from);
-  out += ", \"to\": ";
-  append_point(out, wall.to);
-  out += "}}\n";
-  return out;
+  std::string v = "{\"id\": ";
+  append_json_string(v, wall.id);
+  v += ", \"from\": ";
+  append_point(v, wall.from);
+  v += ", \"to\": ";
+  append_point(v, wall.to);
+  v += '}';
+  return line(step, "add_wall", v);
 }
 
 std::string input_spawn_line(std::uint64_t step, std::string_view kind, const nlohmann::json& entry) {
-  std::string out;
-  append_step(out, step);
-  out += ", \"spawn\": {";
-  append_json_string(out, kind);
-  out += ": ";
-  out += entry.dump();  // numbers as the shortest text that reads back to the same double
-  out += "}}\n";
-  return out;
+  std::string v = "{";
+  append_json_string(v, kind);
+  v += ": ";
+  v += entry.dump();  // numbers as the shortest text that reads back to the same double
+  v += '}';
+  return line(step, "spawn", v);
 }
 
 std::string input_view_line(std::uint64_t step, std::string_view op, const nlohmann::json& view) {
-  std::string out;
-  append_step(out, step);
-  out += ", \"view\": {\"op\": ";
-  append_json_string(out, op);
-  out += ", \"view\": ";
-  out += view.dump();
-  out += "}}\n";
-  return out;
+  std::string v = "{\"op\": ";
+  append_json_string(v, op);
+  v += ", \"view\": ";
+  v += view.dump();
+  v += '}';
+  return line(step, "view", v);
 }
 
 std::string input_remove_line(std::uint64_t step, std::string_view id) {
-  std::string out;
-  append_step(out, step);
-  out += ", \"remove\": ";
-  append_json_string(out, id);
-  out += "}\n";
-  return out;
+  return line(step, "remove", json_string(id));
 }
 
 std::string input_teleport_line(std::uint64_t step, std::string_view id, sim::Vec2 pos, std::optional<sim::Vec2> vel,
                                 std::optional<double> heading) {
-  std::string out;
-  append_step(out, step);
-  out += ", \"teleport\": {\"id\": ";
-  append_json_string(out, id);
-  out += ", \"pos\": ";
-  append_point(out, pos);
+  std::string v = "{\"id\": ";
+  append_json_string(v, id);
+  v += ", \"pos\": ";
+  append_point(v, pos);
   if (vel) {
-    out += ", \"vel\": ";
-    append_point(out, *vel);
+    v += ", \"vel\": ";
+    append_point(v, *vel);
   }
   if (heading) {
-    out += ", \"heading\": ";
-    append_number(out, *heading);
+    v += ", \"heading\": ";
+    append_number(v, *heading);
   }
-  out += "}}\n";
-  return out;
+  v += '}';
+  return line(step, "teleport", v);
 }
 
 ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string file, SpawnApplier spawn)

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <ostream>
 
+#include "turtlegas/formats/look.hpp"
 #include "turtlegas/sim/angles.hpp"
 
 namespace turtlegas::formats {
@@ -31,25 +32,6 @@ std::string xml_escape(std::string_view s) {
     }
   }
   return out;
-}
-
-/// Viridis at five stops: perceptually even and readable in grey.
-constexpr std::array<std::array<int, 3>, 5> palette = {{
-    {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
-
-/// Turtles and their trails: Tableau 10, distinct hues that stand out from the viridis balls.
-constexpr std::array<const char*, 10> turtle_colours = {"#4e79a7", "#f28e2b", "#e15759", "#76b7b2", "#59a14f",
-                                                         "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac"};
-
-std::string colour(double u) {
-  u = std::clamp(u, 0.0, 1.0) * (palette.size() - 1);
-  const auto k = std::min(static_cast<std::size_t>(u), palette.size() - 2);
-  const double f = u - static_cast<double>(k);
-  std::array<char, 8> buf{};
-  int rgb[3];
-  for (int c = 0; c < 3; ++c) rgb[c] = static_cast<int>(std::lround(palette[k][c] + f * (palette[k + 1][c] - palette[k][c])));
-  std::snprintf(buf.data(), buf.size(), "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
-  return buf.data();
 }
 
 }  // namespace
@@ -79,24 +61,12 @@ Snapshot snapshot_of(const turtle::WorldServer& server, const sim::WorldDef& def
 
 void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
   const double aw = snap.arena.width, ah = snap.arena.height;
-  const double scale = width_px / std::max(aw, ah);
-  const double margin = 12.0, title_h = 30.0, legend_w = 90.0;
-  const double w = aw * scale + 2 * margin + legend_w;
-  const double h = std::max(ah * scale, 160.0) + title_h + 2 * margin;
-  const double top = title_h + margin;
+  const look::Layout layout = look::layout_for(aw, ah, width_px);
+  const double scale = layout.scale, margin = look::margin, w = layout.width, h = layout.height, top = layout.top;
 
-  // Colours span 0 to the 99th-percentile speed, so one fast outlier does not wash out the rest.
-  std::vector<double> speeds;
-  speeds.reserve(snap.balls.size());
-  for (const auto& b : snap.balls) speeds.push_back(sim::norm(b.vel));
-  double v_max = 0.0;
-  if (!speeds.empty()) {
-    const auto k = static_cast<std::ptrdiff_t>((speeds.size() - 1) * 99 / 100);
-    std::vector<double> sorted = speeds;
-    std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-    v_max = sorted[static_cast<std::size_t>(k)];
-  }
-  const double v_scale = v_max > 0.0 ? v_max : 1.0;
+  // Colours span 0 to the 99th-percentile speed (look.hpp).
+  const look::SpeedScale speeds = look::speed_scale(snap.balls);
+  const double v_max = speeds.v_max;
 
   const std::string title = xml_escape(snap.title.empty() ? std::string("turtlegas") : snap.title);
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -132,7 +102,7 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
   for (std::size_t i = 0; i < snap.balls.size(); ++i) {
     const auto& b = snap.balls[i];
     out << "<circle cx=\"" << fmt(b.pos.x) << "\" cy=\"" << fmt(b.pos.y) << "\" r=\"" << fmt(b.radius)
-        << "\" fill=\"" << colour(speeds[i] / v_scale) << "\"/>\n";
+        << "\" fill=\"" << look::hex(look::speed_colour(speeds.at(i))) << "\"/>\n";
   }
   // Trails under the turtles, so a turtle is never hidden by its own path.
   for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
@@ -142,7 +112,7 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
       std::size_t to = from;
       while (to < t.trail.size() && !turtle::is_trail_break(t.trail[to])) ++to;
       if (to - from >= 2) {
-        out << "<polyline class=\"trail\" fill=\"none\" stroke=\"" << turtle_colours[i % turtle_colours.size()]
+        out << "<polyline class=\"trail\" fill=\"none\" stroke=\"" << look::hex(look::turtle_colour(i))
             << "\" stroke-width=\"1.5\" stroke-linejoin=\"round\" vector-effect=\"non-scaling-stroke\" points=\"";
         for (std::size_t k = from; k < to; ++k) out << (k == from ? "" : " ") << fmt(t.trail[k].x) << ',' << fmt(t.trail[k].y);
         out << "\"/>\n";
@@ -154,7 +124,7 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
     const auto& t = snap.turtles[i];
     const sim::Vec2 tip = t.pos + t.radius * sim::heading_unit(t.heading);
     out << "<circle class=\"turtle\" cx=\"" << fmt(t.pos.x) << "\" cy=\"" << fmt(t.pos.y) << "\" r=\"" << fmt(t.radius)
-        << "\" fill=\"" << turtle_colours[i % turtle_colours.size()]
+        << "\" fill=\"" << look::hex(look::turtle_colour(i))
         << "\" fill-opacity=\"0.8\" stroke=\"#222\" stroke-width=\"1\" vector-effect=\"non-scaling-stroke\"/>\n"
         << "<line class=\"heading\" x1=\"" << fmt(t.pos.x) << "\" y1=\"" << fmt(t.pos.y) << "\" x2=\"" << fmt(tip.x)
         << "\" y2=\"" << fmt(tip.y)
@@ -181,15 +151,15 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
     out << "</svg>\n";
     return;
   }
-  const double lx = margin + aw * scale + 24.0, ly = top + 16.0, lh = 120.0;
+  const double lx = layout.legend_x, ly = layout.legend_y, lh = look::legend_h;
   out << "<defs><linearGradient id=\"speed\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">";
-  for (std::size_t k = 0; k < palette.size(); ++k) {
-    const double u = static_cast<double>(k) / (palette.size() - 1);
-    out << "<stop offset=\"" << fmt(u) << "\" stop-color=\"" << colour(u) << "\"/>";
+  for (std::size_t k = 0; k < look::palette.size(); ++k) {
+    const double u = static_cast<double>(k) / (look::palette.size() - 1);
+    out << "<stop offset=\"" << fmt(u) << "\" stop-color=\"" << look::hex(look::speed_colour(u)) << "\"/>";
   }
   out << "</linearGradient></defs>\n"
       << "<text x=\"" << fmt(lx - 8) << "\" y=\"" << fmt(ly - 6) << "\" font-size=\"12\">speed</text>\n"
-      << "<rect x=\"" << fmt(lx) << "\" y=\"" << fmt(ly) << "\" width=\"14\" height=\"" << fmt(lh)
+      << "<rect x=\"" << fmt(lx) << "\" y=\"" << fmt(ly) << "\" width=\"" << fmt(look::legend_bar_w) << "\" height=\"" << fmt(lh)
       << "\" fill=\"url(#speed)\" stroke=\"#999\"/>\n"
       << "<text x=\"" << fmt(lx + 18) << "\" y=\"" << fmt(ly + 10) << "\" font-size=\"11\">&#8805; " << fmt(v_max)
       << "</text>\n"

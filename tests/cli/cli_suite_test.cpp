@@ -217,11 +217,12 @@ TEST_CASE("suite: SIGINT stops a sweep: its runs killed, the journal whole, and 
             R"({"format": "turtlegas-sweep/1", "world": "gas.json", "until": 3000, "seeds": {"count": 3}})");
   const fs::path journal = dir.path / "sweep.results.jsonl.partial";
   Spawned p(dir.path, {"sweep", "sweep.json"});
-  // The header and the first run's line: one run done, the next running.
+  // The header (written twice: docs/sweeps.md) and the first run's line: one run done, the next
+  // running.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (lines_of(read(journal)) < 2 && std::chrono::steady_clock::now() < deadline)
+  while (lines_of(read(journal)) < 3 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  REQUIRE(lines_of(read(journal)) == 2);
+  REQUIRE(lines_of(read(journal)) == 3);
   p.send(SIGINT);
   const auto ended = p.wait_for(30);
   REQUIRE(ended.has_value());
@@ -232,8 +233,8 @@ TEST_CASE("suite: SIGINT stops a sweep: its runs killed, the journal whole, and 
                           "command again to go on"));
   CHECK(!fs::exists(dir.path / "sweep.results.jsonl"));  // written only when whole
   const std::string kept = read(journal);
-  REQUIRE(lines_of(kept) == 2);
-  const std::string run0 = kept.substr(kept.find('\n') + 1);
+  REQUIRE(lines_of(kept) == 3);
+  const std::string run0 = kept.substr(kept.find('\n', kept.find('\n') + 1) + 1);
   CHECK(json::parse(run0).at("run") == 0);
 
   Spawned resumed(dir.path, {"sweep", "sweep.json"});

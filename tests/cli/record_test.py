@@ -6,7 +6,7 @@
 - its keyframes hold the state of a fresh `run --until t --state-out`, to the bit;
 - `turtlegas replay` seeks (forward and back) to 5 random times and its state (GET /api/state,
   and the snapshot message) is a fresh run's to the bit;
-- a cut recording and a SIGKILLed run load up to their last keyframe, with a warning;
+- a cut recording and a SIGKILLed run (its R.partial) load up to their last keyframe, with a warning;
 - `render` PNG pixels match the scene's geometry; --frames writes fps (T1 - T0) + 1 frames.
 
 Seeded randomness (the seed is printed on failure); every wait is bounded."""
@@ -175,13 +175,15 @@ def check_killed():
     proc = subprocess.Popen([BIN, "run", os.path.join(ROOT, "worlds", "gas.json"), "--until", "100000", "--record", rec,
                              "--keyframe-seconds", "1"], stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and (not os.path.exists(rec) or read(rec).count(b'\n{"keyframe":') < 4):
+    partial = rec + ".partial"  # R itself appears only when the recording is whole
+    while time.monotonic() < deadline and (not os.path.exists(partial) or read(partial).count(b'\n{"keyframe":') < 4):
         time.sleep(0.02)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
-    kfs = keyframes(rec)
+    assert not os.path.exists(rec), "a killed run's recording was put in place as if whole"
+    kfs = keyframes(partial)
     assert len(kfs) >= 4, "the killed run left no keyframes"
-    p = run("render", rec, "--at", kfs[-1][1]["t"], "--out", path("killed.svg"))
+    p = run("render", partial, "--at", kfs[-1][1]["t"], "--out", path("killed.svg"))
     assert b"incomplete" in p.stderr and b"recovered" in p.stderr, p.stderr
 
 

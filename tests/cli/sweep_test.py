@@ -78,7 +78,7 @@ def main():
         kpartial = Path(str(killed) + ".partial")
         deadline = time.time() + 60
         while time.time() < deadline and proc.poll() is None:
-            if kpartial.exists() and len(kpartial.read_text().splitlines()) >= 2:
+            if kpartial.exists() and len(kpartial.read_text().splitlines()) >= 3:  # two header lines, a run
                 proc.send_signal(signal.SIGKILL)
                 break
             time.sleep(0.001)
@@ -100,7 +100,7 @@ def main():
         partial = Path(str(cut) + ".partial")
         run([tg, "sweep", spec, "--out", cut, "--quiet", "--timeout", "0.000001"], tmp, ok=(1,))
         header = partial.read_text().splitlines()[0]
-        if cut.exists() or len(partial.read_text().splitlines()) != 1:
+        if cut.exists() or len(partial.read_text().splitlines()) != 2:  # the header, written twice
             fail("a sweep whose runs all failed wrote results, or recorded runs")
         partial.write_text(header + "\n" + "\n".join(lines[1:6]) + "\n" + lines[7][: len(lines[7]) // 2])
         res = run([tg, "sweep", spec, "--out", cut], tmp)
