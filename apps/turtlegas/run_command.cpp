@@ -96,6 +96,9 @@ void print_summary(const formats::RunFigures& run, const sim::World& world, cons
   std::printf("  exits        %llu  (%zu balls left)\n", ull(st.exits), run.balls_alive);
   if (st.wedged + st.crushed > 0)
     std::printf("  squeezed     %llu wedged, %llu crushed (docs/physics.md)\n", ull(st.wedged), ull(st.crushed));
+  if (st.folded > 0)
+    std::printf("  folded       %llu elastic wedges, energy kept (docs/physics.md, \"The elastic wedge\")\n",
+                ull(st.folded));
   std::printf("  events       %llu  (cell crossings %llu, stale %llu, steps %llu)\n", ull(st.events),
               ull(st.cell_crossings), ull(st.stale), ull(st.steps));
   std::printf("  wall time    %.3f s  (%s collisions/s)\n", run.wall_seconds, fmt(run.collisions_per_second(st)).c_str());
