@@ -50,7 +50,7 @@ class BodyStore {
 
   std::vector<Layers> layers;  ///< per body (with_layers only)
 
-  /// The squeeze rule's mark (squeeze.hpp): the two obstacles a body was last held between, its
+  /// The squeeze rule's mark (contacts/squeeze.hpp): the two obstacles a body was last held between, its
   /// course counter then, when, and whether it flies straight. The vector stays empty until a
   /// body is first held.
   struct Held {

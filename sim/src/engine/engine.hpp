@@ -16,7 +16,10 @@
 //   turtle_motion.*            turtles' commands, contacts and state
 //   walls.*, moving_walls.*    walls and their ends; keyframes and visibility
 //   cell_size.*, checks.hpp    the cell-size policy; energy and overlap
-//   squeeze.hpp                bodies held between two obstacles: wedged or crushed
+//   contacts/                  zero-time contacts, the principle on top (contacts.hpp): tolerances,
+//                              skip(), squeeze.hpp (wedged or crushed), carried.hpp (turtles a
+//                              moving wall pushes), restitution.hpp (the TC rule), resolve.hpp
+//                              (the hook after a contact: collide)
 //   exact_clock.hpp            cell crossings, exits, the rebase of internal time
 //   step_clock.hpp             the start and the end of one of the memo's steps
 //   operations.hpp             spawn, remove, teleport: changes to a running world
@@ -70,6 +73,9 @@
 #include "body_store.hpp"
 #include "cell_size.hpp"
 #include "checks.hpp"
+#include "contacts/carried.hpp"
+#include "contacts/contacts.hpp"
+#include "contacts/squeeze.hpp"
 #include "engine_base.hpp"
 #include "flights.hpp"
 #include "interactions.hpp"
@@ -78,7 +84,6 @@
 #include "neighbourhood.hpp"
 #include "parts.hpp"
 #include "records.hpp"
-#include "squeeze.hpp"
 #include "turtle_motion.hpp"
 #include "variant.hpp"
 #include "walls.hpp"
@@ -242,6 +247,7 @@ class Engine final : public EngineBase {
   /// Serves events up to internal time `limit`. Returns false when it stopped early to rebase the
   /// clock (exact mode), so that the caller takes the limit afresh in the new internal time.
   bool process(double limit);
+  /// Serves body i's predicted contact, and the squeeze rule after it (contacts/resolve.hpp).
   void collide(std::uint32_t i);
   void served(Changed c) {
     repredict(c.first);
@@ -258,7 +264,7 @@ class Engine final : public EngineBase {
   /// Body i, brought to now and placed at pos (unlinked already, or new), enters its cell and
   /// predicts afresh.
   void place(std::uint32_t i, Vec2 pos);
-  /// The squeeze rule (squeeze.hpp) for body i after its contact with bodies_.last[i]; `before`:
+  /// The squeeze rule (contacts/squeeze.hpp) for body i after its contact with bodies_.last[i]; `before`:
   /// its partner before that. Returns false when the body was crushed (and removed).
   bool squeezed(std::uint32_t i, LastPartner before);
   /// Body i is crushed between A and B: it is removed, with a `crushed` event.
@@ -461,74 +467,6 @@ void Engine<F, kBallBall, kStep, kExtras>::check_stop() {
 }
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
-void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
-  const Pending p = bodies_.pending[i];
-  const LastPartner before = bodies_.last[i];
-  switch (p.kind) {
-    case Partner::body:
-      if (bodies_.body[p.partner].count != p.partner_count) {
-        ++record_.stats.stale;
-        sync(i);
-        predict(i);
-        schedule(i);
-        return;
-      }
-      if (is_turtle(i) || is_turtle(p.partner)) {
-        // A ball is squeezed against a turtle, a turtle against a turtle; never against a ball.
-        const LastPartner before_partner = bodies_.last[p.partner];
-        const Changed c = apply_turtle_body(parts(), i, p.partner);
-        auto before_of = [&](std::uint32_t k) { return k == i ? before : before_partner; };
-        const bool keep_first = !is_turtle(c.second) || squeezed(c.first, before_of(c.first));
-        const bool keep_second = squeezed(c.second, before_of(c.second));
-        if (keep_first) repredict(c.first);
-        if (keep_second) repredict(c.second);
-      } else {
-        // A ball the squeeze rule holds, pushed into its holders, is as heavy as they are.
-        if (!bodies_.held.empty()) [[unlikely]] {
-          const LastPartner before_partner = bodies_.last[p.partner];
-          if (const std::uint32_t o = push_held(parts(), i, p.partner); o != kNone) {
-            // The pusher met an obstacle of infinite mass: the squeeze rule answers it.
-            const std::uint32_t k = o == i ? p.partner : i;
-            if (squeezed(o, o == i ? before : before_partner)) repredict(o);
-            repredict(k);
-            return;
-          }
-        }
-        served(apply_ball_ball(parts(), i, p.partner));
-      }
-      return;
-    case Partner::wall: {
-      const Changed c = apply_wall(parts(), i, p.partner);
-      if (squeezed(i, before)) served(c);
-      return;
-    }
-    case Partner::end: {
-      const Changed c = apply_end(parts(), i, p.partner);
-      if (squeezed(i, before)) served(c);
-      return;
-    }
-    case Partner::moving_end: {
-      const Changed c = apply_moving_end(parts(), i, p.partner);
-      if (squeezed(i, before)) served(c);
-      return;
-    }
-    case Partner::none: break;
-  }
-  // A body with nothing pending has an infinite key and is never popped.
-  sync(i);
-  predict(i);
-  schedule(i);
-}
-
-template <Flight F, bool kBallBall, bool kStep, bool kExtras>
-bool Engine<F, kBallBall, kStep, kExtras>::squeezed(std::uint32_t i, LastPartner before) {
-  Side A, B;
-  if (squeeze(parts(), i, before, bodies_.last[i], A, B) != Squeeze::crushed) return true;
-  crush(i, A, B);
-  return false;
-}
-
-template <Flight F, bool kBallBall, bool kStep, bool kExtras>
 void Engine<F, kBallBall, kStep, kExtras>::crush(std::uint32_t i, const Side& A, const Side& B) {
   const bool turtle = is_turtle(i);
   const std::uint32_t nb = bodies_.balls();
@@ -582,20 +520,8 @@ void Engine<F, kBallBall, kStep, kExtras>::keyframe() {
     Body& b = bodies_.body[i];
     if (b.cell == kNone) continue;
     sync(i);
-    if (is_turtle(i) && turtles_.pushed_by[i - nb] != kNone && schedule_.keyed[turtles_.pushed_by[i - nb]]) {
-      // The push ends with the segment of motion that made it; the turtle stands where it is.
-      // (Another wall's keyframe changes nothing here: the push goes on.)
-      b.v = {};
-      turtles_.pushed_by[i - nb] = kNone;
-      turtles_.pushed_via[i - nb] = kNone;
-      ++b.count;
-    }
-    // "Just collided, cannot meet again" does not survive a change of the wall's velocity.
-    const LastPartner last = bodies_.last[i];
-    if (!last.is_none() && ((last.kind() == Partner::moving_end && schedule_.keyed[last.index() / 2]) ||
-                            (last.kind() == Partner::wall && walls_.mover_of[last.index()] != kNone &&
-                             schedule_.keyed[walls_.mover_of[last.index()]])))
-      bodies_.last[i] = LastPartner::none();
+    if (is_turtle(i)) push_ends(turtles_, i - nb, b, schedule_.keyed);  // contacts/carried.hpp
+    if (keyed_partner(bodies_.last[i], walls_, schedule_)) bodies_.last[i] = LastPartner::none();  // contacts.hpp
     repredict(i);
   }
 }
@@ -657,6 +583,7 @@ void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
 }  // namespace
 }  // namespace turtlegas::sim::detail
 
+#include "contacts/resolve.hpp"
 #include "exact_clock.hpp"
 #include "operations.hpp"
 #include "region.hpp"

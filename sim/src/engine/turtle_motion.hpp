@@ -90,7 +90,8 @@ class Turtles {
   /// Per turtle: the mover (WallSchedule::movers) pushing it, or kNone.
   std::vector<std::uint32_t> pushed_by;
   /// Per turtle pushed: the turtle through which that mover pushes it (a carried turtle pushing
-  /// another along), or kNone (the mover's wall itself). Parts::carried reads both.
+  /// another along), or kNone (the mover's wall itself). The contacts room sets and reads both
+  /// (contacts/carried.hpp).
   std::vector<std::uint32_t> pushed_via;
 
  private:
