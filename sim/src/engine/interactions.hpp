@@ -30,6 +30,25 @@ struct Changed {
   std::uint32_t second = kNone;
 };
 
+/// The common end of every response: body i changed course (Parts::changed: predictions made
+/// with it are stale) and met `partner` last (the contacts room's LastPartner rule, contacts.hpp).
+template <Flight Fl, bool kStep, bool kExtras>
+[[gnu::always_inline]] inline Changed answered(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner partner) {
+  p.changed(i);
+  p.bodies.last[i] = partner;
+  return {i};
+}
+
+/// The same for two bodies that met each other.
+template <Flight Fl, bool kStep, bool kExtras>
+[[gnu::always_inline]] inline Changed answered(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t j) {
+  p.changed(i);
+  p.changed(j);
+  p.bodies.last[i] = LastPartner::of(Partner::body, j);
+  p.bodies.last[j] = LastPartner::of(Partner::body, i);
+  return {i, j};
+}
+
 // ---------------------------------------------------------------------------------------------
 // Ball-ball
 
@@ -69,13 +88,8 @@ Changed apply_ball_ball(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, std
   respond_disc_disc(a.v, b.v, w.bodies.mass[i], w.bodies.mass[j], F, e);
   if (w.record.impulses) [[unlikely]]
     w.impulse(EventKind::ball_ball, i, j, w.bodies.mass[i] * (a.v - va), -F);
-  ++w.record.stats.ball_ball;
-  w.note(EventKind::ball_ball, i, j);
-  w.changed(i);
-  w.changed(j);
-  w.bodies.last[i] = LastPartner::of(Partner::body, j);
-  w.bodies.last[j] = LastPartner::of(Partner::body, i);
-  return {i, j};
+  w.count(w.record.stats.ball_ball, EventKind::ball_ball, i, j);
+  return answered(w, i, j);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -133,11 +147,9 @@ Changed apply_turtle_body(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, s
     if (Vec2 vc; carried(w, t, vc)) bt.v = vc;  // contacts/carried.hpp
     const Vec2 rel = bo.v - bt.v;
     if (dot(rel, n) < 0.0) bo.v = bt.v + w.bounce(o, rel, n);
-    ++w.record.stats.turtle_ball;
-    w.note(EventKind::turtle_ball, t - nb, o);
+    w.count(w.record.stats.turtle_ball, EventKind::turtle_ball, t - nb, o);
   } else {
-    ++w.record.stats.turtle_turtle;
-    w.note(EventKind::turtle_turtle, t - nb, o - nb);
+    w.count(w.record.stats.turtle_turtle, EventKind::turtle_turtle, t - nb, o - nb);
     w.touch(t, EventKind::turtle_turtle, o - nb, -n);
     w.touch(o, EventKind::turtle_turtle, t - nb, n);
     // A carried turtle goes on; one it meets that is not carried is pushed along by it (both have
@@ -153,11 +165,7 @@ Changed apply_turtle_body(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, s
       if (un > 0.0) carry(w.turtles, q - nb, w.bodies.body[q], un * nq, w.turtles.pushed_by[c - nb], c - nb);
     }
   }
-  w.changed(t);
-  w.changed(o);
-  w.bodies.last[t] = LastPartner::of(Partner::body, o);
-  w.bodies.last[o] = LastPartner::of(Partner::body, t);
-  return {t, o};
+  return answered(w, t, o);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -203,8 +211,7 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
   const Vec2 n = d >= 0.0 ? s.n : -s.n;
   p.record.note_contact(a.r - std::abs(d), a.r);
   if (p.is_turtle(i)) {
-    ++p.record.stats.turtle_wall;
-    p.note(EventKind::turtle_wall, i - p.bodies.balls(), w);
+    p.count(p.record.stats.turtle_wall, EventKind::turtle_wall, i - p.bodies.balls(), w);
     p.touch(i, EventKind::turtle_wall, w, n);
     // A moving wall pushing a turtle carries it along at its normal speed (both have infinite
     // mass), until the wall's next keyframe. A turning or stretching wall's push changes along the
@@ -228,12 +235,9 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
     }
     if (p.record.impulses) [[unlikely]]
       p.impulse(EventKind::ball_wall, i, w, p.bodies.mass[i] * (a.v - va), std::abs(d) * n);
-    ++p.record.stats.ball_wall;
-    p.note(EventKind::ball_wall, i, w);
+    p.count(p.record.stats.ball_wall, EventKind::ball_wall, i, w);
   }
-  p.changed(i);
-  p.bodies.last[i] = LastPartner::of(Partner::wall, w);
-  return {i};
+  return answered(p, i, LastPartner::of(Partner::wall, w));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -264,19 +268,15 @@ Changed apply_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint
   const double dist = norm(F);
   p.record.note_contact(a.r - dist, a.r);
   if (p.is_turtle(i)) {
-    ++p.record.stats.turtle_wall_end;
-    p.note(EventKind::turtle_wall_end, i - p.bodies.balls(), end.wall);
+    p.count(p.record.stats.turtle_wall_end, EventKind::turtle_wall_end, i - p.bodies.balls(), end.wall);
     p.touch(i, EventKind::turtle_wall_end, end.wall, F / dist);
   } else {
     const Vec2 va = a.v;
     a.v = p.bounce(i, a.v, F / dist);
     if (p.record.impulses) [[unlikely]] p.impulse(EventKind::ball_wall_end, i, end.wall, p.bodies.mass[i] * (a.v - va), F);
-    ++p.record.stats.ball_wall_end;
-    p.note(EventKind::ball_wall_end, i, end.wall);
+    p.count(p.record.stats.ball_wall_end, EventKind::ball_wall_end, i, end.wall);
   }
-  p.changed(i);
-  p.bodies.last[i] = LastPartner::of(Partner::end, e);
-  return {i};
+  return answered(p, i, LastPartner::of(Partner::end, e));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -331,19 +331,15 @@ Changed apply_moving_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, st
   const double dist = norm(F);
   p.record.note_contact(a.r - dist, a.r);
   if (p.is_turtle(i)) {
-    ++p.record.stats.turtle_wall_end;
-    p.note(EventKind::turtle_wall_end, i - p.bodies.balls(), m.wall);
+    p.count(p.record.stats.turtle_wall_end, EventKind::turtle_wall_end, i - p.bodies.balls(), m.wall);
     p.touch(i, EventKind::turtle_wall_end, m.wall, F / dist);
   } else {
     const Vec2 va = a.v;
     a.v = ue + p.bounce(i, a.v - ue, F / dist);
     if (p.record.impulses) [[unlikely]] p.impulse(EventKind::ball_wall_end, i, m.wall, p.bodies.mass[i] * (a.v - va), F);
-    ++p.record.stats.ball_wall_end;
-    p.note(EventKind::ball_wall_end, i, m.wall);
+    p.count(p.record.stats.ball_wall_end, EventKind::ball_wall_end, i, m.wall);
   }
-  p.changed(i);
-  p.bodies.last[i] = LastPartner::of(Partner::moving_end, code);
-  return {i};
+  return answered(p, i, LastPartner::of(Partner::moving_end, code));
 }
 
 }  // namespace

@@ -112,6 +112,12 @@ struct Parts {
   bool is_turtle(std::uint32_t id) const { return motion.is_turtle(id); }
   void sync(std::uint32_t i) const { sync_body<F, kStep, kExtras>(bodies, motion, step, i, now); }
   void note(EventKind kind, std::uint32_t a, std::uint32_t b) const { record.note(t_base + now, kind, a, b); }
+  /// An event of `kind` served between a and b (as the log names them): its Stats `counter`
+  /// bumped and its line logged.
+  [[gnu::always_inline]] void count(std::uint64_t& counter, EventKind kind, std::uint32_t a, std::uint32_t b) const {
+    ++counter;
+    note(kind, a, b);
+  }
   /// Ball a received dp in a collision with b (World::set_impulse_log); r as Impulse::r.
   void impulse(EventKind kind, std::uint32_t a, std::uint32_t b, Vec2 dp, Vec2 r) const {
     record.impulses->push_back({t_base + now, kind, a, b, dp, r});

@@ -458,8 +458,7 @@ template <Flight Fl, bool kStep, bool kExtras>
   o.v = bk.v + p.bounce(other, o.v - bk.v, n);  // as off a wall: the plain restitution
   if (p.record.impulses) [[unlikely]]
     p.impulse(EventKind::ball_ball, other, k, p.bodies.mass[other] * (o.v - va), -F);
-  ++p.record.stats.ball_ball;
-  p.note(EventKind::ball_ball, i, j);
+  p.count(p.record.stats.ball_ball, EventKind::ball_ball, i, j);
   p.changed(other);
   p.bodies.last[other] = LastPartner::of(Partner::body, k);
   return other;
