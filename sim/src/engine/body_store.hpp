@@ -36,7 +36,7 @@ class BodyStore {
   /// squeeze marks and the cell lists keep follows them, so that the relative order of all ids
   /// (which breaks ties in the queue) stays as it was. The new record is default (cell kNone,
   /// unlinked); its layers are the caller's to insert. Every queue node is left out of any queue: the caller resets the queue
-  /// and sets the keys again (EventQueue::contains and key, read before). A run-time spawn (operations.hpp).
+  /// and sets the keys again (EventQueue::contains and key, read before). A run-time spawn (world_changes.hpp).
   void insert(std::uint32_t at, bool ball);
   std::size_t size() const { return body.size(); }
   /// The queue's nodes, one in each record (EventQueue::reset).

@@ -7,22 +7,29 @@
 // (factory.cpp): the flight (straight, or parabolas under gravity), ball-ball collisions on or
 // off, exact or step mode, extras or not. It is chosen when the World is built, so nothing is
 // decided per collision. The engine owns the loop and the two clocks; the rooms it holds do the
-// rest, each receiving what it touches (parts.hpp):
+// rest, each receiving what it touches (room_views.hpp). `ls sim/src/engine` reads:
+//   engine_base.hpp            EngineBase, the interface World forwards to; make_engine
+//   factory.cpp                the table of compiled variants, and the choice of a row
+//   variant_seam.hpp           make_variant: the seam between the table and the units compiling it
 //   records.hpp, body_store.*  the bodies: one 128-byte record each, columns, cell lists
+//   big_memory.*               the records' and the cell lists' memory (huge pages when large)
+//   arena.hpp                  the arena's size and boundary, minimum images
 //   flights.hpp                how balls fly, and the time-of-impact choice that follows
+//   charged_flight.cpp         ChargedFlight's out-of-line parts (balls under E and B fields)
 //   kick.hpp                   step mode's field, a velocity kick between steps
+//   room_views.hpp             what the rooms see of each other: Look (a prediction), Parts (a response)
 //   neighbourhood.hpp          who a body looks at (the memo's table, CellGrid)
 //   interactions.hpp           predict / apply / validate per pair kind
-//   turtle_motion.*            turtles' commands, contacts and state
-//   walls.*, moving_walls.*    walls and their ends; keyframes and visibility
-//   cell_size.*, checks.hpp    the cell-size policy; energy and overlap
 //   contacts/                  zero-time contacts, the principle on top (contacts.hpp): tolerances,
 //                              skip(), squeeze.hpp (wedged or crushed), carried.hpp (turtles a
 //                              moving wall pushes), restitution.hpp (the TC rule), resolve.hpp
 //                              (the hook after a contact: collide)
+//   turtle_motion.*            turtles' commands, contacts and state
+//   walls.*, moving_walls.*    walls and their ends; keyframes and visibility
+//   cell_size.*, checks.hpp    the cell-size policy; energy and overlap
 //   exact_clock.hpp            cell crossings, exits, the rebase of internal time
 //   step_clock.hpp             the start and the end of one of the memo's steps
-//   operations.hpp             spawn, remove, teleport: changes to a running world
+//   world_changes.hpp          spawn, remove, teleport: changes to a running world
 //   region.hpp                 the balls in a rectangle, from the cell lists
 //
 // Order of work, exact mode (event-driven):
@@ -82,10 +89,10 @@
 #include "kick.hpp"
 #include "moving_walls.hpp"
 #include "neighbourhood.hpp"
-#include "parts.hpp"
 #include "records.hpp"
+#include "room_views.hpp"
 #include "turtle_motion.hpp"
-#include "variant.hpp"
+#include "variant_seam.hpp"
 #include "walls.hpp"
 
 namespace turtlegas::sim::detail {
@@ -157,7 +164,7 @@ class Engine final : public EngineBase {
   }
   void command_turtle(std::size_t k, const TurtleCommand& command) override;
   std::size_t add_wall(const WallDef& wall) override;
-  // Changes to a running world (operations.hpp).
+  // Changes to a running world (world_changes.hpp).
   std::size_t spawn_ball(const BallDef& ball) override;
   std::size_t spawn_turtle(const TurtleDef& turtle) override;
   void remove_body(bool turtle, std::size_t index) override;
@@ -255,7 +262,7 @@ class Engine final : public EngineBase {
   }
   void end_command(std::uint32_t i);
   void keyframe();
-  // operations.hpp
+  // world_changes.hpp
   /// Throws PlacementError unless a disc of radius r at pos (layers `layers`) lies clear of the
   /// walls and of every body but `self` (kNone: none), inside the arena.
   void check_clear(Vec2 pos, double r, const Layers& layers, std::uint32_t self) const;
@@ -595,7 +602,7 @@ void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
 
 #include "contacts/resolve.hpp"
 #include "exact_clock.hpp"
-#include "operations.hpp"
+#include "world_changes.hpp"
 #include "region.hpp"
 #include "step_clock.hpp"
 
@@ -608,7 +615,7 @@ std::unique_ptr<EngineBase> make_variant(const WorldDef& def, std::vector<BallDe
 
 }  // namespace turtlegas::sim::detail
 
-/// The explicit instantiation of one row of the table in factory.cpp (see variant.hpp).
+/// The explicit instantiation of one row of the table in factory.cpp (see variant_seam.hpp).
 #define TURTLEGAS_ENGINE_VARIANT(flight, balls, mode, extras)                                   \
   namespace turtlegas::sim::detail {                                                             \
   template std::unique_ptr<EngineBase> make_variant<flight, variant::balls, variant::mode, variant::extras>( \

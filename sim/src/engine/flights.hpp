@@ -298,7 +298,7 @@ class Motion {
 
   const F& flight() const { return flight_; }
   bool is_turtle(std::uint32_t id) const { return kExtras && id >= balls_; }
-  /// A ball spawned at run time takes id balls_ (operations.hpp; flights with per-ball data refuse).
+  /// A ball spawned at run time takes id balls_ (world_changes.hpp; flights with per-ball data refuse).
   void add_ball() { ++balls_; }
   /// Whether body id's motion relative to something that flies straight is a straight line.
   bool straight(std::uint32_t id) const { return is_turtle(id) || flight_.straight(id); }

@@ -18,7 +18,7 @@
 
 #include "contacts/carried.hpp"
 #include "contacts/contacts.hpp"
-#include "parts.hpp"
+#include "room_views.hpp"
 #include "turtlegas/sim/toi.hpp"
 
 namespace turtlegas::sim::detail {

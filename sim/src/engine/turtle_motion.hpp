@@ -70,7 +70,7 @@ class Turtles {
   /// until the next control step), and the contact waits for its touch sensors.
   void touch(std::size_t k, Body& b, double& end, double now, double t_base, double dt, EventKind kind,
              std::uint32_t other, Vec2 normal);
-  /// A turtle joins at run time (operations.hpp): standing still, no command.
+  /// A turtle joins at run time (world_changes.hpp): standing still, no command.
   void add(const TurtleDef& d);
   /// Turtle k is set down (a teleport, at `now`) with `heading`, standing still: the command it
   /// was running ends there, not touched, its `done` what it had done by then.

@@ -13,7 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "../parts.hpp"
+#include "../room_views.hpp"
 #include "contacts.hpp"
 
 namespace turtlegas::sim::detail {

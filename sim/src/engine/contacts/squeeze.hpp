@@ -26,7 +26,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "../parts.hpp"
+#include "../room_views.hpp"
 #include "carried.hpp"
 #include "contacts.hpp"
 
