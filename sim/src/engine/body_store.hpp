@@ -36,7 +36,7 @@ class BodyStore {
   /// squeeze marks and the cell lists keep follows them, so that the relative order of all ids
   /// (which breaks ties in the queue) stays as it was. The new record is default (cell kNone,
   /// unlinked); its layers are the caller's to insert. Every queue node is left out of any queue: the caller resets the queue
-  /// and sets the keys again (EventQueue::contains and key, read before). A run-time spawn (operations.hpp).
+  /// and sets the keys again (EventQueue::contains and key, read before). A run-time spawn (world_changes.hpp).
   void insert(std::uint32_t at, bool ball);
   std::size_t size() const { return body.size(); }
   /// The queue's nodes, one in each record (EventQueue::reset).
@@ -50,7 +50,7 @@ class BodyStore {
 
   std::vector<Layers> layers;  ///< per body (with_layers only)
 
-  /// The squeeze rule's mark (squeeze.hpp): the two obstacles a body was last held between, its
+  /// The squeeze rule's mark (contacts/squeeze.hpp): the two obstacles a body was last held between, its
   /// course counter then, when, and whether it flies straight. The vector stays empty until a
   /// body is first held.
   struct Held {

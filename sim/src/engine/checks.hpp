@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "../overlap.hpp"
-#include "parts.hpp"
+#include "room_views.hpp"
 
 namespace turtlegas::sim::detail {
 namespace {

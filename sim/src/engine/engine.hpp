@@ -7,19 +7,29 @@
 // (factory.cpp): the flight (straight, or parabolas under gravity), ball-ball collisions on or
 // off, exact or step mode, extras or not. It is chosen when the World is built, so nothing is
 // decided per collision. The engine owns the loop and the two clocks; the rooms it holds do the
-// rest, each receiving what it touches (parts.hpp):
+// rest, each receiving what it touches (room_views.hpp). `ls sim/src/engine` reads:
+//   engine_base.hpp            EngineBase, the interface World forwards to; make_engine
+//   factory.cpp                the table of compiled variants, and the choice of a row
+//   variant_seam.hpp           make_variant: the seam between the table and the units compiling it
 //   records.hpp, body_store.*  the bodies: one 128-byte record each, columns, cell lists
+//   big_memory.*               the records' and the cell lists' memory (huge pages when large)
+//   arena.hpp                  the arena's size and boundary, minimum images
 //   flights.hpp                how balls fly, and the time-of-impact choice that follows
+//   charged_flight.cpp         ChargedFlight's out-of-line parts (balls under E and B fields)
 //   kick.hpp                   step mode's field, a velocity kick between steps
+//   room_views.hpp             what the rooms see of each other: Look (a prediction), Parts (a response)
 //   neighbourhood.hpp          who a body looks at (the memo's table, CellGrid)
 //   interactions.hpp           predict / apply / validate per pair kind
+//   contacts/                  zero-time contacts, the principle on top (contacts.hpp): tolerances,
+//                              skip(), squeeze.hpp (wedged or crushed), carried.hpp (turtles a
+//                              moving wall pushes), restitution.hpp (the TC rule), resolve.hpp
+//                              (the hook after a contact: collide)
 //   turtle_motion.*            turtles' commands, contacts and state
 //   walls.*, moving_walls.*    walls and their ends; keyframes and visibility
 //   cell_size.*, checks.hpp    the cell-size policy; energy and overlap
-//   squeeze.hpp                bodies held between two obstacles: wedged or crushed
 //   exact_clock.hpp            cell crossings, exits, the rebase of internal time
 //   step_clock.hpp             the start and the end of one of the memo's steps
-//   operations.hpp             spawn, remove, teleport: changes to a running world
+//   world_changes.hpp          spawn, remove, teleport: changes to a running world
 //   region.hpp                 the balls in a rectangle, from the cell lists
 //
 // Order of work, exact mode (event-driven):
@@ -70,17 +80,19 @@
 #include "body_store.hpp"
 #include "cell_size.hpp"
 #include "checks.hpp"
+#include "contacts/carried.hpp"
+#include "contacts/contacts.hpp"
+#include "contacts/squeeze.hpp"
 #include "engine_base.hpp"
 #include "flights.hpp"
 #include "interactions.hpp"
 #include "kick.hpp"
 #include "moving_walls.hpp"
 #include "neighbourhood.hpp"
-#include "parts.hpp"
 #include "records.hpp"
-#include "squeeze.hpp"
+#include "room_views.hpp"
 #include "turtle_motion.hpp"
-#include "variant.hpp"
+#include "variant_seam.hpp"
 #include "walls.hpp"
 
 namespace turtlegas::sim::detail {
@@ -152,7 +164,7 @@ class Engine final : public EngineBase {
   }
   void command_turtle(std::size_t k, const TurtleCommand& command) override;
   std::size_t add_wall(const WallDef& wall) override;
-  // Changes to a running world (operations.hpp).
+  // Changes to a running world (world_changes.hpp).
   std::size_t spawn_ball(const BallDef& ball) override;
   std::size_t spawn_turtle(const TurtleDef& turtle) override;
   void remove_body(bool turtle, std::size_t index) override;
@@ -242,6 +254,7 @@ class Engine final : public EngineBase {
   /// Serves events up to internal time `limit`. Returns false when it stopped early to rebase the
   /// clock (exact mode), so that the caller takes the limit afresh in the new internal time.
   bool process(double limit);
+  /// Serves body i's predicted contact, and the squeeze rule after it (contacts/resolve.hpp).
   void collide(std::uint32_t i);
   void served(Changed c) {
     repredict(c.first);
@@ -249,7 +262,7 @@ class Engine final : public EngineBase {
   }
   void end_command(std::uint32_t i);
   void keyframe();
-  // operations.hpp
+  // world_changes.hpp
   /// Throws PlacementError unless a disc of radius r at pos (layers `layers`) lies clear of the
   /// walls and of every body but `self` (kNone: none), inside the arena.
   void check_clear(Vec2 pos, double r, const Layers& layers, std::uint32_t self) const;
@@ -258,17 +271,22 @@ class Engine final : public EngineBase {
   /// Body i, brought to now and placed at pos (unlinked already, or new), enters its cell and
   /// predicts afresh.
   void place(std::uint32_t i, Vec2 pos);
-  /// The squeeze rule (squeeze.hpp) for body i after its contact with bodies_.last[i]; `before`:
+  /// The squeeze rule (contacts/squeeze.hpp) for body i after its contact with bodies_.last[i]; `before`:
   /// its partner before that. Returns false when the body was crushed (and removed).
   bool squeezed(std::uint32_t i, LastPartner before);
   /// Body i is crushed between A and B: it is removed, with a `crushed` event.
   void crush(std::uint32_t i, const Side& A, const Side& B);
+  /// Body i, taken out of its cell list (unlink), leaves the world (crushed or exited): out of
+  /// the queue, predictions made against it stale, a turtle's command ended. Its record stays,
+  /// with cell kNone. (remove_body writes the same steps out: calling this from
+  /// there too changed GCC's inlining of the engine's loop, +0.14 % of the gas's instructions.)
+  void retire(std::uint32_t i);
 
   // The exact clock (exact_clock.hpp).
   /// Inlined into process(), its one caller: robust3's additions to process() made GCC call it
   /// out of line, +1.5 % instructions per event on the uncharged gas (callgrind, docs/performance.md).
   [[gnu::always_inline]] void cross(std::uint32_t i);
-  /// Body i's centre has left an open arena: it is removed, with an `exit` event.
+  /// Body i's centre has left an open arena: it is removed (retire), with an `exit` event.
   void exit(std::uint32_t i);
   double rebase();
 
@@ -461,74 +479,6 @@ void Engine<F, kBallBall, kStep, kExtras>::check_stop() {
 }
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
-void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
-  const Pending p = bodies_.pending[i];
-  const LastPartner before = bodies_.last[i];
-  switch (p.kind) {
-    case Partner::body:
-      if (bodies_.body[p.partner].count != p.partner_count) {
-        ++record_.stats.stale;
-        sync(i);
-        predict(i);
-        schedule(i);
-        return;
-      }
-      if (is_turtle(i) || is_turtle(p.partner)) {
-        // A ball is squeezed against a turtle, a turtle against a turtle; never against a ball.
-        const LastPartner before_partner = bodies_.last[p.partner];
-        const Changed c = apply_turtle_body(parts(), i, p.partner);
-        auto before_of = [&](std::uint32_t k) { return k == i ? before : before_partner; };
-        const bool keep_first = !is_turtle(c.second) || squeezed(c.first, before_of(c.first));
-        const bool keep_second = squeezed(c.second, before_of(c.second));
-        if (keep_first) repredict(c.first);
-        if (keep_second) repredict(c.second);
-      } else {
-        // A ball the squeeze rule holds, pushed into its holders, is as heavy as they are.
-        if (!bodies_.held.empty()) [[unlikely]] {
-          const LastPartner before_partner = bodies_.last[p.partner];
-          if (const std::uint32_t o = push_held(parts(), i, p.partner); o != kNone) {
-            // The pusher met an obstacle of infinite mass: the squeeze rule answers it.
-            const std::uint32_t k = o == i ? p.partner : i;
-            if (squeezed(o, o == i ? before : before_partner)) repredict(o);
-            repredict(k);
-            return;
-          }
-        }
-        served(apply_ball_ball(parts(), i, p.partner));
-      }
-      return;
-    case Partner::wall: {
-      const Changed c = apply_wall(parts(), i, p.partner);
-      if (squeezed(i, before)) served(c);
-      return;
-    }
-    case Partner::end: {
-      const Changed c = apply_end(parts(), i, p.partner);
-      if (squeezed(i, before)) served(c);
-      return;
-    }
-    case Partner::moving_end: {
-      const Changed c = apply_moving_end(parts(), i, p.partner);
-      if (squeezed(i, before)) served(c);
-      return;
-    }
-    case Partner::none: break;
-  }
-  // A body with nothing pending has an infinite key and is never popped.
-  sync(i);
-  predict(i);
-  schedule(i);
-}
-
-template <Flight F, bool kBallBall, bool kStep, bool kExtras>
-bool Engine<F, kBallBall, kStep, kExtras>::squeezed(std::uint32_t i, LastPartner before) {
-  Side A, B;
-  if (squeeze(parts(), i, before, bodies_.last[i], A, B) != Squeeze::crushed) return true;
-  crush(i, A, B);
-  return false;
-}
-
-template <Flight F, bool kBallBall, bool kStep, bool kExtras>
 void Engine<F, kBallBall, kStep, kExtras>::crush(std::uint32_t i, const Side& A, const Side& B) {
   const bool turtle = is_turtle(i);
   const std::uint32_t nb = bodies_.balls();
@@ -536,11 +486,16 @@ void Engine<F, kBallBall, kStep, kExtras>::crush(std::uint32_t i, const Side& A,
                squeeze_flags(turtle, A, B));
   ++record_.stats.crushed;
   unlink(i);
+  retire(i);
+}
+
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::retire(std::uint32_t i) {
   Body& b = bodies_.body[i];
   b.cell = kNone;
   ++b.count;  // predictions made against it are now stale
   heap_.remove(i);
-  if (turtle) turtles_.exit(i - nb, b, bodies_.end[i]);
+  if (is_turtle(i)) turtles_.exit(i - bodies_.balls(), b, bodies_.end[i]);
 }
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
@@ -582,20 +537,8 @@ void Engine<F, kBallBall, kStep, kExtras>::keyframe() {
     Body& b = bodies_.body[i];
     if (b.cell == kNone) continue;
     sync(i);
-    if (is_turtle(i) && turtles_.pushed_by[i - nb] != kNone && schedule_.keyed[turtles_.pushed_by[i - nb]]) {
-      // The push ends with the segment of motion that made it; the turtle stands where it is.
-      // (Another wall's keyframe changes nothing here: the push goes on.)
-      b.v = {};
-      turtles_.pushed_by[i - nb] = kNone;
-      turtles_.pushed_via[i - nb] = kNone;
-      ++b.count;
-    }
-    // "Just collided, cannot meet again" does not survive a change of the wall's velocity.
-    const LastPartner last = bodies_.last[i];
-    if (!last.is_none() && ((last.kind() == Partner::moving_end && schedule_.keyed[last.index() / 2]) ||
-                            (last.kind() == Partner::wall && walls_.mover_of[last.index()] != kNone &&
-                             schedule_.keyed[walls_.mover_of[last.index()]])))
-      bodies_.last[i] = LastPartner::none();
+    if (is_turtle(i)) push_ends(turtles_, i - nb, b, schedule_.keyed);  // contacts/carried.hpp
+    if (keyed_partner(bodies_.last[i], walls_, schedule_)) bodies_.last[i] = LastPartner::none();  // contacts.hpp
     repredict(i);
   }
 }
@@ -657,8 +600,9 @@ void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
 }  // namespace
 }  // namespace turtlegas::sim::detail
 
+#include "contacts/resolve.hpp"
 #include "exact_clock.hpp"
-#include "operations.hpp"
+#include "world_changes.hpp"
 #include "region.hpp"
 #include "step_clock.hpp"
 
@@ -671,7 +615,7 @@ std::unique_ptr<EngineBase> make_variant(const WorldDef& def, std::vector<BallDe
 
 }  // namespace turtlegas::sim::detail
 
-/// The explicit instantiation of one row of the table in factory.cpp (see variant.hpp).
+/// The explicit instantiation of one row of the table in factory.cpp (see variant_seam.hpp).
 #define TURTLEGAS_ENGINE_VARIANT(flight, balls, mode, extras)                                   \
   namespace turtlegas::sim::detail {                                                             \
   template std::unique_ptr<EngineBase> make_variant<flight, variant::balls, variant::mode, variant::extras>( \

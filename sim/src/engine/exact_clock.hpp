@@ -64,11 +64,7 @@ void Engine<F, kBallBall, kStep, kExtras>::exit(std::uint32_t i) {
   const std::uint32_t nb = bodies_.balls();
   record_.note(t_base_ + now_, EventKind::exit, turtle ? i - nb : i, turtle ? 1 : 0);
   ++record_.stats.exits;
-  Body& b = bodies_.body[i];
-  b.cell = kNone;
-  ++b.count;  // predictions made against it are now stale
-  heap_.remove(i);
-  if (turtle) turtles_.exit(i - nb, b, bodies_.end[i]);
+  retire(i);
 }
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>

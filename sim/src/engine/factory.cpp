@@ -11,7 +11,7 @@
 
 #include "engine_base.hpp"
 #include "flights.hpp"
-#include "variant.hpp"
+#include "variant_seam.hpp"
 
 // flight, balls, mode, extras; within a mode the flights in order of cost (the factory takes the
 // first row that serves the scene). Step mode flies straight and kicks between steps, so its rows

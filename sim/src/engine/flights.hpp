@@ -22,6 +22,7 @@
 #include <string_view>
 #include <vector>
 
+#include "contacts/contacts.hpp"
 #include "records.hpp"
 #include "turtlegas/sim/field_toi.hpp"
 #include "turtlegas/sim/toi.hpp"
@@ -297,7 +298,7 @@ class Motion {
 
   const F& flight() const { return flight_; }
   bool is_turtle(std::uint32_t id) const { return kExtras && id >= balls_; }
-  /// A ball spawned at run time takes id balls_ (operations.hpp; flights with per-ball data refuse).
+  /// A ball spawned at run time takes id balls_ (world_changes.hpp; flights with per-ball data refuse).
   void add_ball() { ++balls_; }
   /// Whether body id's motion relative to something that flies straight is a straight line.
   bool straight(std::uint32_t id) const { return is_turtle(id) || flight_.straight(id); }
@@ -323,14 +324,12 @@ class Motion {
   double toi_segment(std::uint32_t id, Vec2 rel, Vec2 v, Vec2 u, const Segment& s, double radius, double t_max) const {
     if (!is_turtle(id)) return flight_.toi_segment(id, rel, v, u, s, radius, t_max);
     // A turtle that has turned to drive along a wall it touches moves along it up to the
-    // round-off of its heading's sine and cosine against the wall's normal (~1e-16 of its speed):
-    // a normal rate below kGrazeRate of its speed is a graze, not an approach (it would stop the
-    // turtle at once). Moving along the wall's line it never meets the interior (its ends are
-    // points of their own); over a drive of 1e4 radii the ignored rate drifts it 1e-9 of a radius.
-    if (std::abs(dot(v, s.n)) <= kGrazeRate * norm(v)) return kNever;
+    // round-off of its heading's sine and cosine against the wall's normal: a graze, not an
+    // approach (it would stop the turtle at once; contacts.hpp, kGrazeRate). Moving along the
+    // wall's line it never meets the interior (its ends are points of their own).
+    if (grazes_line(v, s.n)) return kNever;
     return toi_disc_segment(rel, v, Vec2{}, s, radius);
   }
-  static constexpr double kGrazeRate = 1e-13;
   double toi_deforming_segment(std::uint32_t id, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const {
     return is_turtle(id) ? toi_disc_deforming_segment(rel, v, Vec2{}, d0, w, radius, t_max)
                          : flight_.toi_deforming_segment(id, rel, v, d0, w, radius, t_max);

@@ -16,7 +16,9 @@
 #include <cmath>
 #include <cstdint>
 
-#include "parts.hpp"
+#include "contacts/carried.hpp"
+#include "contacts/contacts.hpp"
+#include "room_views.hpp"
 #include "turtlegas/sim/toi.hpp"
 
 namespace turtlegas::sim::detail {
@@ -28,26 +30,27 @@ struct Changed {
   std::uint32_t second = kNone;
 };
 
+/// The common end of every response: body i changed course (Parts::changed: predictions made
+/// with it are stale) and met `partner` last (the contacts room's LastPartner rule, contacts.hpp).
+template <Flight Fl, bool kStep, bool kExtras>
+[[gnu::always_inline]] inline Changed answered(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner partner) {
+  p.changed(i);
+  p.bodies.last[i] = partner;
+  return {i};
+}
+
+/// The same for two bodies that met each other.
+template <Flight Fl, bool kStep, bool kExtras>
+[[gnu::always_inline]] inline Changed answered(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint32_t j) {
+  p.changed(i);
+  p.changed(j);
+  p.bodies.last[i] = LastPartner::of(Partner::body, j);
+  p.bodies.last[j] = LastPartner::of(Partner::body, i);
+  return {i, j};
+}
+
 // ---------------------------------------------------------------------------------------------
 // Ball-ball
-
-/// Whether two discs whose centres separate by r + w t (in a straight line) only graze: the
-/// closest approach of that line, |r x w| / |w|, is within 1e-14 of the smaller radius `r_min`
-/// of the contact distance sigma. Ignoring a graze overlaps the discs by no more than that (far
-/// below the overlap budget; a pass 1e-13 inside contact still collides: hard_cases_test). The
-/// buckling chain's pairs pass within (1e-13)^2 of it, plus a few ulps of round-off. It is
-/// the wall ends' rule (predict_end) for a disc pair: in a chain of touching discs that slide past
-/// each other (a buckling chain a piston drives into a disc held in a V), each contact answered
-/// at one instant left its neighbours "touching and approaching" by round-off (1e-13 of their
-/// speed), and the chain served those contacts at that instant for ever.
-/// It runs for every winning candidate of a straight pair, so it is squared: (r x w)^2 against
-/// (sigma - 1e-14 r_min)^2 |w|^2, no root and no division (both sides >= 0: the same comparison).
-/// The squares are the ones toi_disc_disc takes, finite for every pair whose time it found
-/// (validate.cpp keeps speed times distance below 1e154).
-inline bool grazes(Vec2 r, Vec2 w, double sigma, double r_min) {
-  const double c = cross(r, w), s = sigma - 1e-14 * r_min, w2 = norm2(w);
-  return c * c >= s * s * w2 && w2 > 0.0;  // (w2 > 0 tested first cost 0.6 % more)
-}
 
 /// Ball i (at its own time, now) and ball j seen through `shift` (a periodic image).
 template <Flight F, bool kExtras>
@@ -62,11 +65,10 @@ template <Flight F, bool kExtras>
   const Vec2 vj = sj.v;
   const double t = l.now + f.toi_balls(i, j, r, bi.v, vj, bi.r + bj.r, p.t_coll - l.now);
   if (t < p.t_coll) {
-    // Checked only for a winner: most candidates miss, and last[j] is a cache miss.
+    // Checked only for a winner: most candidates miss, and last[j] is a cache miss (contacts.hpp).
     if (f.straight_pair(i, j)) {
-      if (l.bodies.last[i] == LastPartner::of(Partner::body, j) && l.bodies.last[j] == LastPartner::of(Partner::body, i))
-        return;
-      if (grazes(r, vj - bi.v, bi.r + bj.r, std::min(bi.r, bj.r))) return;
+      if (just_met_body(l.bodies, true, i, j)) return;  // (skip_body without the marks: push_held)
+      if (grazes_pair(r, vj - bi.v, bi.r + bj.r, std::min(bi.r, bj.r))) return;
     }
     p.take(t, Partner::body, j, bj.count);
   }
@@ -86,13 +88,8 @@ Changed apply_ball_ball(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, std
   respond_disc_disc(a.v, b.v, w.bodies.mass[i], w.bodies.mass[j], F, e);
   if (w.record.impulses) [[unlikely]]
     w.impulse(EventKind::ball_ball, i, j, w.bodies.mass[i] * (a.v - va), -F);
-  ++w.record.stats.ball_ball;
-  w.note(EventKind::ball_ball, i, j);
-  w.changed(i);
-  w.changed(j);
-  w.bodies.last[i] = LastPartner::of(Partner::body, j);
-  w.bodies.last[j] = LastPartner::of(Partner::body, i);
-  return {i, j};
+  w.count(w.record.stats.ball_ball, EventKind::ball_ball, i, j);
+  return answered(w, i, j);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -107,13 +104,8 @@ template <Flight F, bool kExtras>
   const Vec2 rel = bi.x - (bj.x + (l.now - bj.t) * bj.v + shift);
   const Vec2 v = bi.v - bj.v;
   const double t = l.now + l.motion.toi_point(i, rel, v, bj.v, bi.r + bj.r, p.t_coll - l.now);
-  if (t < p.t_coll) {
-    if (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
-        l.bodies.last[j] == LastPartner::of(Partner::body, i))
-      return;
-    if (l.bodies.held_against(i, LastPartner::of(Partner::body, j), t)) return;  // squeeze.hpp
+  if (t < p.t_coll && !skip_body(l.bodies, l.motion.straight(i), i, j, t))
     p.take(t, Partner::body, j, bj.count);
-  }
 }
 
 /// Ball j (which may fall), seen from turtle i.
@@ -127,13 +119,8 @@ template <Flight F, bool kExtras>
   const Vec2 rel = f.pos(j, bj.x, bj.v, dtj) + shift - bi.x;
   const Vec2 v = f.vel(j, bj.v, dtj) - bi.v;
   const double t = l.now + f.toi_point(j, rel, v, bi.v, bi.r + bj.r, p.t_coll - l.now);
-  if (t < p.t_coll) {
-    if (f.straight(j) && l.bodies.last[i] == LastPartner::of(Partner::body, j) &&
-        l.bodies.last[j] == LastPartner::of(Partner::body, i))
-      return;
-    if (l.bodies.held_against(j, LastPartner::of(Partner::body, i), t)) return;  // squeeze.hpp
+  if (t < p.t_coll && !skip_body(l.bodies, f.straight(j), j, i, t))
     p.take(t, Partner::body, j, bj.count);
-  }
 }
 
 template <Flight Fl, bool kStep, bool kExtras>
@@ -157,38 +144,28 @@ Changed apply_turtle_body(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, s
     w.touch(t, EventKind::turtle_ball, o, -n);
     // A turtle a moving wall carries goes on at the wall's speed (it used to stop, be caught by the
     // wall at once and meet the ball again, for ever at one instant).
-    if (Vec2 vc; w.carried(t, vc)) bt.v = vc;
+    if (Vec2 vc; carried(w, t, vc)) bt.v = vc;  // contacts/carried.hpp
     const Vec2 rel = bo.v - bt.v;
     if (dot(rel, n) < 0.0) bo.v = bt.v + w.bounce(o, rel, n);
-    ++w.record.stats.turtle_ball;
-    w.note(EventKind::turtle_ball, t - nb, o);
+    w.count(w.record.stats.turtle_ball, EventKind::turtle_ball, t - nb, o);
   } else {
-    ++w.record.stats.turtle_turtle;
-    w.note(EventKind::turtle_turtle, t - nb, o - nb);
+    w.count(w.record.stats.turtle_turtle, EventKind::turtle_turtle, t - nb, o - nb);
     w.touch(t, EventKind::turtle_turtle, o - nb, -n);
     w.touch(o, EventKind::turtle_turtle, t - nb, n);
     // A carried turtle goes on; one it meets that is not carried is pushed along by it (both have
     // infinite mass) at its normal speed, carried by the same wall through it.
     Vec2 vt, vo;
-    const bool ct = w.carried(t, vt), co = w.carried(o, vo);
+    const bool ct = carried(w, t, vt), co = carried(w, o, vo);
     if (ct) bt.v = vt;
     if (co) bo.v = vo;
     if (ct != co) {
       const std::uint32_t c = ct ? t : o, q = ct ? o : t;
       const Vec2 nq = ct ? n : -n;  // from the carrier to the other
       const double un = dot(ct ? vt : vo, nq);
-      if (un > 0.0) {
-        w.bodies.body[q].v = un * nq;
-        w.turtles.pushed_by[q - nb] = w.turtles.pushed_by[c - nb];
-        w.turtles.pushed_via[q - nb] = c - nb;
-      }
+      if (un > 0.0) carry(w.turtles, q - nb, w.bodies.body[q], un * nq, w.turtles.pushed_by[c - nb], c - nb);
     }
   }
-  w.changed(t);
-  w.changed(o);
-  w.bodies.last[t] = LastPartner::of(Partner::body, o);
-  w.bodies.last[o] = LastPartner::of(Partner::body, t);
-  return {t, o};
+  return answered(w, t, o);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -198,12 +175,13 @@ Changed apply_turtle_body(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, s
 template <Flight F, bool kExtras>
 [[gnu::always_inline]] inline void predict_wall(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t w, Vec2 shift,
                   Pending& p) {
-  if (!l.meets_wall(i, w) || (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::wall, w))) return;
+  // skip() in two halves (contacts.hpp): the wall just met is left out before the search.
+  if (!l.meets_wall(i, w) || just_met(l.bodies, l.motion.straight(i), i, LastPartner::of(Partner::wall, w))) return;
   const Segment& s = l.walls.segments[w];
   // Relative to the wall's first end, so walls far from the origin lose nothing.
   const double t = l.now + l.motion.toi_segment(i, bi.x - (s.p1 + shift), bi.v, Vec2{}, s, bi.r, p.t_coll - l.now);
   if (t < p.t_coll && !(l.bodies.held_against(i, LastPartner::of(Partner::wall, w), t)))
-    p.take(t, Partner::wall, w);  // (a squeeze just answered is not met again at once: squeeze.hpp)
+    p.take(t, Partner::wall, w);
 }
 
 template <Flight Fl, bool kStep, bool kExtras>
@@ -233,8 +211,7 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
   const Vec2 n = d >= 0.0 ? s.n : -s.n;
   p.record.note_contact(a.r - std::abs(d), a.r);
   if (p.is_turtle(i)) {
-    ++p.record.stats.turtle_wall;
-    p.note(EventKind::turtle_wall, i - p.bodies.balls(), w);
+    p.count(p.record.stats.turtle_wall, EventKind::turtle_wall, i - p.bodies.balls(), w);
     p.touch(i, EventKind::turtle_wall, w, n);
     // A moving wall pushing a turtle carries it along at its normal speed (both have infinite
     // mass), until the wall's next keyframe. A turning or stretching wall's push changes along the
@@ -243,12 +220,8 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
     // threshold's speed for its press (at a pivot the normal speed is 0).
     const double un = dot(u, n);
     double knock = !turning ? un : std::max(2.0 * un, -press * p.restitution.tc / 2.0);
-    if (turning && knock > 0.0) knock = std::max(knock, 0x1p-40 * norm(u));  // (round-off: as for a ball, below)
-    if (knock > 0.0) {
-      a.v = knock * n;
-      p.turtles.pushed_by[i - p.bodies.balls()] = mi;
-      p.turtles.pushed_via[i - p.bodies.balls()] = kNone;
-    }
+    if (turning && knock > 0.0) knock = std::max(knock, kDepartFloor * norm(u));  // (round-off: as for a ball, below)
+    if (knock > 0.0) carry(p.turtles, i - p.bodies.balls(), a, knock * n, mi, kNone);  // contacts/carried.hpp
   } else {
     const Vec2 va = a.v;
     a.v = u + p.bounce(i, a.v - u, n, press);
@@ -256,18 +229,15 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
       // A turning line's approach rate (the solver's) and the normal speed of its point at the foot
       // (this response's) agree only to round-off: a ball left at a rate within it (riding the arm
       // at its speed) could be "touching and approaching" again at once, for ever. It leaves at
-      // 2^-40 of its speed at least (1e-12: far below any physics, far above the round-off).
-      const double floor = 0x1p-40 * (norm(a.v) + norm(u)), rn = dot(a.v - u, n);
+      // kDepartFloor of its speed at least (contacts.hpp).
+      const double floor = kDepartFloor * (norm(a.v) + norm(u)), rn = dot(a.v - u, n);
       if (rn < floor) a.v += (floor - rn) * n;
     }
     if (p.record.impulses) [[unlikely]]
       p.impulse(EventKind::ball_wall, i, w, p.bodies.mass[i] * (a.v - va), std::abs(d) * n);
-    ++p.record.stats.ball_wall;
-    p.note(EventKind::ball_wall, i, w);
+    p.count(p.record.stats.ball_wall, EventKind::ball_wall, i, w);
   }
-  p.changed(i);
-  p.bodies.last[i] = LastPartner::of(Partner::wall, w);
-  return {i};
+  return answered(p, i, LastPartner::of(Partner::wall, w));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -276,19 +246,15 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
 template <Flight F, bool kExtras>
 [[gnu::always_inline]] inline void predict_end(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift,
                  Pending& p) {
-  if (!l.meets_end(i, e) || (l.motion.straight(i) && l.bodies.last[i] == LastPartner::of(Partner::end, e))) return;
+  // skip() in two halves (contacts.hpp): the end just met is left out before the search.
+  if (!l.meets_end(i, e) || just_met(l.bodies, l.motion.straight(i), i, LastPartner::of(Partner::end, e))) return;
   const Vec2 rel = bi.x - (l.walls.ends[e].p + shift);
   const double t = l.now + l.motion.toi_point(i, rel, bi.v, Vec2{}, bi.r, p.t_coll - l.now);
   if (t < p.t_coll && !(l.bodies.held_against(i, LastPartner::of(Partner::end, e), t))) {
     // A straight path that passes an end at the contact distance (a disc sliding along a wall
-    // past the joint with the next one) "touches and approaches" it by round-off only. If its
-    // closest approach |rel x v| / |v| is within 1e-10 of a radius of contact, ignoring it can
-    // overlap the end by no more than that: a graze, not a contact (its response would turn the
-    // velocity by round-off, and a squeeze between two such joints could repeat without end).
-    if (l.motion.straight(i)) {
-      const double speed = norm(bi.v);
-      if (speed > 0.0 && std::abs(cross(rel, bi.v)) / speed >= bi.r * (1.0 - 1e-10)) return;
-    }
+    // past the joint with the next one) "touches and approaches" it by round-off only: a graze
+    // (contacts.hpp, kEndGraze).
+    if (l.motion.straight(i) && grazes_end(rel, bi.v, bi.r)) return;
     p.take(t, Partner::end, e);
   }
 }
@@ -302,19 +268,15 @@ Changed apply_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint
   const double dist = norm(F);
   p.record.note_contact(a.r - dist, a.r);
   if (p.is_turtle(i)) {
-    ++p.record.stats.turtle_wall_end;
-    p.note(EventKind::turtle_wall_end, i - p.bodies.balls(), end.wall);
+    p.count(p.record.stats.turtle_wall_end, EventKind::turtle_wall_end, i - p.bodies.balls(), end.wall);
     p.touch(i, EventKind::turtle_wall_end, end.wall, F / dist);
   } else {
     const Vec2 va = a.v;
     a.v = p.bounce(i, a.v, F / dist);
     if (p.record.impulses) [[unlikely]] p.impulse(EventKind::ball_wall_end, i, end.wall, p.bodies.mass[i] * (a.v - va), F);
-    ++p.record.stats.ball_wall_end;
-    p.note(EventKind::ball_wall_end, i, end.wall);
+    p.count(p.record.stats.ball_wall_end, EventKind::ball_wall_end, i, end.wall);
   }
-  p.changed(i);
-  p.bodies.last[i] = LastPartner::of(Partner::end, e);
-  return {i};
+  return answered(p, i, LastPartner::of(Partner::end, e));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -332,27 +294,28 @@ template <Flight F, bool kExtras>
   const Vec2 p1 = m.p1_at(l.now);
   const Vec2 v = bi.v - m.u;
   const double horizon = std::min(p.t_coll, l.schedule.next_key);
-  const LastPartner last = l.bodies.last[i];
+  const bool straight = l.motion.straight(i);
+  // Relative to a turning or stretching wall no motion is straight: no straight-line argument
+  // rules out meeting the same wall again.
+  const bool straight_to_wall = straight && m.rigid();
+  const LastPartner wall = LastPartner::of(Partner::wall, w);
   double t_wall = kNever;
   if (!m.rigid()) {
-    // Turning or stretching: no straight-line argument rules out meeting the same wall again.
     t_wall = l.now + l.motion.toi_deforming_segment(i, bi.x - p1, v, m.d_at(l.now), m.w, bi.r, horizon - l.now);
-  } else if (!(l.motion.straight(i) && last == LastPartner::of(Partner::wall, w))) {
+  } else if (!just_met(l.bodies, straight_to_wall, i, wall)) {  // (before the search)
     t_wall = l.now + l.motion.toi_segment(i, bi.x - p1, v, m.u, s, bi.r, horizon - l.now);
   }
-  if (t_wall < p.t_coll && t_wall <= horizon &&
-      !(l.bodies.held_against(i, LastPartner::of(Partner::wall, w), t_wall)))
+  if (t_wall < p.t_coll && t_wall <= horizon && !l.bodies.held_against(i, wall, t_wall))
     p.take(t_wall, Partner::wall, w);
   for (std::uint32_t which = 0; which < 2; ++which) {
     const std::uint32_t code = 2 * mi + which;
-    if (l.motion.straight(i) && last == LastPartner::of(Partner::moving_end, code)) continue;
+    const LastPartner end = LastPartner::of(Partner::moving_end, code);
+    if (just_met(l.bodies, straight, i, end)) continue;  // (before the search)
     // Each end moves in a straight line, so its contacts have the closed forms of a fixed point.
     const Vec2 e = m.end_at(s, which == 1, l.now);
     const Vec2 ve = which == 0 ? v : v - m.w;  // the body's velocity relative to that end
     const double t = l.now + l.motion.toi_point(i, bi.x - e, ve, which == 0 ? m.u : m.u + m.w, bi.r, horizon - l.now);
-    if (t < p.t_coll && t <= horizon &&
-        !(l.bodies.held_against(i, LastPartner::of(Partner::moving_end, code), t)))
-      p.take(t, Partner::moving_end, code);
+    if (t < p.t_coll && t <= horizon && !l.bodies.held_against(i, end, t)) p.take(t, Partner::moving_end, code);
   }
 }
 
@@ -368,19 +331,15 @@ Changed apply_moving_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, st
   const double dist = norm(F);
   p.record.note_contact(a.r - dist, a.r);
   if (p.is_turtle(i)) {
-    ++p.record.stats.turtle_wall_end;
-    p.note(EventKind::turtle_wall_end, i - p.bodies.balls(), m.wall);
+    p.count(p.record.stats.turtle_wall_end, EventKind::turtle_wall_end, i - p.bodies.balls(), m.wall);
     p.touch(i, EventKind::turtle_wall_end, m.wall, F / dist);
   } else {
     const Vec2 va = a.v;
     a.v = ue + p.bounce(i, a.v - ue, F / dist);
     if (p.record.impulses) [[unlikely]] p.impulse(EventKind::ball_wall_end, i, m.wall, p.bodies.mass[i] * (a.v - va), F);
-    ++p.record.stats.ball_wall_end;
-    p.note(EventKind::ball_wall_end, i, m.wall);
+    p.count(p.record.stats.ball_wall_end, EventKind::ball_wall_end, i, m.wall);
   }
-  p.changed(i);
-  p.bodies.last[i] = LastPartner::of(Partner::moving_end, code);
-  return {i};
+  return answered(p, i, LastPartner::of(Partner::moving_end, code));
 }
 
 }  // namespace

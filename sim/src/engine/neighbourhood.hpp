@@ -24,7 +24,7 @@
 #include "../cell_grid.hpp"
 #include "turtlegas/sim/format.hpp"
 #include "interactions.hpp"
-#include "parts.hpp"
+#include "room_views.hpp"
 
 namespace turtlegas::sim::detail {
 namespace {

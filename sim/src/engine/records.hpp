@@ -38,8 +38,8 @@ enum class Partner : std::uint8_t { none, body, wall, end, moving_end };
 /// Who a body collided with last: a partner's kind and index packed in 32 bits (they fit in the
 /// padding of Pending). With straight relative motion a pair that has just collided cannot meet
 /// again before one of them has another event, so the prediction skips it rather than trusting
-/// the sign of a round-off-sized approach speed (whether the motion is straight is the flight's
-/// call: flights.hpp).
+/// the sign of a round-off-sized approach speed (the contacts room's rule: contacts/contacts.hpp,
+/// just_met and skip; whether the motion is straight is the flight's call: flights.hpp).
 class LastPartner {
  public:
   /// The index takes the low 29 bits, the kind the top 3. validate() keeps every index a scene

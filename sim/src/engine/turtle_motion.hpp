@@ -70,7 +70,7 @@ class Turtles {
   /// until the next control step), and the contact waits for its touch sensors.
   void touch(std::size_t k, Body& b, double& end, double now, double t_base, double dt, EventKind kind,
              std::uint32_t other, Vec2 normal);
-  /// A turtle joins at run time (operations.hpp): standing still, no command.
+  /// A turtle joins at run time (world_changes.hpp): standing still, no command.
   void add(const TurtleDef& d);
   /// Turtle k is set down (a teleport, at `now`) with `heading`, standing still: the command it
   /// was running ends there, not touched, its `done` what it had done by then.
@@ -90,7 +90,8 @@ class Turtles {
   /// Per turtle: the mover (WallSchedule::movers) pushing it, or kNone.
   std::vector<std::uint32_t> pushed_by;
   /// Per turtle pushed: the turtle through which that mover pushes it (a carried turtle pushing
-  /// another along), or kNone (the mover's wall itself). Parts::carried reads both.
+  /// another along), or kNone (the mover's wall itself). The contacts room sets and reads both
+  /// (contacts/carried.hpp).
   std::vector<std::uint32_t> pushed_via;
 
  private:

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The squeeze rule: the one answer for every body caught between two obstacles of infinite mass
+// The squeeze rule (the contacts room, contacts.hpp): the one answer for every body caught between two obstacles of infinite mass
 // (walls, wall ends, moving walls and their ends, and turtles). docs/physics.md, "Wedged and
 // crushed bodies", states it and proves its criteria; in short, at a contact of body i with
 // obstacle B, whose previous contact was with obstacle A on the other side (n_A . n_B < 0):
-//   1. held: if its free room towards A is within kHeldGap of a radius, it touches both. Its
+//   1. held: if its free room towards A is within touch_gap (contacts.hpp), it touches both. Its
 //      velocity becomes the nearest one that leaves both (the velocity of a perfectly inelastic
 //      contact with both at once); if none exists (A and B parallel and closing), it is crushed.
 //   2. certain crush: if A and B are parallel wall interiors (or a wall's interior and a wall end
@@ -26,19 +26,17 @@
 #include <cmath>
 #include <cstdint>
 
-#include "contacts/fold.hpp"
-#include "parts.hpp"
+#include "../room_views.hpp"
+#include "carried.hpp"
+#include "contacts.hpp"
+#include "fold.hpp"
 
 namespace turtlegas::sim::detail {
 namespace {
 
-/// Free room (distance beyond contact) up to which a body counts as touching an obstacle: the
-/// engine's overlap budget, 1e-9 of a radius, plus the round-off of positions far from the origin.
-inline double held_gap(const Body& b) { return 1e-9 * b.r + 0x1p-46 * (std::abs(b.x.x) + std::abs(b.x.y)); }
-
 /// Normals whose cross product is below this are parallel: over one radius the two obstacles'
 /// separation then changes by less than the overlap budget, 1e-9 of a radius.
-inline constexpr double kParallel = 1e-9;
+inline constexpr double kParallel = kOverlapBudget;
 
 /// An obstacle as body i sees it now.
 struct Side {
@@ -75,7 +73,7 @@ bool still_held(const Parts<Fl, kStep, kExtras>& p, std::uint32_t k, int depth =
   if (depth > 0) return true;
   p.sync(k);
   const Side A = side_of(p, k, h.a, depth + 1), B = side_of(p, k, h.b, depth + 1);
-  return A.ok && B.ok && A.gap <= held_gap(bs.body[k]) && B.gap <= held_gap(bs.body[k]);
+  return A.ok && B.ok && A.gap <= touch_gap(bs.body[k]) && B.gap <= touch_gap(bs.body[k]);
 }
 
 template <Flight Fl, bool kStep, bool kExtras>
@@ -97,9 +95,9 @@ Side side_of(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner wh
       s.n = F / dist;
       // Turtles stop when they touch: a turtle driving onto the body stops at its contact with it,
       // so its own motion never closes a squeeze (it counts as standing); one that a moving wall
-      // carries goes on (Parts::carried) and closes it at the wall's speed.
+      // carries goes on (carried.hpp) and closes it at the wall's speed.
       s.u = t.v;
-      if (Vec2 vc; p.carried(k, vc)) s.u = vc;
+      if (Vec2 vc; carried(p, k, vc)) s.u = vc;
       else if (dot(t.v, F) > 0.0) s.u = {};
       s.gap = dist - a.r - t.r;
       s.turtle = p.is_turtle(k);
@@ -180,7 +178,7 @@ Side third_side(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
   for (const LastPartner c : {h.a, h.b}) {
     if (c.is_none() || c == a || c == b) continue;
     const Side C = side_of(p, i, c);
-    if (C.ok && C.gap <= held_gap(p.bodies.body[i])) return C;
+    if (C.ok && C.gap <= touch_gap(p.bodies.body[i])) return C;
   }
   return {};
 }
@@ -309,10 +307,10 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
   // How fast the two close on the body along the squeeze (parallel obstacles only).
   // (Beyond the round-off of those products: a wall sliding along itself does not close.)
   const double closing = dot(A.u, A.n) + dot(B.u, B.n);
-  const bool closes = closing > 0x1p-40 * (norm(A.u) + norm(B.u));
+  const bool closes = closing > kDepartFloor * (norm(A.u) + norm(B.u));
   Vec2 v = v0;
   bool held = true;
-  if (A.gap <= held_gap(body)) {
+  if (A.gap <= touch_gap(body)) {
     // 1. Held between A and B, and a third obstacle it was held by before, if it still touches
     // that one too (a disc jammed between a wall, a held disc and a piston).
     if (p.motion.straight(i)) {
@@ -340,7 +338,7 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
         p.sync(k);
         const Body& o = p.bodies.body[k];
         const double gap = norm(p.arena.min_image(body.x - o.x)) - body.r - o.r;
-        if (gap <= held_gap(body) + held_gap(o)) return true;
+        if (gap <= touch_gap(body) + touch_gap(o)) return true;
       }
       return false;
     };
@@ -394,7 +392,7 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
           const bool on_a = wa >= wb;
           const Side& pressed = on_a ? A : B;
           const double hop = on_a ? wa : wb;  // = |a_n| tc / 2
-          const double capped = std::min(hop, std::sqrt(2.0 * hop / p.restitution.tc * body.r * 1e-9));
+          const double capped = std::min(hop, std::sqrt(2.0 * hop / p.restitution.tc * body.r * kOverlapBudget));
           v += (dot(pressed.u, pressed.n) + capped - dot(v, pressed.n)) * pressed.n;
           if (p.restitution.e == 1.0) {
             // Elastic: keep the speed relative to the pressed obstacle, as Restitution::bounce does
@@ -499,8 +497,7 @@ template <Flight Fl, bool kStep, bool kExtras>
   o.v = bk.v + p.bounce(other, o.v - bk.v, n);  // as off a wall: the plain restitution
   if (p.record.impulses) [[unlikely]]
     p.impulse(EventKind::ball_ball, other, k, p.bodies.mass[other] * (o.v - va), -F);
-  ++p.record.stats.ball_ball;
-  p.note(EventKind::ball_ball, i, j);
+  p.count(p.record.stats.ball_ball, EventKind::ball_ball, i, j);
   p.changed(other);
   p.bodies.last[other] = LastPartner::of(Partner::body, k);
   return other;

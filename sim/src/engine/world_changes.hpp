@@ -162,7 +162,7 @@ void Engine<F, kBallBall, kStep, kExtras>::remove_body(bool turtle, std::size_t 
     throw std::invalid_argument(std::string(turtle ? "turtle" : "ball") + " #" + std::to_string(k) +
                                 " has left the world already");
   sync(i);
-  unlink(i);
+  unlink(i);  // (retire()'s steps: see there why they are written out here)
   b.cell = kNone;
   ++b.count;  // predictions made against it are now stale
   heap_.remove(i);
