@@ -326,6 +326,18 @@ std::optional<DefProblem> check_ids(const WorldDef& def) {
   return std::nullopt;
 }
 
+/// Calls visit(centre, item) for every item of `grid` near each of a disc's images (`count`
+/// centres in img, radius r: the disc and, in a periodic arena, its copies across the edges it
+/// crosses), the images in order; stops as soon as visit returns true, and says whether it did.
+template <class Grid, class Visit>
+bool for_each_image_hit(const Grid& grid, const std::array<Vec2, 4>& img, int count, double r, const Visit& visit) {
+  for (int m = 0; m < count; ++m) {
+    const Vec2 p = img[m];
+    if (grid.any(grid.cover_disc(p, r), [&](std::uint32_t item) { return visit(p, item); })) return true;
+  }
+  return false;
+}
+
 /// Disc-disc and disc-wall overlaps, with one grid over the arena grown by the largest radius (so
 /// every disc lies inside it). Walls are entered in every cell their segment crosses, discs in
 /// every cell their bounding box covers; a pair that overlaps then shares at least one cell. In a
@@ -387,27 +399,25 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
       const int m_count = images(k, img);
       const double r = d.radius(k);
       std::optional<std::size_t> hit;
-      for (int m = 0; m < m_count && !hit; ++m) {
-        const Vec2 p = img[m];
-        grid.any(grid.cover_disc(p, r), [&](std::uint32_t item) {
-          const std::size_t j = item / 4;
-          if (!balls_collide && d.is_ball(j) && d.is_ball(k)) return false;
-          if (!d.layers(j).collides_with(d.layers(k))) return false;
-          Vec2 q = d.pos(j);
-          if (item % 4 != 0) {
-            images(j, other);
-            q = other[item % 4];
-          }
-          const double s = r + d.radius(j);
-          if (norm2(p - q) < s * s) hit = j;
-          return hit.has_value();
-        });
-      }
-      if (hit)
+      for_each_image_hit(grid, img, m_count, r, [&](Vec2 p, std::uint32_t item) {
+        const std::size_t j = item / 4;
+        if (!balls_collide && d.is_ball(j) && d.is_ball(k)) return false;
+        if (!d.layers(j).collides_with(d.layers(k))) return false;
+        Vec2 q = d.pos(j);
+        if (item % 4 != 0) {
+          images(j, other);
+          q = other[item % 4];
+        }
+        const double s = r + d.radius(j);
+        if (norm2(p - q) < s * s) hit = j;
+        return hit.has_value();
+      });
+      if (hit) {
+        const std::size_t j = *hit;
         return d.problem(k, "pos",
-                         d.name(k) + " at " + vec(d.pos(k)) + " overlaps " + d.name(*hit) + " at " + vec(d.pos(*hit)) +
-                             " (radii " + num(r) + " + " + num(d.radius(*hit)) +
-                             "); move them apart or make them smaller");
+                         d.name(k) + " at " + vec(d.pos(k)) + " overlaps " + d.name(j) + " at " + vec(d.pos(j)) +
+                             " (radii " + num(r) + " + " + num(d.radius(j)) + "); move them apart or make them smaller");
+      }
       for (int m = 0; m < m_count; ++m)
         grid.insert(grid.cover_disc(img[m], r), static_cast<std::uint32_t>(k * 4 + static_cast<std::size_t>(m)));
     }
@@ -422,15 +432,12 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
     const int m_count = images(k, img);
     const double r = d.radius(k);
     std::optional<std::size_t> hit;
-    for (int m = 0; m < m_count && !hit; ++m) {
-      const Vec2 p = img[m];
-      walls_grid.any(walls_grid.cover_disc(p, r), [&](std::uint32_t w) {
-        const WallDef& wall = def.walls[w];
-        if (!wall.layers.collides_with(d.layers(k))) return false;
-        if (segment_distance2(p, wall.from, wall.to) < r * r) hit = w;
-        return hit.has_value();
-      });
-    }
+    for_each_image_hit(walls_grid, img, m_count, r, [&](Vec2 p, std::uint32_t w) {
+      const WallDef& wall = def.walls[w];
+      if (!wall.layers.collides_with(d.layers(k))) return false;
+      if (segment_distance2(p, wall.from, wall.to) < r * r) hit = w;
+      return hit.has_value();
+    });
     if (hit) {
       const WallDef& wall = def.walls[*hit];
       return d.problem(k, "pos",

@@ -17,6 +17,7 @@
 #include "scenes.hpp"
 #include "turtlegas/sim/field_flight.hpp"
 #include "turtlegas/sim/field_toi.hpp"
+#include "turtlegas/sim/reference.hpp"
 #include "turtlegas/sim/world.hpp"
 
 using namespace turtlegas::sim;
@@ -550,78 +551,8 @@ struct RefRun {
 };
 
 RefRun field_reference(const WorldDef& def, double t_end) {
-  std::vector<WallDef> wall_defs = def.walls;
-  if (def.arena.boundary == Boundary::walls)
-    for (auto& w : arena_walls(def.arena)) wall_defs.push_back(w);
-  std::vector<Segment> walls;
-  walls.reserve(wall_defs.size());
-  for (const auto& w : wall_defs) walls.push_back(make_segment(w.from, w.to));
-  struct End {
-    Vec2 p;
-    std::uint32_t wall;
-  };
-  std::vector<End> ends;
-  for (std::uint32_t w = 0; w < wall_defs.size(); ++w)
-    for (Vec2 p : {wall_defs[w].from, wall_defs[w].to}) {
-      bool seen = false;
-      for (const End& e : ends) seen = seen || e.p == p;
-      if (!seen) ends.push_back({p, w});
-    }
-  const std::size_t n = def.balls.size();
-  const EffectsDef& fx = def.effects;
-  std::vector<FieldFlight> f(n);
-  std::vector<Vec2> x(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const BallDef& b = def.balls[i];
-    const double qm = b.charge / b.mass;
-    f[i] = {b.vel, fx.gravity + qm * fx.electric, qm * fx.magnetic};
-    x[i] = b.pos;
-  }
   RefRun out;
-  double now = 0.0;
-  for (;;) {
-    double best = t_end - now;
-    int kind = 0;
-    std::size_t bi = 0, bj = 0;
-    auto offer = [&](double dt, int k, std::size_t i, std::size_t j) {
-      if (dt < best) {
-        best = dt;
-        kind = k;
-        bi = i;
-        bj = j;
-      }
-    };
-    for (std::size_t i = 0; i < n; ++i) {
-      const double r = def.balls[i].radius;
-      for (std::size_t j = i + 1; j < n; ++j)
-        offer(toi_field_disc_disc(x[j] - x[i], f[i], f[j], r + def.balls[j].radius, best), 1, i, j);
-      for (std::size_t w = 0; w < walls.size(); ++w)
-        offer(toi_field_disc_segment(x[i] - walls[w].p1, f[i], walls[w], r, best), 2, i, w);
-      for (std::size_t k = 0; k < ends.size(); ++k) offer(toi_field_disc_point(x[i] - ends[k].p, f[i], r, best), 3, i, k);
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      const FieldState s = field_advance(x[i], f[i], best);
-      x[i] = s.x;
-      f[i].v = s.v;
-    }
-    now += best;
-    if (kind == 0) break;
-    if (kind == 1) {
-      respond_disc_disc(f[bi].v, f[bj].v, def.balls[bi].mass, def.balls[bj].mass, x[bj] - x[bi], 1.0);
-      out.events.push_back({now, EventKind::ball_ball, static_cast<std::uint32_t>(bi), static_cast<std::uint32_t>(bj)});
-    } else if (kind == 2) {
-      const Segment& s = walls[bj];
-      const Vec2 nrm = dot(x[bi] - s.p1, s.n) >= 0.0 ? s.n : -s.n;
-      f[bi].v -= 2.0 * dot(f[bi].v, nrm) * nrm;
-      out.events.push_back({now, EventKind::ball_wall, static_cast<std::uint32_t>(bi), static_cast<std::uint32_t>(bj)});
-    } else {
-      const Vec2 F = x[bi] - ends[bj].p;
-      const Vec2 nrm = F / norm(F);
-      f[bi].v -= 2.0 * dot(f[bi].v, nrm) * nrm;
-      out.events.push_back({now, EventKind::ball_wall_end, static_cast<std::uint32_t>(bi), ends[bj].wall});
-    }
-  }
-  for (std::size_t i = 0; i < n; ++i) out.final.push_back({x[i], f[i].v, true});
+  out.events = reference::field_events(def, t_end, &out.final);
   return out;
 }
 
