@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "disc_grid.hpp"
 #include "turtlegas/sim/cover_grid.hpp"
 #include "turtlegas/sim/format.hpp"
 #include "turtlegas/sim/world_def.hpp"
@@ -338,10 +339,12 @@ bool for_each_image_hit(const Grid& grid, const std::array<Vec2, 4>& img, int co
   return false;
 }
 
-/// Disc-disc and disc-wall overlaps, with one grid over the arena grown by the largest radius (so
-/// every disc lies inside it). Walls are entered in every cell their segment crosses, discs in
-/// every cell their bounding box covers; a pair that overlaps then shares at least one cell. In a
-/// periodic arena a disc that crosses an edge is also entered (and tested) at its shifted images.
+/// Disc-disc and disc-wall overlaps. Disc pairs in hashed cells sized by the radii (DiscGrid:
+/// where the discs are, however large the arena); discs against walls with one grid over the arena
+/// grown by the largest radius (so every disc lies inside it), walls entered in every cell their
+/// segment crosses, discs looking in every cell their bounding box covers. A pair that overlaps
+/// shares at least one cell. In a periodic arena a disc that crosses an edge is also entered (and
+/// tested) at its shifted images.
 /// Two balls may overlap when ball-ball collisions are off, and any two objects whose collision
 /// layers do not meet may overlap (they pass through each other).
 std::optional<DefProblem> check_overlaps(const WorldDef& def) {
@@ -387,20 +390,29 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
 
   const bool balls_collide = def.effects.ball_ball;
   if (balls_collide || !def.turtles.empty()) {
-    CoverGrid grid(lo, hi, side, max_cells);
+    // The discs' own cells, hashed (disc_grid.hpp), not a grid over the arena: 1e5 discs clustered
+    // in a 1e9 arena shared one cell of an arena grid, and their check was O(N^2).
+    DiscGrid grid(side);
     // Items are disc * 4 + image, so a periodic pair is caught from whichever side crosses the edge.
     std::array<Vec2, 4> img{}, other{};
-    // Room for every entry first: a list grown by doubling would briefly hold three times as many.
     std::size_t entries = 0;
-    for (std::size_t k = 0; k < n; ++k)
-      for (int m = 0, m_count = images(k, img); m < m_count; ++m) entries += grid.cover_disc(img[m], d.radius(k)).cells();
+    for (std::size_t k = 0; k < n; ++k) entries += 4 * static_cast<std::size_t>(images(k, img));
     grid.reserve(entries);
-    for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t k = 0; k < n; ++k)
+      for (int m = 0, m_count = images(k, img); m < m_count; ++m)
+        grid.add(img[m], d.radius(k), static_cast<std::uint32_t>(k * 4 + static_cast<std::size_t>(m)));
+    grid.build();
+    // The pair reported is the one whose later disc comes first, with its earliest partner, as
+    // when each disc was checked against those before it. A pair is seen from the disc at the
+    // lower level of the grid (or from both), so once disc k is done every pair whose later disc
+    // is at most k has been seen.
+    std::optional<std::pair<std::size_t, std::size_t>> first;  // (later, earlier)
+    for (std::size_t k = 0; k < n && !(first && first->first < k); ++k) {
       const int m_count = images(k, img);
       const double r = d.radius(k);
-      std::optional<std::size_t> hit;
       for_each_image_hit(grid, img, m_count, r, [&](Vec2 p, std::uint32_t item) {
         const std::size_t j = item / 4;
+        if (j == k) return false;
         if (!balls_collide && d.is_ball(j) && d.is_ball(k)) return false;
         if (!d.layers(j).collides_with(d.layers(k))) return false;
         Vec2 q = d.pos(j);
@@ -409,17 +421,18 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
           q = other[item % 4];
         }
         const double s = r + d.radius(j);
-        if (norm2(p - q) < s * s) hit = j;
-        return hit.has_value();
+        if (!(norm2(p - q) < s * s)) return false;
+        const std::pair<std::size_t, std::size_t> pair{std::max(j, k), std::min(j, k)};
+        if (!first || pair < *first) first = pair;
+        return false;
       });
-      if (hit) {
-        const std::size_t j = *hit;
-        return d.problem(k, "pos",
-                         d.name(k) + " at " + vec(d.pos(k)) + " overlaps " + d.name(j) + " at " + vec(d.pos(j)) +
-                             " (radii " + num(r) + " + " + num(d.radius(j)) + "); move them apart or make them smaller");
-      }
-      for (int m = 0; m < m_count; ++m)
-        grid.insert(grid.cover_disc(img[m], r), static_cast<std::uint32_t>(k * 4 + static_cast<std::size_t>(m)));
+    }
+    if (first) {
+      const auto [k, j] = *first;
+      return d.problem(k, "pos",
+                       d.name(k) + " at " + vec(d.pos(k)) + " overlaps " + d.name(j) + " at " + vec(d.pos(j)) +
+                           " (radii " + num(d.radius(k)) + " + " + num(d.radius(j)) +
+                           "); move them apart or make them smaller");
     }
   }
 
