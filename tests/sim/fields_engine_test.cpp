@@ -916,3 +916,29 @@ TEST_CASE("held-out-oracle scenes, long-double oracle: events and final state to
   for (const OracleScene& s : held_out_scenes())
     DYNAMIC_SECTION(s.name) { compare_with_oracle(s.def, s.until, s.min_events); }
 }
+
+TEST_CASE("an ion whose circle is tangent to a cell border crosses it a few times a turn, not hundreds",
+          "[.][fields][engine][crossings]") {
+  // Found while testing estimate_work (hidden until it passes): an ion at (50, 50) moving along x,
+  // 800 turns a second (radius 0.006), with cells of 50: its guiding centre sits on x = 50, so the
+  // circle crosses that border twice a turn, and the circle is tangent to y = 50 where it starts.
+  // Measured: 196,639 cell crossings in the first second, ~245 a turn; moved by half its radius
+  // (crossing both borders cleanly), 3,199, four a turn.
+  WorldDef d = box(100, 100);
+  d.arena.cell = 50.0;
+  d.effects.magnetic = 0.5;
+  d.balls.push_back(charged("ion", {50, 50}, {30, 0}, 1.0, 1.0, 4.0 * M_PI * 800.0));
+  auto crossings = [](const WorldDef& def) {
+    World w(def, Mode::exact);
+    w.set_event_limit(1000000);
+    w.advance_to(1.0);
+    return w.stats().cell_crossings;
+  };
+  d.balls[0].pos.y = 50.003;  // the same circle moved by half its radius: no longer tangent to y = 50
+  const std::uint64_t off = crossings(d);
+  d.balls[0].pos.y = 50.0;
+  const std::uint64_t tangent = crossings(d);
+  INFO("crossings: tangent " << tangent << ", half a radius off " << off);
+  CHECK(off <= 8 * 800);
+  CHECK(tangent <= 8 * 800);
+}
