@@ -16,28 +16,13 @@
 
 #include "bench_common.hpp"
 #include "turtlegas/sim/field_toi.hpp"
+#include "turtlegas/sim/seeded_rng.hpp"
 
 using namespace turtlegas::sim;
 
 namespace {
 
-struct Rng {
-  std::mt19937_64 gen;
-  explicit Rng(std::uint64_t seed) : gen(seed) {}
-  double uniform(double lo, double hi) { return lo + (hi - lo) * static_cast<double>(gen() >> 11) * 0x1.0p-53; }
-  double log_uniform(double lo, double hi) { return std::exp(uniform(std::log(lo), std::log(hi))); }
-  double sign() { return (gen() & 1) ? 1.0 : -1.0; }
-  Vec2 direction() {
-    const double phi = uniform(0.0, 6.283185307179586);
-    return {std::cos(phi), std::sin(phi)};
-  }
-  /// magnitude() * direction(), the direction drawn first (tests/sim/field_oracle.hpp says why).
-  template <class Magnitude>
-  Vec2 direction_then(Magnitude magnitude) {
-    const Vec2 d = direction();
-    return magnitude() * d;
-  }
-};
+using Rng = SeededRng;  // the field tests' generator (tests/sim/field_oracle.hpp)
 
 double random_w(Rng& rng) { return rng.sign() * rng.log_uniform(1e-6, 1e6) * rng.log_uniform(1e-8, 1e6); }
 

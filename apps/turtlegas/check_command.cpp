@@ -37,7 +37,7 @@ int check_one(const std::string& file, const turtle::Registry& registry) {
   }
   std::printf("%s: ok: \"%s\", %s, arena %s x %s (boundary %s), cell %s (%d x %d), dt %s s\n", file.c_str(),
               def.name.c_str(), count_summary(def, def.balls.size()).c_str(), fmt(def.arena.width).c_str(),
-              fmt(def.arena.height).c_str(), boundary_name(def.arena.boundary), fmt(cell_size).c_str(), cells_x, cells_y,
+              fmt(def.arena.height).c_str(), sim::to_string(def.arena.boundary).data(), fmt(cell_size).c_str(), cells_x, cells_y,
               fmt(def.dt).c_str());
   for (const std::string& w : warnings) spdlog::warn("{}: {}", file, w);
   if (!def.turtles.empty()) {

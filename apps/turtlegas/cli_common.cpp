@@ -118,15 +118,6 @@ std::string count_summary(const sim::WorldDef& def, std::size_t balls) {
   return s;
 }
 
-const char* boundary_name(sim::Boundary b) {
-  switch (b) {
-    case sim::Boundary::none: return "none";
-    case sim::Boundary::walls: return "walls";
-    case sim::Boundary::periodic: return "periodic";
-  }
-  return "?";
-}
-
 std::string fmt(double v) {
   std::array<char, 32> buf{};
   std::snprintf(buf.data(), buf.size(), "%.6g", v);

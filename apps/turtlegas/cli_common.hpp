@@ -74,8 +74,6 @@ CLI::Option* add_program_budget_option(CLI::App& cmd, double& seconds, const std
 
 /// "3 balls, 1 wall (+4 arena walls), 2 turtles".
 std::string count_summary(const sim::WorldDef& def, std::size_t balls);
-/// "none", "walls" or "periodic".
-const char* boundary_name(sim::Boundary b);
 /// Six significant digits, for summaries.
 std::string fmt(double v);
 /// "wander x3, script": each controller the scene uses and how many turtles run it, in file order.

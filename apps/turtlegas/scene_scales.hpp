@@ -1,40 +1,32 @@
 // SPDX-License-Identifier: MIT
-// How much work a scene predicts per simulated second, from its scales alone (speeds, fields,
-// the cell, the step): for `check`'s warnings about runs that would never finish, and for the
-// size of a run's first chunk (so that a runaway scene still shows progress and obeys its limits).
+// What a scene's scales predict (sim::estimate_work, the one cost model), in words: for `check`'s
+// warnings about runs that would never finish, `run`'s, `render`'s and `tag`'s, and for the size of
+// a run's first chunk (so that a runaway scene still shows progress and obeys its limits).
 #pragma once
 
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "turtlegas/sim/estimate.hpp"
 #include "turtlegas/sim/world_def.hpp"
 
 namespace turtlegas::apps {
 
-/// Order-of-magnitude predictions, meant to catch absurd scenes (a speed of 1e150, a dt of
-/// 1e-300), not to time ordinary ones: each is an upper estimate of the steady rate.
+/// sim::estimate_work's figures for a scene, in words. Order-of-magnitude predictions, meant to
+/// catch absurd scenes (a speed of 1e150, a dt of 1e-300), not to time ordinary ones.
 struct SceneScales {
-  /// Events (collisions and cell crossings) per simulated second: for every ball, twice the
-  /// fastest speed it can reach (its speed plus what the fields can give it across the arena,
-  /// sqrt(2 a L)) over the cell side; for every turtle its speed over the cell side. Set by
-  /// set_cell() from the sums below.
+  /// Events per simulated second (WorkEstimate::events_per_s: cell crossings and magnetic
+  /// re-plans), 0 until set_cell() gives the cell.
   double events_per_second = 0.0;
   std::string events_why;  ///< the body that dominates, in numbers
   /// Steps per simulated second: step mode's steps, and the turtles' control steps (1/dt each).
   double steps_per_second = 0.0;
   std::string steps_why;
 
-  double speed_sum = 0.0;     ///< units/s: twice each ball's speed bound, plus each turtle's
-  double fastest = 0.0;       ///< units/s, the largest speed bound
-  std::string fastest_id;
-  bool by_fields = false;     ///< the fields give the fastest body most of its speed
-  /// Exact mode's re-plans of charged balls gyrating in the magnetic field, per simulated second:
-  /// a circle re-plans at most every 8 turns (docs/physics.md, "Horizons"), |q Bz / m| / (16 pi)
-  /// for each; the most frequent one and its id.
-  double replans_per_second = 0.0;
-  double turns_per_second = 0.0;
-  std::string gyrating_id;
+  sim::WorkEstimate work;  ///< the numbers
+  std::string fastest_id;    ///< the id of work.fastest (the World may take the balls before set_cell)
+  std::string gyrating_id;   ///< the id of work.gyrating
   /// The event rate and its cause for cells of this side (the engine's cell_size()).
   void set_cell(double cell);
 };

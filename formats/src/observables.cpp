@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <string>
+
+#include "turtlegas/sim/mode_names.hpp"
 
 namespace turtlegas::formats {
 namespace {
@@ -277,7 +280,7 @@ nlohmann::json Observer::result() const {
     walls.push_back({{"id", wall_id_[k]}, {"length", wall_length_[k]}, {"pressure", block(per_wall[k])}});
   return {{"format", "turtlegas-observables/1"},
           {"name", name_},
-          {"boundary", periodic ? "periodic" : boundary_ == sim::Boundary::walls ? "walls" : "none"},
+          {"boundary", std::string(sim::to_string(boundary_))},
           {"area", area},
           {"from", opt_.from},
           {"window", opt_.window},

@@ -5,20 +5,12 @@
 
 #include "turtlegas/formats/json_text.hpp"
 #include "turtlegas/sim/suggest.hpp"
+#include "turtlegas/turtle/json_kind.hpp"
 
 namespace turtlegas::server {
 namespace {
 
 using nlohmann::json;
-
-std::string type_name(const json& v) {
-  if (v.is_null()) return "null";
-  if (v.is_boolean()) return "a boolean";
-  if (v.is_number()) return "a number";
-  if (v.is_string()) return "a string";
-  if (v.is_array()) return "an array";
-  return "an object";
-}
 
 std::string path(const char* key) { return std::string("/") + key; }
 
@@ -29,7 +21,7 @@ std::string path(const char* key) { return std::string("/") + key; }
 }
 
 [[noreturn]] void wrong(const char* key, const json& v, std::string_view what, std::string_view example) {
-  throw RequestError("wrong_type", path(key) + " must be " + std::string(what) + " (got " + type_name(v) +
+  throw RequestError("wrong_type", path(key) + " must be " + std::string(what) + " (got " + turtle::json_kind(v) +
                                        "); send e.g. " + std::string(example),
                      path(key));
 }
@@ -109,7 +101,7 @@ sim::Vec2 point_field(const json& m, const char* key, std::string_view prefix, s
   if (it == m.end())
     throw RequestError("missing_field", p + " is missing: it must be [x, y]; send e.g. " + std::string(example), p);
   if (!it->is_array() || it->size() != 2 || !(*it)[0].is_number() || !(*it)[1].is_number())
-    throw RequestError("wrong_type", p + " must be [x, y], two numbers (got " + type_name(*it) + "); send e.g. " + std::string(example), p);
+    throw RequestError("wrong_type", p + " must be [x, y], two numbers (got " + turtle::json_kind(*it) + "); send e.g. " + std::string(example), p);
   const sim::Vec2 v{(*it)[0].get<double>(), (*it)[1].get<double>()};
   if (!std::isfinite(v.x) || !std::isfinite(v.y)) throw RequestError("bad_value", p + " must be finite", p);
   return v;

@@ -33,15 +33,6 @@ using nlohmann::json;
 
 std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
 
-const char* boundary_name(sim::Boundary b) {
-  switch (b) {
-    case sim::Boundary::none: return "none";
-    case sim::Boundary::walls: return "walls";
-    case sim::Boundary::periodic: return "periodic";
-  }
-  return "none";
-}
-
 bool is_command(const std::string& type) {
   return type == "forward" || type == "back" || type == "left" || type == "right" || type == "wait" ||
          type == "yield" || type == "pen";
@@ -404,7 +395,7 @@ json WorldHost::world_json() const {
                        {"sensors", sensors}});
   }
   return {{"name", def.name},
-          {"arena", {{"width", def.arena.width}, {"height", def.arena.height}, {"boundary", boundary_name(def.arena.boundary)}}},
+          {"arena", {{"width", def.arena.width}, {"height", def.arena.height}, {"boundary", std::string(sim::to_string(def.arena.boundary))}}},
           {"dt", def.dt},
           {"mode", sim::to_string(options_.mode)},
           {"remote", options_.realtime ? "realtime" : "lockstep"},

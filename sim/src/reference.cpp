@@ -7,7 +7,51 @@
 #include <limits>
 #include <stdexcept>
 
+#include "turtlegas/sim/field_flight.hpp"
+#include "turtlegas/sim/field_toi.hpp"
+
 namespace turtlegas::sim::reference {
+
+namespace {
+
+/// A wall end met by a ball: its point, the first wall ending there, and the layers of every wall
+/// ending there (an end is there for a ball if any of them is).
+struct End {
+  Vec2 p;
+  std::uint32_t wall;
+  Layers layers{0u, 0u};
+};
+
+/// The scene's walls, the arena's after them, as segments, and their ends, each point once.
+struct Walls {
+  std::vector<WallDef> defs;
+  std::vector<Segment> segments;
+  std::vector<End> ends;
+};
+
+Walls walls_of(const WorldDef& def) {
+  Walls out;
+  out.defs = def.walls;
+  if (def.arena.boundary == Boundary::walls)
+    for (auto& w : arena_walls(def.arena)) out.defs.push_back(w);
+  out.segments.reserve(out.defs.size());
+  for (const auto& w : out.defs) out.segments.push_back(make_segment(w.from, w.to));
+  for (std::uint32_t w = 0; w < out.defs.size(); ++w)
+    for (Vec2 p : {out.defs[w].from, out.defs[w].to}) {
+      End* seen = nullptr;
+      for (End& x : out.ends)
+        if (x.p == p) seen = &x;
+      if (!seen) {
+        out.ends.push_back({p, w});
+        seen = &out.ends.back();
+      }
+      seen->layers.category |= out.defs[w].layers.category;
+      seen->layers.mask |= out.defs[w].layers.mask;
+    }
+  return out;
+}
+
+}  // namespace
 
 std::vector<Event> events(const WorldDef& def, double t_end, std::vector<BallState>* final) {
   if (def.arena.boundary == Boundary::periodic)
@@ -19,30 +63,10 @@ std::vector<Event> events(const WorldDef& def, double t_end, std::vector<BallSta
   const double e = def.effects.restitution, tc = def.effects.tc;
   const bool inelastic = e < 1.0;
 
-  std::vector<WallDef> wall_defs = def.walls;
-  if (def.arena.boundary == Boundary::walls)
-    for (auto& w : arena_walls(def.arena)) wall_defs.push_back(w);
-  std::vector<Segment> walls;
-  walls.reserve(wall_defs.size());
-  for (const auto& w : wall_defs) walls.push_back(make_segment(w.from, w.to));
-  struct End {
-    Vec2 p;
-    std::uint32_t wall;
-    Layers layers{0u, 0u};  // an end is there for a ball if any wall ending there is
-  };
-  std::vector<End> ends;
-  for (std::uint32_t w = 0; w < wall_defs.size(); ++w)
-    for (Vec2 p : {wall_defs[w].from, wall_defs[w].to}) {
-      End* seen = nullptr;
-      for (End& x : ends)
-        if (x.p == p) seen = &x;
-      if (!seen) {
-        ends.push_back({p, w});
-        seen = &ends.back();
-      }
-      seen->layers.category |= wall_defs[w].layers.category;
-      seen->layers.mask |= wall_defs[w].layers.mask;
-    }
+  const Walls all = walls_of(def);
+  const std::vector<WallDef>& wall_defs = all.defs;
+  const std::vector<Segment>& walls = all.segments;
+  const std::vector<End>& ends = all.ends;
 
   const std::size_t n = def.balls.size();
   std::vector<Vec2> x(n), v(n);
@@ -175,6 +199,73 @@ BallState ballistic(const BallDef& ball, const ArenaDef& arena, double g, double
   const double period = 2.0 * impact / g;
   const double s = std::fmod(t - land, period);
   return {{x, r + s * (impact - 0.5 * g * s)}, {vx, impact - g * s}, true};
+}
+
+std::vector<Event> field_events(const WorldDef& def, double t_end, std::vector<BallState>* final) {
+  if (def.arena.boundary == Boundary::periodic)
+    throw std::invalid_argument("reference::field_events supports boundaries none and walls only");
+  const Walls all = walls_of(def);
+  const std::vector<Segment>& walls = all.segments;
+  const std::vector<End>& ends = all.ends;
+  const std::size_t n = def.balls.size();
+  const EffectsDef& fx = def.effects;
+  std::vector<FieldFlight> f(n);
+  std::vector<Vec2> x(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const BallDef& b = def.balls[i];
+    const double qm = b.charge / b.mass;
+    f[i] = {b.vel, fx.gravity + qm * fx.electric, qm * fx.magnetic};
+    x[i] = b.pos;
+  }
+  std::vector<Event> out;
+  double now = 0.0;
+  for (;;) {
+    double best = t_end - now;
+    int kind = 0;
+    std::size_t bi = 0, bj = 0;
+    auto offer = [&](double dt, int k, std::size_t i, std::size_t j) {
+      if (dt < best) {
+        best = dt;
+        kind = k;
+        bi = i;
+        bj = j;
+      }
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      const double r = def.balls[i].radius;
+      for (std::size_t j = i + 1; j < n; ++j)
+        offer(toi_field_disc_disc(x[j] - x[i], f[i], f[j], r + def.balls[j].radius, best), 1, i, j);
+      for (std::size_t w = 0; w < walls.size(); ++w)
+        offer(toi_field_disc_segment(x[i] - walls[w].p1, f[i], walls[w], r, best), 2, i, w);
+      for (std::size_t k = 0; k < ends.size(); ++k) offer(toi_field_disc_point(x[i] - ends[k].p, f[i], r, best), 3, i, k);
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const FieldState s = field_advance(x[i], f[i], best);
+      x[i] = s.x;
+      f[i].v = s.v;
+    }
+    now += best;
+    if (kind == 0) break;
+    if (kind == 1) {
+      respond_disc_disc(f[bi].v, f[bj].v, def.balls[bi].mass, def.balls[bj].mass, x[bj] - x[bi], 1.0);
+      out.push_back({now, EventKind::ball_ball, static_cast<std::uint32_t>(bi), static_cast<std::uint32_t>(bj)});
+    } else if (kind == 2) {
+      const Segment& s = walls[bj];
+      const Vec2 nrm = dot(x[bi] - s.p1, s.n) >= 0.0 ? s.n : -s.n;
+      f[bi].v -= 2.0 * dot(f[bi].v, nrm) * nrm;
+      out.push_back({now, EventKind::ball_wall, static_cast<std::uint32_t>(bi), static_cast<std::uint32_t>(bj)});
+    } else {
+      const Vec2 F = x[bi] - ends[bj].p;
+      const Vec2 nrm = F / norm(F);
+      f[bi].v -= 2.0 * dot(f[bi].v, nrm) * nrm;
+      out.push_back({now, EventKind::ball_wall_end, static_cast<std::uint32_t>(bi), ends[bj].wall});
+    }
+  }
+  if (final) {
+    final->clear();
+    for (std::size_t i = 0; i < n; ++i) final->push_back({x[i], f[i].v, true});
+  }
+  return out;
 }
 
 }  // namespace turtlegas::sim::reference

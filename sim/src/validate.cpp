@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "disc_grid.hpp"
 #include "turtlegas/sim/cover_grid.hpp"
 #include "turtlegas/sim/format.hpp"
 #include "turtlegas/sim/world_def.hpp"
@@ -326,10 +327,25 @@ std::optional<DefProblem> check_ids(const WorldDef& def) {
   return std::nullopt;
 }
 
-/// Disc-disc and disc-wall overlaps, with one grid over the arena grown by the largest radius (so
-/// every disc lies inside it). Walls are entered in every cell their segment crosses, discs in
-/// every cell their bounding box covers; a pair that overlaps then shares at least one cell. In a
-/// periodic arena a disc that crosses an edge is also entered (and tested) at its shifted images.
+/// Calls visit(centre, item) for every item of `grid` near each of a disc's images (`count`
+/// centres in img, radius r: the disc and, in a periodic arena, its copies across the edges it
+/// crosses), the images in order; stops as soon as visit returns true, and says whether it did.
+template <class Grid, class Visit>
+bool for_each_image_hit(const Grid& grid, const std::array<Vec2, 4>& img, int count, double r, const Visit& visit) {
+  for (int m = 0; m < count; ++m) {
+    const Vec2 p = img[m];
+    if (grid.any(grid.cover_disc(p, r), [&](std::uint32_t item) { return visit(p, item); })) return true;
+  }
+  return false;
+}
+
+/// Disc-disc and disc-wall overlaps. Disc pairs in cells of 4 median radii: one grid over the
+/// arena where such cells fit, otherwise hashed cells where the discs are (DiscGrid, however
+/// large the arena); discs against walls with one grid over the arena
+/// grown by the largest radius (so every disc lies inside it), walls entered in every cell their
+/// segment crosses, discs looking in every cell their bounding box covers. A pair that overlaps
+/// shares at least one cell. In a periodic arena a disc that crosses an edge is also entered (and
+/// tested) at its shifted images.
 /// Two balls may overlap when ball-ball collisions are off, and any two objects whose collision
 /// layers do not meet may overlap (they pass through each other).
 std::optional<DefProblem> check_overlaps(const WorldDef& def) {
@@ -375,41 +391,73 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
 
   const bool balls_collide = def.effects.ball_ball;
   if (balls_collide || !def.turtles.empty()) {
-    CoverGrid grid(lo, hi, side, max_cells);
     // Items are disc * 4 + image, so a periodic pair is caught from whichever side crosses the edge.
     std::array<Vec2, 4> img{}, other{};
-    // Room for every entry first: a list grown by doubling would briefly hold three times as many.
-    std::size_t entries = 0;
-    for (std::size_t k = 0; k < n; ++k)
-      for (int m = 0, m_count = images(k, img); m < m_count; ++m) entries += grid.cover_disc(img[m], d.radius(k)).cells();
-    grid.reserve(entries);
-    for (std::size_t k = 0; k < n; ++k) {
-      const int m_count = images(k, img);
-      const double r = d.radius(k);
-      std::optional<std::size_t> hit;
-      for (int m = 0; m < m_count && !hit; ++m) {
-        const Vec2 p = img[m];
-        grid.any(grid.cover_disc(p, r), [&](std::uint32_t item) {
-          const std::size_t j = item / 4;
-          if (!balls_collide && d.is_ball(j) && d.is_ball(k)) return false;
-          if (!d.layers(j).collides_with(d.layers(k))) return false;
-          Vec2 q = d.pos(j);
-          if (item % 4 != 0) {
-            images(j, other);
-            q = other[item % 4];
-          }
-          const double s = r + d.radius(j);
-          if (norm2(p - q) < s * s) hit = j;
-          return hit.has_value();
-        });
+    // Whether disc k's image at p overlaps the image `item` of another disc it collides with.
+    auto overlaps = [&](std::size_t k, Vec2 p, std::uint32_t item) {
+      const std::size_t j = item / 4;
+      if (j == k) return false;
+      if (!balls_collide && d.is_ball(j) && d.is_ball(k)) return false;
+      if (!d.layers(j).collides_with(d.layers(k))) return false;
+      Vec2 q = d.pos(j);
+      if (item % 4 != 0) {
+        images(j, other);
+        q = other[item % 4];
       }
-      if (hit)
-        return d.problem(k, "pos",
-                         d.name(k) + " at " + vec(d.pos(k)) + " overlaps " + d.name(*hit) + " at " + vec(d.pos(*hit)) +
-                             " (radii " + num(r) + " + " + num(d.radius(*hit)) +
-                             "); move them apart or make them smaller");
-      for (int m = 0; m < m_count; ++m)
-        grid.insert(grid.cover_disc(img[m], r), static_cast<std::uint32_t>(k * 4 + static_cast<std::size_t>(m)));
+      const double s = d.radius(k) + d.radius(j);
+      return norm2(p - q) < s * s;
+    };
+    // The pair reported is the one whose later disc comes first, with its earliest partner.
+    std::optional<std::pair<std::size_t, std::size_t>> first;  // (later, earlier)
+    auto note = [&](std::size_t k, std::size_t j) {
+      const std::pair<std::size_t, std::size_t> pair{std::max(j, k), std::min(j, k)};
+      if (!first || pair < *first) first = pair;
+    };
+    const double cells = std::ceil((hi.x - lo.x) / side) * std::ceil((hi.y - lo.y) / side);
+    if (cells <= static_cast<double>(max_cells)) {
+      // Cells of the side asked for fit over the arena: one grid over it, each disc checked
+      // against those before it (the fastest for a gas that fills its arena: no sort).
+      CoverGrid grid(lo, hi, side, max_cells);
+      // Room for every entry first: a list grown by doubling would briefly hold three times as many.
+      std::size_t entries = 0;
+      for (std::size_t k = 0; k < n; ++k)
+        for (int m = 0, m_count = images(k, img); m < m_count; ++m) entries += grid.cover_disc(img[m], d.radius(k)).cells();
+      grid.reserve(entries);
+      for (std::size_t k = 0; k < n && !first; ++k) {
+        const int m_count = images(k, img);
+        const double r = d.radius(k);
+        for_each_image_hit(grid, img, m_count, r, [&](Vec2 p, std::uint32_t item) {
+          if (overlaps(k, p, item)) note(k, item / 4);
+          return false;
+        });
+        for (int m = 0; m < m_count; ++m)
+          grid.insert(grid.cover_disc(img[m], r), static_cast<std::uint32_t>(k * 4 + static_cast<std::size_t>(m)));
+      }
+    } else {
+      // The arena is too large for such cells (an arena grid would be coarsened, and 1e5 discs
+      // clustered in a 1e9 arena shared one cell: O(N^2)): the discs' own cells, hashed
+      // (disc_grid.hpp). A pair is seen from the disc at the lower level of that grid (or from
+      // both), so once disc k is done every pair whose later disc is at most k has been seen.
+      DiscGrid grid(side);
+      std::size_t entries = 0;
+      for (std::size_t k = 0; k < n; ++k) entries += 4 * static_cast<std::size_t>(images(k, img));
+      grid.reserve(entries);
+      for (std::size_t k = 0; k < n; ++k)
+        for (int m = 0, m_count = images(k, img); m < m_count; ++m)
+          grid.add(img[m], d.radius(k), static_cast<std::uint32_t>(k * 4 + static_cast<std::size_t>(m)));
+      grid.build();
+      for (std::size_t k = 0; k < n && !(first && first->first < k); ++k)
+        for_each_image_hit(grid, img, images(k, img), d.radius(k), [&](Vec2 p, std::uint32_t item) {
+          if (overlaps(k, p, item)) note(k, item / 4);
+          return false;
+        });
+    }
+    if (first) {
+      const auto [k, j] = *first;
+      return d.problem(k, "pos",
+                       d.name(k) + " at " + vec(d.pos(k)) + " overlaps " + d.name(j) + " at " + vec(d.pos(j)) +
+                           " (radii " + num(d.radius(k)) + " + " + num(d.radius(j)) +
+                           "); move them apart or make them smaller");
     }
   }
 
@@ -422,15 +470,12 @@ std::optional<DefProblem> check_overlaps(const WorldDef& def) {
     const int m_count = images(k, img);
     const double r = d.radius(k);
     std::optional<std::size_t> hit;
-    for (int m = 0; m < m_count && !hit; ++m) {
-      const Vec2 p = img[m];
-      walls_grid.any(walls_grid.cover_disc(p, r), [&](std::uint32_t w) {
-        const WallDef& wall = def.walls[w];
-        if (!wall.layers.collides_with(d.layers(k))) return false;
-        if (segment_distance2(p, wall.from, wall.to) < r * r) hit = w;
-        return hit.has_value();
-      });
-    }
+    for_each_image_hit(walls_grid, img, m_count, r, [&](Vec2 p, std::uint32_t w) {
+      const WallDef& wall = def.walls[w];
+      if (!wall.layers.collides_with(d.layers(k))) return false;
+      if (segment_distance2(p, wall.from, wall.to) < r * r) hit = w;
+      return hit.has_value();
+    });
     if (hit) {
       const WallDef& wall = def.walls[*hit];
       return d.problem(k, "pos",

@@ -13,6 +13,7 @@
 #include <random>
 
 #include "turtlegas/sim/field_flight.hpp"
+#include "turtlegas/sim/seeded_rng.hpp"
 
 namespace field_oracle {
 
@@ -94,27 +95,7 @@ inline State<long double> ld_state(Vec2 x0, const FieldFlight& f, long double t)
   return textbook<L>(lift<L>(x0), f, t);
 }
 
-// Log-uniform in [lo, hi], random sign optional.
-struct Rng {
-  std::mt19937_64 gen;
-  explicit Rng(std::uint64_t seed) : gen(seed) {}
-  double uniform(double lo, double hi) { return lo + (hi - lo) * static_cast<double>(gen() >> 11) * 0x1.0p-53; }
-  double log_uniform(double lo, double hi) { return std::exp(uniform(std::log(lo), std::log(hi))); }
-  double sign() { return (gen() & 1) ? 1.0 : -1.0; }
-  Vec2 direction() {
-    const double phi = uniform(0.0, 6.283185307179586);
-    return {std::cos(phi), std::sin(phi)};
-  }
-  /// magnitude() * direction(), the direction drawn first. Scenes must not be drawn as
-  /// `rng.uniform(...) * rng.direction()`: the order in which an overloaded operator's operands
-  /// are evaluated is unspecified, g++ takes the right one first and clang++ the left, so the two
-  /// compilers drew different random scenes. This keeps g++'s order, the one the tests were
-  /// written and tuned with.
-  template <class Magnitude>
-  Vec2 direction_then(Magnitude magnitude) {
-    const Vec2 d = direction();
-    return magnitude() * d;
-  }
-};
+/// The seeded scene generator, shared with bench/field_toi_bench.cpp.
+using Rng = turtlegas::sim::SeededRng;
 
 }  // namespace field_oracle

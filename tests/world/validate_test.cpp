@@ -319,7 +319,49 @@ TEST_CASE("validate agrees with brute force on random scenes") {
     const auto p = sim::validate(def);
     if (p) INFO(p->message);
     CHECK(p.has_value() == overlap);
+    if (def.arena.boundary != sim::Boundary::periodic) {
+      // The same discs in a 1e9 arena: checked in their own hashed cells, not a grid over it.
+      def.arena.width = def.arena.height = 1e9;
+      const auto q = sim::validate(def);
+      CHECK(q.has_value() == overlap);
+      if (p && q) CHECK(q->message == p->message);
+    }
   }
+}
+
+TEST_CASE("clustered discs in a huge arena are checked by their own cells, and an overlap is still found") {
+  // Issue 29: 1e5 discs clustered in a 1e9 arena shared one cell of a grid laid over the arena, and
+  // the overlap check took 4 minutes (O(N^2)). Two clusters of 50,000 discs (a bounding box of the
+  // discs would be the arena again) on lattices whose neighbours touch exactly; at O(N^2) this
+  // test takes minutes, at the discs' own cells well under a second.
+  sim::WorldDef def = scene();
+  def.arena.width = 1e9;
+  def.arena.height = 1e9;
+  const int side = 224;  // 224^2 = 50,176 discs per cluster
+  for (const sim::Vec2 corner : {sim::Vec2{20000, 20000}, sim::Vec2{6e8, 7e8}})
+    for (int i = 0; i < side * side; ++i)
+      def.balls.push_back(ball("b" + std::to_string(def.balls.size()), corner + sim::Vec2{2.0 * (i % side), 2.0 * (i / side)}));
+  // One large disc at a level of its own, touching a cluster's corner disc, and a small one inside
+  // the large one's reach but clear of it.
+  def.balls.push_back(ball("big", {20000 - 1 - 5000, 20000}, 5000));
+  def.balls.push_back(ball("small", {20000 - 5000, 20000 + 5001.5}, 0.5));
+  const std::size_t n = def.balls.size();
+  CHECK_FALSE(sim::validate(def).has_value());
+
+  // A disc planted in the second cluster, overlapping two neighbours: named with the first of them.
+  def.balls.push_back(ball("planted", sim::Vec2{6e8, 7e8} + sim::Vec2{2.0 * 100 + 1.0, 2.0 * 50}, 0.75));
+  sim::DefProblem p = problem_of(def);
+  CHECK(p.index == n);
+  const std::size_t first = static_cast<std::size_t>(side * side + 50 * side + 100);
+  CHECK(contains(p.message, "ball 'planted' at [600000201, 700000100] overlaps ball 'b" + std::to_string(first) + "'"));
+  def.balls.pop_back();
+
+  // The large disc grown by a hair overlaps the cluster's corner disc (and its neighbour above):
+  // seen from the corner disc's side (the lower level of the grid), named by the later of the two.
+  def.balls[n - 2].radius = 5000.25;
+  p = problem_of(def);
+  CHECK(p.index == n - 2);
+  CHECK(contains(p.message, "ball 'big' at [14999, 20000] overlaps ball 'b0' at [20000, 20000]"));
 }
 
 TEST_CASE("arena_walls: order, ends and ids") {

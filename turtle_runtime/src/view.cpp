@@ -7,6 +7,7 @@
 #include <string>
 
 #include "turtlegas/sim/format.hpp"
+#include "turtlegas/turtle/json_kind.hpp"
 
 
 namespace turtlegas::turtle {
@@ -63,19 +64,10 @@ std::string view_json_text(const View& v) {
 
 namespace {
 
-std::string kind_of(const json& v) {
-  if (v.is_string()) return "a string";
-  if (v.is_number()) return "a number";
-  if (v.is_boolean()) return "true or false";
-  if (v.is_null()) return "null";
-  if (v.is_array()) return "an array";
-  return "an object";
-}
-
 sim::Vec2 pair(const json& v, const std::string& path, const char* what, bool positive) {
   if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
     throw ViewError(path, path.substr(1) + " must be [" + what + "], two numbers, got " +
-                              (v.is_array() ? "an array of " + std::to_string(v.size()) : kind_of(v)));
+                              (v.is_array() ? "an array of " + std::to_string(v.size()) : json_kind(v)));
   const sim::Vec2 p{v[0].get<double>(), v[1].get<double>()};
   for (int k = 0; k < 2; ++k) {
     const double x = k == 0 ? p.x : p.y;
@@ -92,7 +84,7 @@ sim::Vec2 pair(const json& v, const std::string& path, const char* what, bool po
 View parse_view(const json& j, const View* base) {
   if (!j.is_object())
     throw ViewError("", "a view must be a JSON object such as {\"id\": \"v1\", \"center\": [250, 200], \"size\": [500, 400]}, got " +
-                            kind_of(j));
+                            json_kind(j));
   static constexpr std::string_view keys[] = {"id", "follow", "center", "offset", "size", "rotate", "layers", "title"};
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (it.key().starts_with("x-")) continue;
@@ -104,7 +96,7 @@ View parse_view(const json& j, const View* base) {
   View v = base ? *base : View{};
   if (const auto it = j.find("id"); it != j.end()) {
     if (!it->is_string() || it->get_ref<const std::string&>().empty() || it->get_ref<const std::string&>().size() > 200)
-      throw ViewError("/id", "id must be a non-empty string of at most 200 characters, got " + kind_of(*it));
+      throw ViewError("/id", "id must be a non-empty string of at most 200 characters, got " + json_kind(*it));
     if (base && it->get_ref<const std::string&>() != base->id)
       throw ViewError("/id", "a change cannot rename view \"" + base->id + "\"; close it and open a new one");
     v.id = it->get<std::string>();
@@ -114,7 +106,7 @@ View parse_view(const json& j, const View* base) {
   if (const auto it = j.find("follow"); it != j.end()) {
     if (it->is_null()) v.follow.reset();
     else if (it->is_string() && !it->get_ref<const std::string&>().empty()) v.follow = it->get<std::string>();
-    else throw ViewError("/follow", "follow must be a turtle's id or null (a fixed view), got " + kind_of(*it));
+    else throw ViewError("/follow", "follow must be a turtle's id or null (a fixed view), got " + json_kind(*it));
   }
   if (const auto it = j.find("center"); it != j.end()) {
     if (v.follow)
@@ -130,7 +122,7 @@ View parse_view(const json& j, const View* base) {
   }
   if (const auto it = j.find("size"); it != j.end()) v.size = pair(*it, "/size", "width, height", true);
   if (const auto it = j.find("rotate"); it != j.end()) {
-    if (!it->is_boolean()) throw ViewError("/rotate", "rotate must be true or false, got " + kind_of(*it));
+    if (!it->is_boolean()) throw ViewError("/rotate", "rotate must be true or false, got " + json_kind(*it));
     v.rotate = it->get<bool>();
     if (v.rotate && !v.follow)
       throw ViewError("/rotate", "rotate turns a view with the turtle it follows; a fixed view cannot rotate "
@@ -146,7 +138,7 @@ View parse_view(const json& j, const View* base) {
       for (std::size_t k = 0; k < it->size(); ++k) {
         const json& n = (*it)[k];
         const std::string p = "/layers/" + std::to_string(k);
-        if (!n.is_string()) throw ViewError(p, "a layer is a name (" + known + "), got " + kind_of(n));
+        if (!n.is_string()) throw ViewError(p, "a layer is a name (" + known + "), got " + json_kind(n));
         const auto& names = view_layer_names();
         const auto f = std::find(names.begin(), names.end(), n.get_ref<const std::string&>());
         if (f == names.end())
@@ -154,11 +146,11 @@ View parse_view(const json& j, const View* base) {
         v.layers |= 1u << static_cast<unsigned>(f - names.begin());
       }
     } else {
-      throw ViewError("/layers", "layers must be \"all\" or a list of names (" + known + "), got " + kind_of(*it));
+      throw ViewError("/layers", "layers must be \"all\" or a list of names (" + known + "), got " + json_kind(*it));
     }
   }
   if (const auto it = j.find("title"); it != j.end()) {
-    if (!it->is_string()) throw ViewError("/title", "title must be a string, got " + kind_of(*it));
+    if (!it->is_string()) throw ViewError("/title", "title must be a string, got " + json_kind(*it));
     v.title = it->get<std::string>();
   }
   return v;

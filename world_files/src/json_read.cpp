@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <utility>
 
 #include "turtlegas/sim/format.hpp"
@@ -26,14 +25,6 @@ std::string json_token(std::string_view key) {
 
 std::string json_at(const std::string& path, std::string_view key) { return path + "/" + json_token(key); }
 std::string json_at(const std::string& path, std::size_t index) { return path + "/" + std::to_string(index); }
-
-std::string json_kind(const json& v) {
-  const std::string name = v.type_name();
-  if (v.is_null()) return "null";
-  if (v.is_boolean()) return "true or false";
-  const bool vowel = !name.empty() && std::strchr("aeiou", name[0]) != nullptr;
-  return (vowel ? "an " : "a ") + name;
-}
 
 const std::string* unknown_key(const json& obj, std::initializer_list<std::string_view> known, std::string_view also) {
   if (!obj.is_object()) return nullptr;

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "reader.hpp"
+#include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/sim/suggest.hpp"
 #include "turtlegas/turtle/script.hpp"
 #include "turtlegas/world/draw_walker.hpp"
@@ -107,9 +108,7 @@ void Reader::read_arena(const json& v, sim::ArenaDef& arena) {
   if (const json* c = find(v, "cell")) arena.cell = positive(*c, at(path, "cell"), "arena cell");
   if (const json* b = find(v, "boundary")) {
     const std::string s = string(*b, at(path, "boundary"));
-    if (s == "none") arena.boundary = sim::Boundary::none;
-    else if (s == "walls") arena.boundary = sim::Boundary::walls;
-    else if (s == "periodic") arena.boundary = sim::Boundary::periodic;
+    if (const auto boundary = sim::boundary_from_string(s)) arena.boundary = *boundary;
     else fail(at(path, "boundary"), "boundary must be \"none\", \"walls\" or \"periodic\" (got \"" + s + "\")");
   }
 }

@@ -17,6 +17,12 @@ namespace turtlegas::sim::reference {
 /// Boundaries `none` and `walls` only. Returns the events and leaves final states in *final.
 std::vector<Event> events(const WorldDef& def, double t_end, std::vector<BallState>* final = nullptr);
 
+/// events() for balls on field flights (field_flight.hpp: gravity, the electric and the magnetic
+/// field), elastic, every ball flown from its last event with field_advance and every pair, face
+/// and end predicted by field_toi.hpp after every event: O(N^2) per event, no grid, no crossings,
+/// no last-partner skip, no layers. Boundaries `none` and `walls` only.
+std::vector<Event> field_events(const WorldDef& def, double t_end, std::vector<BallState>* final = nullptr);
+
 /// Where a ball is at time t (seconds) when it flies alone (no other ball, no wall but the arena's)
 /// in an arena with `Boundary::walls`, elastic, under gravity (0, -g), g > 0 in units/s^2: x
 /// reflects between the side walls (the line x0 + vx t folded into [r, width - r]), y is a

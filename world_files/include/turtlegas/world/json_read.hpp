@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "turtlegas/sim/vec2.hpp"
+#include "turtlegas/turtle/json_kind.hpp"
 
 namespace turtlegas::world {
 
@@ -22,8 +23,9 @@ std::string json_at(const std::string& path, std::string_view key);
 /// `path` + "/" + index: the JSON pointer of an array element.
 std::string json_at(const std::string& path, std::size_t index);
 
-/// "a string", "an array", ..., "true or false", "null": what a value is, for messages.
-std::string json_kind(const nlohmann::json& v);
+/// "a string", "an array", ..., "true or false", "null": what a value is, for messages (one
+/// wording for the house: turtlegas/turtle/json_kind.hpp).
+using turtle::json_kind;
 
 /// The first key of object `obj` that is neither in `known`, nor `also`, nor private (starting
 /// with x-); nullptr when there is none (or `obj` is not an object).
