@@ -11,10 +11,13 @@
 
 #include <spdlog/spdlog.h>
 
+#include "host_text.hpp"
 #include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/state_file.hpp"
+#include "turtlegas/server/protocol.hpp"
 #include "turtlegas/server/world_host.hpp"
 #include "turtlegas/sim/mode_names.hpp"
+#include "turtlegas/world/world_file.hpp"
 #include "turtlegas/world/entries.hpp"
 
 namespace turtlegas::server {
@@ -92,7 +95,7 @@ void WorldHost::record_view(const char* op, const nlohmann::json& view) {
 std::shared_ptr<turtle::InputSource> WorldHost::world_input() {
   if (!options_.replay || options_.replay->inputs.empty()) return nullptr;
   // A fresh reader for every build: a seek backwards replays the inputs from the start. A spawn
-  // grows the host's scene as a live spawn does (body_changes.cpp), so that ids and frames name it.
+  // grows the host's scene as a live spawn does (host_world_changes.cpp), so that ids and frames name it.
   formats::SpawnApplier spawn = [this](turtle::WorldServer& server, const nlohmann::json& entry) {
     spawn_into_scene(server, entry, options_.replay->path);
   };
@@ -156,5 +159,57 @@ std::string WorldHost::state_text() const {
   formats::write_state(out, server_->world(), formats::RunNames{ball_ids_, scene_.def, server_->world()});
   return out.str();
 }
+
+void WorldHost::require_not_replay(const std::string& type) const {
+  if (options_.replay)
+    throw RequestError("replay", "\"" + type + "\" would change the world, and this is a replay of " + options_.replay->path +
+                                     ": it can only play, pause, seek, reverse, step and change speed");
+}
+
+bool WorldHost::replay_target(double& target) {
+  const double t = server_->time(), dt = scene_.def.dt, end = options_.replay->end;
+  if (!reverse_ || steps_left_ > 0) {
+    if (t >= end) return false;
+    if (!(target > t)) target = std::nextafter(t, INFINITY);
+    target = std::min(target, end);
+    return true;
+  }
+  if (t <= 0.0) return false;
+  target = dt > 0.0 ? std::max(0.0, (std::ceil(t / dt) - 1.0) * dt) : 0.0;
+  if (!(target < t)) target = std::max(0.0, target - dt);
+  return true;
+}
+
+void WorldHost::seek(double t) {
+  const bool back = t < server_->time();
+  fan_out_events();
+  const bool restored = restore_snapshot(t);
+  const bool rebuild = back && !restored;
+  if (rebuild) {
+    world::Scene scene = world::parse_scene(world_text(), options_.world_file, registry_);
+    scene.def.dt = options_.replay->dt;
+    build_world(std::move(scene));
+  }
+  in_step_ = true;
+  try {
+    replay_run_until(t);
+  } catch (const std::exception& e) {
+    in_step_ = false;
+    events_.clear();
+    end_world(e.what());
+    return;
+  }
+  in_step_ = false;
+  if (rebuild || restored) reopen_client_views();
+  events_.clear();  // what happened on the way is not shown: the viewer jumps
+  reanchor();
+  if (!rebuild && !restored) return;
+  std::map<std::string, FrameStream> fresh;
+  for (auto& [key, s] : streams_) fresh.try_emplace(key, s.kind(), *server_).first->second.next_due = now();
+  streams_ = std::move(fresh);
+  for (auto& [cid, c] : clients_)
+    if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"], looks_));
+}
+
 
 }  // namespace turtlegas::server

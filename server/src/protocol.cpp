@@ -36,15 +36,6 @@ std::string path(const char* key) { return std::string("/") + key; }
 
 }  // namespace
 
-const std::vector<std::string>& message_types() {
-  static const std::vector<std::string> types = {
-      "hello", "subscribe", "unsubscribe", "snapshot", "pause", "resume", "step", "speed", "run_until",
-      "claim", "release", "forward", "back", "left", "right", "wait", "yield", "pen", "add_wall",
-      "save", "load", "spawn", "remove", "teleport", "view_open", "view_change", "view_close", "ping", "stats",
-      "play", "seek", "reverse"};
-  return types;
-}
-
 std::string error_text(std::string_view code, std::string_view message, const json* id, std::string_view request,
                        std::string_view field) {
   json e = {{"type", "error"}};

@@ -22,9 +22,6 @@ namespace turtlegas::server {
 inline constexpr std::string_view protocol_name = "turtlegas/1";
 inline constexpr std::string_view server_name = "turtlegas serve 1";
 
-/// Every message type the server knows, in docs/protocol.md's order.
-const std::vector<std::string>& message_types();
-
 /// A message that fails: the error reply's code, message and JSON pointer (docs/protocol.md,
 /// "Errors"). Thrown by the readers below and by the host's handlers; nothing has changed.
 struct RequestError : std::runtime_error {
