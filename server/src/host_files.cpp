@@ -3,6 +3,8 @@
 // in the save directory only; and the input log that makes a served run replayable.
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -48,6 +50,10 @@ void WorldHost::do_file_requests() {
       continue;
     }
     if (!f.load) {
+      if (const std::string what = in_use(path); !what.empty()) {
+        fail("bad_path", "/file: '" + f.file + "' is " + what + ", in use by the server; save under another name");
+        continue;
+      }
       if (ended_) {
         fail("ended", "the world has ended (" + *ended_ + ")");
         continue;
@@ -105,6 +111,7 @@ void WorldHost::do_file_requests() {
     inputs_file_.reset();
     if (recorder_) finish_recording("load");
     build_world(std::move(scene));
+    served_file_ = path;
     {
       std::lock_guard lock(text_mutex_);
       options_.world_text = std::move(text);
@@ -121,8 +128,50 @@ void WorldHost::do_file_requests() {
 }
 
 void WorldHost::write_input(const std::string& line) {
-  if (inputs_file_) *inputs_file_ << line;
+  if (inputs_file_) {
+    *inputs_file_ << line;
+    inputs_file_->flush();  // on disk as it is taken (the header is, too: host_world.cpp)
+    if (!*inputs_file_) output_failed("--inputs-out", options_.inputs_path);
+  }
   if (recorder_) recorder_->input(line);
+}
+
+void WorldHost::output_failed(const char* option, const std::string& path) {
+  const int e = errno;
+  if (std::string(option) == "--events") events_writer_.reset(), events_file_.reset();
+  if (std::string(option) == "--inputs-out") inputs_file_.reset();
+  if (!output_error_.empty()) return;
+  output_error_ = std::string(option) + ": writing '" + path + "' failed" + (e ? " (" + std::string(std::strerror(e)) + ")" : "");
+  spdlog::error("{}; the server stops", output_error_);
+  stopping_ = true;
+  stop_reason_ = "error";
+}
+
+void WorldHost::check_outputs() {
+  if (events_file_ && !*events_file_) output_failed("--events", options_.events_path);
+  if (inputs_file_ && !*inputs_file_) output_failed("--inputs-out", options_.inputs_path);
+  if (record_file_ && !*record_file_ && output_error_.empty()) output_failed("--record", options_.record_path);
+}
+
+std::string WorldHost::in_use(const std::filesystem::path& path) const {
+  const std::pair<const std::string*, const char*> files[] = {
+      {nullptr, "the served world"},
+      {&options_.events_path, "the live event log (--events)"},
+      {&options_.inputs_path, "the live input log (--inputs-out)"},
+      {&options_.record_path, "the live recording (--record)"}};
+  for (const auto& [name, what] : files) {
+    const std::filesystem::path other = name ? std::filesystem::path(*name) : served_file_;
+    if (other.empty()) continue;
+    std::error_code ec;
+    // The same file by any name: a hard link or a symlinked directory is caught by `equivalent`.
+    if (std::filesystem::equivalent(path, other, ec) && !ec) return what;
+    ec.clear();
+    const auto a = std::filesystem::weakly_canonical(path, ec);
+    if (ec) continue;
+    const auto b = std::filesystem::weakly_canonical(other, ec);
+    if (!ec && a == b) return what;
+  }
+  return {};
 }
 
 }  // namespace turtlegas::server

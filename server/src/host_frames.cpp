@@ -22,6 +22,7 @@ void WorldHost::fan_out_events() {
   if (events_.empty()) return;
   if (events_writer_) events_writer_->write(events_);
   if (recorder_) recorder_->events(events_);
+  check_outputs();  // a full disk stops the server, named, rather than cut the logs silently
   bool wanted = false;
   for (const auto& [key, s] : streams_) wanted = wanted || s.kind().all_events || !s.kind().events.empty();
   if (wanted) {

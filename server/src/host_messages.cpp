@@ -145,7 +145,7 @@ void WorldHost::on_hello(ClientState& c, const json& m, const std::string& /*typ
     throw RequestError("bad_protocol", "/protocol: this server speaks \"turtlegas/1\" (got \"" + protocol.substr(0, 64) + "\")", "/protocol");
   if (options_.token && m.contains("token")) {
     const std::string token = string_field(m, "token", R"({"type": "hello", "protocol": "turtlegas/1", "token": "T"})");
-    if (token != *options_.token) {
+    if (!same_token(token, *options_.token)) {
       c.hello = true;
       throw RequestError("bad_token", "/token is not the server's token; the connection stays unauthorized (view only, from loopback)", "/token");
     }

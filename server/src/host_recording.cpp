@@ -82,7 +82,7 @@ void WorldHost::finish_recording(const std::string& stopped, bool keyframe) {
   recorder_->finish(keyframe ? server_->time() : recorder_->last_keyframe_time(), stopped);
   recorder_.reset();
   record_file_->close();
-  if (!*record_file_) spdlog::error("--record: writing '{}' failed (disk full?)", options_.record_path);
+  if (!*record_file_) output_failed("--record", options_.record_path);
   record_file_.reset();
   spdlog::info("recording '{}' closed at t={}{}", options_.record_path, server_->time(),
                stopped.empty() ? std::string() : " (" + stopped + ")");

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The world host's world: opening the logs, building the one WorldServer from a scene (at start
 // and on `load`), and the world file's text for GET /api/world.
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
 #include <utility>
 
@@ -23,8 +25,14 @@ WorldHost::WorldHost(HostOptions options, const turtle::Registry& registry, worl
   if (!options_.inputs_path.empty()) {
     inputs_file_.emplace(options_.inputs_path, std::ios::binary | std::ios::trunc);
     if (!*inputs_file_) throw std::runtime_error("--inputs-out: cannot write '" + options_.inputs_path + "'");
+    // The header on disk at once, and each input as it is taken (write_input): a server killed
+    // with SIGKILL leaves an input log that `run --inputs` replays up to its last line.
     *inputs_file_ << formats::input_header_line(scene.def.name, scene.def.dt);
+    inputs_file_->flush();
+    if (!*inputs_file_)
+      throw std::runtime_error("--inputs-out: writing '" + options_.inputs_path + "' failed (" + std::strerror(errno) + ")");
   }
+  served_file_ = options_.world_file;
   build_world(std::move(scene));
   start_recording();
   plan_snapshots();

@@ -63,9 +63,12 @@ int serve(ServeOptions options, const turtle::Registry& registry, world::Scene s
                                std::to_string(port) + ": " + e.code().message() + " (choose another port, or 0 for any)");
     }
   };
-  http = listen(options.port, [&host, web_root](asio::ip::tcp::socket&& s) {
-    std::make_shared<detail::HttpSession>(std::move(s), host, web_root)->run();
+  // Filled in once the port is known (port 0), before the first accept.
+  auto door = std::make_shared<detail::Door>();
+  http = listen(options.port, [&host, web_root, door](asio::ip::tcp::socket&& s) {
+    std::make_shared<detail::HttpSession>(std::move(s), host, web_root, door)->run();
   }, "HTTP");
+  *door = detail::make_door(options.bind, http->port(), options.allow_origins);
   const unsigned short line_port = options.line_port ? *options.line_port : options.port == 0 ? 0 : static_cast<unsigned short>(options.port + 1);
   lines = listen(line_port, [&host](asio::ip::tcp::socket&& s) {
     if (host.clients_open() >= host.options().limits.max_clients) {

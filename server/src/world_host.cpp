@@ -175,6 +175,7 @@ int WorldHost::run() {
   fan_out_events();
   if (events_file_) events_file_->flush();
   if (inputs_file_) inputs_file_->flush();
+  check_outputs();
   if (recorder_) finish_recording(stop_reason_ == "until" ? "" : stop_reason_);
   const std::string bye = dump({{"type", "bye"}, {"reason", stop_reason_}, {"t", server_->time()}});
   for (auto& [id, c] : clients_) {
@@ -183,7 +184,7 @@ int WorldHost::run() {
   }
   spdlog::info("stopped at t={} ({})", fmt(server_->time()), stop_reason_);
   if (on_finished) on_finished();
-  return 0;
+  return output_error_.empty() ? 0 : 1;
 }
 
 void WorldHost::step_world(double target) {

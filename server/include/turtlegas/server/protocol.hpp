@@ -63,6 +63,10 @@ std::string_view pen_name(bool down, turtle::PenMode mode);
 /// a message or a fault.
 std::string report_text(const turtle::RemoteReport& r, std::string_view turtle_id, const nlohmann::json& id);
 
+/// Whether `given` is `token`, in a time that does not depend on where they differ (a token guessed
+/// byte by byte from reply times would otherwise be possible).
+bool same_token(std::string_view given, std::string_view token);
+
 /// A save/load name: 1 to 100 of A-Z a-z 0-9 . _ -, not starting with '.'. Throws bad_path.
 void check_plain_name(const std::string& name);
 

@@ -94,7 +94,8 @@ class WorldHost {
   std::size_t clients_open() const { return clients_open_.load(); }
   std::uint64_t next_client_id() { return ++last_client_id_; }
 
-  /// The simulation thread's loop: until a stop (a signal, --until). Returns the exit code.
+  /// The simulation thread's loop: until a stop (a signal, --until, an output that cannot be
+  /// written). Returns the exit code: 0, or 1 when an output failed.
   int run();
   /// Called on the simulation thread once the loop has ended and every client was told.
   std::function<void()> on_finished;
@@ -225,6 +226,14 @@ class WorldHost {
   void on_file(ClientState& c, const nlohmann::json& m, const std::string& type);
   void do_file_requests();
   void write_input(const std::string& line);
+  /// What `path` is to the server when it reads or writes it ("the served world", "the live event
+  /// log (--events)", ...), else empty: save refuses those.
+  std::string in_use(const std::filesystem::path& path) const;
+  /// A log or the recording could not be written (errno says why): logged with the option and the
+  /// path, the server stops, and run() returns 1.
+  void output_failed(const char* option, const std::string& path);
+  /// output_failed() for each output stream that has gone bad.
+  void check_outputs();
 
   // A replay's clock (host_recording.cpp).
   void require_not_replay(const std::string& type) const;
@@ -292,6 +301,8 @@ class WorldHost {
   std::uint64_t step_end_ = 0;    ///< the boundary the running step_world ends on
   double anchor_sim_ = 0.0, anchor_wall_ = 0.0;
   std::optional<std::string> ended_;
+  std::string output_error_;  ///< set: an output failed (output_failed)
+  std::filesystem::path served_file_;  ///< the world file served (the original, or the last `load`)
   bool stopping_ = false;
   std::string stop_reason_;
   bool in_step_ = false;
