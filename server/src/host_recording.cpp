@@ -192,7 +192,7 @@ void WorldHost::seek(double t) {
   }
   in_step_ = true;
   try {
-    replay_run_until(t);
+    seek_run_until(t);
   } catch (const std::exception& e) {
     in_step_ = false;
     events_.clear();
@@ -211,5 +211,57 @@ void WorldHost::seek(double t) {
     if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"], looks_));
 }
 
+
+void WorldHost::check_replay() {
+  if (!options_.replay) return;
+  ReplaySource& r = *options_.replay;
+  if (!(std::isfinite(r.dt) && r.dt >= 0.0 && r.dt <= 1e6))
+    throw std::invalid_argument(r.path + ": the header's dt (" + fmt(r.dt) +
+                                " s) is not a time step from 0 to 1e6 s; the recording is damaged");
+  double before = 0.0;
+  for (const double k : r.keyframes)
+    if (!(std::isfinite(k) && k >= before)) throw std::invalid_argument(r.path + ": keyframe times out of order or not finite; the recording is damaged");
+    else before = k;
+  if (!(r.end >= 0.0) || !std::isfinite(r.end) || (!r.keyframes.empty() && r.end > r.keyframes.back())) {
+    // A recording ends on its last keyframe (formats/recording.cpp writes one at its end): an index
+    // claiming more would make a seek run for ever.
+    const double last = r.keyframes.empty() ? 0.0 : r.keyframes.back();
+    spdlog::warn("{}: its index says it ends at t={} s, but its last keyframe is at t={} s; it is replayed to {} s",
+                 r.path, fmt(r.end), fmt(last), fmt(last));
+    r.end = last;
+  }
+  if (r.dt > 0.0 && r.end / r.dt > 1e12)
+    throw std::invalid_argument(r.path + ": " + fmt(r.end) + " s at dt " + fmt(r.dt) +
+                                " s are more than 1e12 control steps; the recording is damaged");
+}
+
+bool WorldHost::stop_requested() {
+  std::lock_guard lock(mutex_);
+  for (const Inbound& in : inbox_)
+    if (in.kind == Inbound::Kind::stop) {
+      stopping_ = true;
+      stop_reason_ = in.reason;
+      return true;
+    }
+  return false;
+}
+
+void WorldHost::seek_run_until(double t) {
+  // The other messages wait for the seek's end (handled mid-way, a seek or a state request would
+  // see the world on its way); only a stop cuts it short, so a long seek never holds SIGTERM up.
+  constexpr double kChunk = 0.05;  // wall seconds
+  const double dt = scene_.def.dt;
+  double span = dt > 0.0 ? 16.0 * dt : t;
+  while (server_->time() < t && !stop_requested()) {
+    const double from = server_->time(), start = now();
+    double next = std::min(t, from + span);
+    if (!(next > from)) next = t;
+    replay_run_until(next);
+    if (!(server_->time() > from)) break;  // it cannot go on (the world ended)
+    const double took = now() - start;
+    if (took < kChunk / 2) span *= 2.0;
+    else if (took > 2 * kChunk && dt > 0.0) span = std::max(dt, span / 2.0);
+  }
+}
 
 }  // namespace turtlegas::server

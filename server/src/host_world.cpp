@@ -14,6 +14,7 @@ namespace turtlegas::server {
 
 WorldHost::WorldHost(HostOptions options, const turtle::Registry& registry, world::Scene scene)
     : options_(std::move(options)), registry_(registry) {
+  check_replay();
   paused_ = options_.paused;
   speed_ = options_.speed;
   input_ = remote_input();

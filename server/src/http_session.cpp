@@ -128,10 +128,13 @@ Door make_door(const std::string& bind, unsigned short port, const std::vector<s
 HttpSession::HttpSession(boost::asio::ip::tcp::socket&& socket, WorldHost& host, std::filesystem::path web_root,
                          std::shared_ptr<const Door> door)
     : stream_(std::move(socket)), host_(host), web_root_(std::move(web_root)), door_(std::move(door)) {
+  host_.http_opened();
   boost::system::error_code ec;
   const auto peer = stream_.socket().remote_endpoint(ec);
   loopback_ = !ec && peer.address().is_loopback();
 }
+
+HttpSession::~HttpSession() { host_.http_closed(); }
 
 void HttpSession::run() { read(); }
 
@@ -141,6 +144,13 @@ void HttpSession::read() {
   parser_->header_limit(16 * 1024);
   stream_.expires_after(std::chrono::seconds(30));
   http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+    if (ec == http::error::header_limit) {  // the request line counts: a huge URL lands here too
+      Request req;
+      req.version(11);
+      req.keep_alive(false);
+      return self->write(self->respond(req, http::status::request_header_fields_too_large,
+                                       "the request line and headers may have at most 16 KiB\n", "text/plain"));
+    }
     if (ec) {
       beast::error_code ignored;
       self->stream_.socket().shutdown(boost::asio::ip::tcp::socket::shutdown_both, ignored);
@@ -166,6 +176,10 @@ std::shared_ptr<HttpSession::Response> HttpSession::respond(const Request& req, 
 
 void HttpSession::serve(Request req) {
   const std::string target(req.target());
+  if (target.size() > 8192) {
+    req.keep_alive(false);
+    return write(respond(req, http::status::uri_too_long, "a URL may have at most 8 KiB\n", "text/plain"));
+  }
   const std::string path = target.substr(0, target.find('?'));
   if (!door_->allows_host(sv(req[http::field::host])))
     return write(respond(req, http::status::forbidden,
@@ -179,7 +193,7 @@ void HttpSession::serve(Request req) {
                                "--allow-origin " + std::string(sv(origin->value()).substr(0, 200)) + " to let it\n",
                            "text/plain"));
     if (path != "/ws") return write(respond(req, http::status::not_found, "the WebSocket is at /ws\n", "text/plain"));
-    if (host_.clients_open() >= host_.options().limits.max_clients)
+    if (host_.connections_open() > host_.options().limits.max_clients)  // this connection counted once
       return write(respond(req, http::status::service_unavailable,
                            error_text("too_many_clients", "the server has its maximum of connections (--max-clients)") + "\n",
                            "application/json"));

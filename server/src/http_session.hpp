@@ -40,6 +40,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
   HttpSession(boost::asio::ip::tcp::socket&& socket, WorldHost& host, std::filesystem::path web_root,
               std::shared_ptr<const Door> door);
+  ~HttpSession();
+  HttpSession(const HttpSession&) = delete;
+  HttpSession& operator=(const HttpSession&) = delete;
   void run();
 
  private:

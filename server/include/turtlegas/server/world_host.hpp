@@ -92,6 +92,11 @@ class WorldHost {
   std::string world_text() const;
   const HostOptions& options() const { return options_; }
   std::size_t clients_open() const { return clients_open_.load(); }
+  /// HTTP connections (an HttpSession's life), counted with the clients against --max-clients.
+  void http_opened() { ++http_open_; }
+  void http_closed() { --http_open_; }
+  /// WebSocket, TCP-line and HTTP connections: what --max-clients bounds (docs/protocol.md, "Limits").
+  std::size_t connections_open() const { return clients_open_.load() + http_open_.load(); }
   std::uint64_t next_client_id() { return ++last_client_id_; }
 
   /// The simulation thread's loop: until a stop (a signal, --until, an output that cannot be
@@ -242,6 +247,15 @@ class WorldHost {
   void seek(double t);
   /// A replay's next target when it plays, forward or in reverse, and whether it has one.
   bool replay_target(double& target);
+  /// A replay's index and header checked against its keyframes before anything is built: a header
+  /// dt that is no time step is refused (std::invalid_argument), an end beyond the last keyframe
+  /// clamped to it with a warning.
+  void check_replay();
+  /// replay_run_until(t) in chunks of about 50 ms of wall time; between them a stop (SIGINT,
+  /// SIGTERM) is seen and ends the seek there.
+  void seek_run_until(double t);
+  /// A stop waits in the inbox: stopping_ is set (the rest of the inbox waits for the loop).
+  bool stop_requested();
 
   // `serve --record` and a replay's own inputs and views (host_recording.cpp).
   void start_recording();
@@ -315,6 +329,7 @@ class WorldHost {
   std::deque<Inbound> inbox_;
   std::atomic<bool> inbox_ready_{false};  ///< inbox_ is not empty (read without the lock, to spin on)
   std::atomic<std::size_t> clients_open_{0};
+  std::atomic<std::size_t> http_open_{0};
   std::atomic<std::uint64_t> last_client_id_{0};
 };
 
