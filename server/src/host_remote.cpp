@@ -19,11 +19,6 @@ namespace {
 
 using nlohmann::json;
 
-/// The lockstep wait ran out: ends the world (docs/protocol.md, "Lockstep and real time").
-struct LockstepTimeout : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
 }  // namespace
 
 class WorldHost::Input : public turtle::InputSource {
@@ -156,11 +151,25 @@ std::optional<turtle::RemoteCommand> WorldHost::next_command(std::uint64_t step,
     const double deadline = now() + options_.lockstep_timeout;
     while (!s.queued && s.owner != 0 && !stopping_) {
       const double t = now();
-      if (t >= deadline)
-        throw LockstepTimeout("lockstep timeout: turtle '" + scene_.def.turtles[turtle].id + "' (claimed by connection " +
-                              std::to_string(s.owner) + ") sent no command for " + fmt(options_.lockstep_timeout) +
-                              " s at t=" + fmt(server_->time()) +
-                              "; answer every result with a command, or serve with --realtime or a longer --lockstep-timeout");
+      if (t >= deadline) {
+        // The client that holds the world up loses its claims, not everyone their world: its
+        // turtles stand still from here (docs/protocol.md, "Lockstep and real time").
+        const std::string why = "lockstep timeout: turtle '" + scene_.def.turtles[turtle].id + "' (claimed by connection " +
+                                std::to_string(s.owner) + ") sent no command for " + fmt(options_.lockstep_timeout) +
+                                " s at t=" + fmt(server_->time()) +
+                                "; this connection's claims are released and its turtles stand still. Answer every result "
+                                "with a command, or serve with --realtime or a longer --lockstep-timeout";
+        spdlog::warn("{}", why);
+        auto it = clients_.find(s.owner);
+        if (it == clients_.end()) {
+          s.owner = 0;
+          break;
+        }
+        ++it->second.errors;
+        reply_text(it->second, error_text("lockstep_timeout", why));
+        release_all(it->second, "lockstep timeout");
+        break;
+      }
       send_due_frames(t);
       double wake = deadline;
       for (const auto& [key, st] : streams_) wake = std::min(wake, st.next_due);
