@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
-#include <fstream>
-#include <sstream>
+#include <cstdint>
 #include <string_view>
+#include <tuple>
 
 #include <boost/asio/ip/address.hpp>
 #include <boost/asio/post.hpp>
@@ -222,15 +222,46 @@ void HttpSession::serve(Request req) {
     }
     return write(respond(req, http::status::not_found, "no such API: /api/world and /api/state\n", "text/plain"));
   }
-  if (const auto file = static_file(web_root_, path)) {
-    std::ifstream in(*file, std::ios::binary);
-    std::ostringstream body;
-    body << in.rdbuf();
-    return write(respond(req, http::status::ok, body.str(), content_type(*file)));
-  }
+  if (const auto file = static_file(web_root_, path)) return write_file(req, *file);
   if (path == "/" || path == "/index.html")
     return write(respond(req, http::status::ok, std::string(placeholder_page), "text/html; charset=utf-8"));
   write(respond(req, http::status::not_found, "not found\n", "text/plain"));
+}
+
+void HttpSession::write_file(const Request& req, const std::filesystem::path& file) {
+  http::file_body::value_type body;
+  beast::error_code ec;
+  body.open(file.c_str(), beast::file_mode::scan, ec);
+  if (ec) return write(respond(req, http::status::not_found, "not found\n", "text/plain"));
+  const std::uint64_t size = body.size();
+  auto res = std::make_shared<http::response<http::file_body>>(std::piecewise_construct, std::make_tuple(std::move(body)),
+                                                                std::make_tuple(http::status::ok, req.version()));
+  res->set(http::field::server, std::string(server_name));
+  res->set(http::field::content_type, content_type(file));
+  res->set(http::field::cache_control, "no-store");
+  res->keep_alive(req.keep_alive());
+  res->content_length(size);
+  if (req.method() == http::verb::head) {  // the headers alone: an empty body of the file's length
+    auto head = std::make_shared<http::response<http::empty_body>>(http::status::ok, req.version());
+    head->base() = res->base();
+    auto& out = *head;
+    return http::async_write(stream_, out, [self = shared_from_this(), head](beast::error_code e, std::size_t) {
+      self->written(e, head->keep_alive());
+    });
+  }
+  auto& out = *res;
+  http::async_write(stream_, out, [self = shared_from_this(), res](beast::error_code e, std::size_t) {
+    self->written(e, res->keep_alive());
+  });
+}
+
+void HttpSession::written(beast::error_code ec, bool keep_alive) {
+  if (ec || !keep_alive) {
+    beast::error_code ignored;
+    stream_.socket().shutdown(boost::asio::ip::tcp::socket::shutdown_send, ignored);
+    return;
+  }
+  read();
 }
 
 void HttpSession::write(std::shared_ptr<Response> res) {

@@ -51,6 +51,10 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void read();
   void serve(Request req);
   void write(std::shared_ptr<Response> res);
+  /// A static file, streamed from disk as the socket takes it (not read whole into memory).
+  void write_file(const Request& req, const std::filesystem::path& file);
+  /// After a response is written: the next request, or the connection shut.
+  void written(boost::beast::error_code ec, bool keep_alive);
   std::shared_ptr<Response> respond(const Request& req, boost::beast::http::status status, std::string body,
                                     const char* type);
 

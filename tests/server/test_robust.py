@@ -132,6 +132,47 @@ def test_huge_url_and_headers():
         check(s.stop() == 0, "stops")
 
 
+def rss_bytes(pid):
+    for line in open("/proc/%d/status" % pid):
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) * 1024
+    return 0
+
+
+def test_static_files_streamed():
+    root = tempfile.mkdtemp()
+    try:
+        size = 64 << 20
+        with open(os.path.join(root, "big.bin"), "wb") as f:
+            f.write(os.urandom(1 << 20) * 64)
+        with Server(world("protocol_room.json"), "--paused", "--web-root", root) as s:
+            before = rss_bytes(s.proc.pid)
+            slow = socket.create_connection(("127.0.0.1", s.http_port), timeout=10)
+            slow.sendall(b"GET /big.bin HTTP/1.1\r\nHost: 127.0.0.1:%d\r\n\r\n" % s.http_port)
+            got = slow.recv(4096)
+            check(got.startswith(b"HTTP/1.1 200"), "the big file is served: %r" % got[:40])
+            time.sleep(0.5)
+            grown = rss_bytes(s.proc.pid) - before
+            check(grown < 16 << 20, "a slow reader of a 64 MiB file: the server grew %.1f MiB (it is streamed, not read whole)" % (grown / 2**20))
+            n = len(got) - got.index(b"\r\n\r\n") - 4
+            slow.settimeout(30)
+            while n < size:
+                chunk = slow.recv(1 << 20)
+                if not chunk:
+                    break
+                n += len(chunk)
+            slow.close()
+            check(n == size, "all of it arrives: %d of %d bytes" % (n, size))
+            c = http.client.HTTPConnection("127.0.0.1", s.http_port, timeout=10)
+            c.request("HEAD", "/big.bin")
+            r = c.getresponse()
+            check(r.status == 200 and r.getheader("Content-Length") == str(size) and r.read() == b"", "HEAD: the length, no body")
+            c.close()
+            check(s.stop() == 0, "stops")
+    finally:
+        shutil.rmtree(root)
+
+
 if __name__ == "__main__":
     main([test_replay_index_beyond_keyframes, test_http_counted_by_max_clients, test_out_of_descriptors_does_not_spin,
-          test_huge_url_and_headers])
+          test_huge_url_and_headers, test_static_files_streamed])
