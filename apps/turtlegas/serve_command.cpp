@@ -2,6 +2,7 @@
 #include "serve_command.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -45,6 +46,33 @@ void add_max_clients_option(CLI::App& s, ServeCommandOptions& opt) {
 
 }  // namespace
 
+namespace {
+
+void add_door_options(CLI::App& s, ServeCommandOptions& opt) {
+  s.add_option("--token-file", opt.token_file, "Read the token from this file (its first line); the environment's TURTLEGAS_TOKEN is the other way");
+  s.add_option("--allow-origin", opt.allow_origins,
+               "Let the page at this origin (http://name:port) use the WebSocket, and answer HTTP for that name; "
+               "'*' for any (by default only 127.0.0.1, localhost, [::1] and --bind, with the port)");
+}
+
+/// --token, else --token-file's first line, else $TURTLEGAS_TOKEN, else none.
+std::optional<std::string> read_token(const ServeCommandOptions& opt) {
+  if (!opt.token.empty() && !opt.token_file.empty()) throw BadInput("--token and --token-file: give one of them");
+  if (!opt.token.empty()) return opt.token;
+  if (!opt.token_file.empty()) {
+    std::ifstream in(opt.token_file, std::ios::binary);
+    std::string line;
+    if (!in || !std::getline(in, line)) throw BadInput("--token-file: cannot read '" + opt.token_file + "'");
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
+    if (line.empty()) throw BadInput("--token-file: '" + opt.token_file + "' has an empty first line; put the token there");
+    return line;
+  }
+  if (const char* env = std::getenv("TURTLEGAS_TOKEN"); env && *env) return std::string(env);
+  return std::nullopt;
+}
+
+}  // namespace
+
 CLI::App* add_serve_command(CLI::App& app, ServeCommandOptions& opt) {
   CLI::App* s = app.add_subcommand("serve", "Run a world in real time and serve it on the network (docs/protocol.md)");
   s->add_option("world", opt.world, "World file (format turtlegas-world/1)")->required();
@@ -52,7 +80,8 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommandOptions& opt) {
   add_port_options(*s, opt);
   s->add_option("--speed", opt.speed, "Simulated seconds per wall second, 0.01 to 1000, or max")->capture_default_str();
   s->add_flag("--paused", opt.paused, "Start paused");
-  s->add_option("--token", opt.token, "Token that control messages and claims need");
+  s->add_option("--token", opt.token, "Token that control messages and claims need (shows in `ps`: prefer --token-file or TURTLEGAS_TOKEN)");
+  add_door_options(*s, opt);
   s->add_option("--until", opt.until, "Stop at this simulated time, as on SIGINT")
       ->check(real_in(0, std::numeric_limits<double>::max(), "seconds"));
   s->add_option("--events", opt.events, "Write the event log here (JSON lines, as `run --events`)");
@@ -99,7 +128,8 @@ CLI::App* add_replay_command(CLI::App& app, ServeCommandOptions& opt) {
   add_port_options(*s, opt);
   s->add_option("--speed", opt.speed, "Simulated seconds per wall second, 0.01 to 1000, or max")->capture_default_str();
   s->add_flag("--paused", opt.paused, "Start paused");
-  s->add_option("--token", opt.token, "Token that control messages need");
+  s->add_option("--token", opt.token, "Token that control messages need (shows in `ps`: prefer --token-file or TURTLEGAS_TOKEN)");
+  add_door_options(*s, opt);
   s->add_option("--web-root", opt.web_root, "Static files for GET / (default: the installed share/turtlegas/web beside the program, else the source tree's server/web)");
   add_max_clients_option(*s, opt);
   add_stack_kib_option(*s, opt.stack_kib);
@@ -168,7 +198,8 @@ PreparedServe prepare_serve(const ServeCommandOptions& opt, const turtle::Regist
       throw BadInput("--save-dir: '" + opt.save_dir + "' is not a directory; create it first");
     h.save_dir = std::filesystem::canonical(opt.save_dir, fe);
   }
-  if (!opt.token.empty()) h.token = opt.token;
+  h.token = read_token(opt);
+  so.allow_origins = opt.allow_origins;
   h.lockstep_timeout = opt.lockstep_timeout;
   h.stack_bytes = opt.stack_kib * 1024;
   h.program_budget = opt.program_budget;

@@ -24,6 +24,8 @@ struct ServeCommandOptions {
   std::string speed = "1";
   bool paused = false;
   std::string token;
+  std::string token_file;  ///< --token-file: the token read from here (kept out of `ps`)
+  std::vector<std::string> allow_origins;  ///< --allow-origin (docs/protocol.md, "Who gets in")
   std::optional<double> until;
   std::string events, inputs_out, save_dir, web_root;
   std::size_t max_clients = 64, max_claims = 8, max_message = 1024 * 1024;

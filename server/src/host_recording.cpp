@@ -11,10 +11,13 @@
 
 #include <spdlog/spdlog.h>
 
+#include "host_text.hpp"
 #include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/state_file.hpp"
+#include "turtlegas/server/protocol.hpp"
 #include "turtlegas/server/world_host.hpp"
 #include "turtlegas/sim/mode_names.hpp"
+#include "turtlegas/world/world_file.hpp"
 #include "turtlegas/world/entries.hpp"
 
 namespace turtlegas::server {
@@ -79,7 +82,7 @@ void WorldHost::finish_recording(const std::string& stopped, bool keyframe) {
   recorder_->finish(keyframe ? server_->time() : recorder_->last_keyframe_time(), stopped);
   recorder_.reset();
   record_file_->close();
-  if (!*record_file_) spdlog::error("--record: writing '{}' failed (disk full?)", options_.record_path);
+  if (!*record_file_) output_failed("--record", options_.record_path);
   record_file_.reset();
   spdlog::info("recording '{}' closed at t={}{}", options_.record_path, server_->time(),
                stopped.empty() ? std::string() : " (" + stopped + ")");
@@ -92,7 +95,7 @@ void WorldHost::record_view(const char* op, const nlohmann::json& view) {
 std::shared_ptr<turtle::InputSource> WorldHost::world_input() {
   if (!options_.replay || options_.replay->inputs.empty()) return nullptr;
   // A fresh reader for every build: a seek backwards replays the inputs from the start. A spawn
-  // grows the host's scene as a live spawn does (body_changes.cpp), so that ids and frames name it.
+  // grows the host's scene as a live spawn does (host_world_changes.cpp), so that ids and frames name it.
   formats::SpawnApplier spawn = [this](turtle::WorldServer& server, const nlohmann::json& entry) {
     spawn_into_scene(server, entry, options_.replay->path);
   };
@@ -155,6 +158,110 @@ std::string WorldHost::state_text() const {
   std::ostringstream out;
   formats::write_state(out, server_->world(), formats::RunNames{ball_ids_, scene_.def, server_->world()});
   return out.str();
+}
+
+void WorldHost::require_not_replay(const std::string& type) const {
+  if (options_.replay)
+    throw RequestError("replay", "\"" + type + "\" would change the world, and this is a replay of " + options_.replay->path +
+                                     ": it can only play, pause, seek, reverse, step and change speed");
+}
+
+bool WorldHost::replay_target(double& target) {
+  const double t = server_->time(), dt = scene_.def.dt, end = options_.replay->end;
+  if (!reverse_ || steps_left_ > 0) {
+    if (t >= end) return false;
+    if (!(target > t)) target = std::nextafter(t, INFINITY);
+    target = std::min(target, end);
+    return true;
+  }
+  if (t <= 0.0) return false;
+  target = dt > 0.0 ? std::max(0.0, (std::ceil(t / dt) - 1.0) * dt) : 0.0;
+  if (!(target < t)) target = std::max(0.0, target - dt);
+  return true;
+}
+
+void WorldHost::seek(double t) {
+  const bool back = t < server_->time();
+  fan_out_events();
+  const bool restored = restore_snapshot(t);
+  const bool rebuild = back && !restored;
+  if (rebuild) {
+    world::Scene scene = world::parse_scene(world_text(), options_.world_file, registry_);
+    scene.def.dt = options_.replay->dt;
+    build_world(std::move(scene));
+  }
+  in_step_ = true;
+  try {
+    seek_run_until(t);
+  } catch (const std::exception& e) {
+    in_step_ = false;
+    events_.clear();
+    end_world(e.what());
+    return;
+  }
+  in_step_ = false;
+  if (rebuild || restored) reopen_client_views();
+  events_.clear();  // what happened on the way is not shown: the viewer jumps
+  reanchor();
+  if (!rebuild && !restored) return;
+  std::map<std::string, FrameStream> fresh;
+  for (auto& [key, s] : streams_) fresh.try_emplace(key, s.kind(), *server_).first->second.next_due = now();
+  streams_ = std::move(fresh);
+  for (auto& [cid, c] : clients_)
+    if (c.stream) reply_text(c, snapshot_text(*server_, ball_ids_, claimed(), clock(), nullptr, world_json()["arena"], looks_));
+}
+
+
+void WorldHost::check_replay() {
+  if (!options_.replay) return;
+  ReplaySource& r = *options_.replay;
+  if (!(std::isfinite(r.dt) && r.dt >= 0.0 && r.dt <= 1e6))
+    throw std::invalid_argument(r.path + ": the header's dt (" + fmt(r.dt) +
+                                " s) is not a time step from 0 to 1e6 s; the recording is damaged");
+  double before = 0.0;
+  for (const double k : r.keyframes)
+    if (!(std::isfinite(k) && k >= before)) throw std::invalid_argument(r.path + ": keyframe times out of order or not finite; the recording is damaged");
+    else before = k;
+  if (!(r.end >= 0.0) || !std::isfinite(r.end) || (!r.keyframes.empty() && r.end > r.keyframes.back())) {
+    // A recording ends on its last keyframe (formats/recording.cpp writes one at its end): an index
+    // claiming more would make a seek run for ever.
+    const double last = r.keyframes.empty() ? 0.0 : r.keyframes.back();
+    spdlog::warn("{}: its index says it ends at t={} s, but its last keyframe is at t={} s; it is replayed to {} s",
+                 r.path, fmt(r.end), fmt(last), fmt(last));
+    r.end = last;
+  }
+  if (r.dt > 0.0 && r.end / r.dt > 1e12)
+    throw std::invalid_argument(r.path + ": " + fmt(r.end) + " s at dt " + fmt(r.dt) +
+                                " s are more than 1e12 control steps; the recording is damaged");
+}
+
+bool WorldHost::stop_requested() {
+  std::lock_guard lock(mutex_);
+  for (const Inbound& in : inbox_)
+    if (in.kind == Inbound::Kind::stop) {
+      stopping_ = true;
+      stop_reason_ = in.reason;
+      return true;
+    }
+  return false;
+}
+
+void WorldHost::seek_run_until(double t) {
+  // The other messages wait for the seek's end (handled mid-way, a seek or a state request would
+  // see the world on its way); only a stop cuts it short, so a long seek never holds SIGTERM up.
+  constexpr double kChunk = 0.05;  // wall seconds
+  const double dt = scene_.def.dt;
+  double span = dt > 0.0 ? 16.0 * dt : t;
+  while (server_->time() < t && !stop_requested()) {
+    const double from = server_->time(), start = now();
+    double next = std::min(t, from + span);
+    if (!(next > from)) next = t;
+    replay_run_until(next);
+    if (!(server_->time() > from)) break;  // it cannot go on (the world ended)
+    const double took = now() - start;
+    if (took < kChunk / 2) span *= 2.0;
+    else if (took > 2 * kChunk && dt > 0.0) span = std::max(dt, span / 2.0);
+  }
 }
 
 }  // namespace turtlegas::server

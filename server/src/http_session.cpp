@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: MIT
 #include "http_session.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
-#include <fstream>
-#include <sstream>
+#include <cstdint>
 #include <string_view>
+#include <tuple>
 
+#include <boost/asio/ip/address.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/beast/websocket.hpp>
 
@@ -68,14 +71,70 @@ std::optional<std::filesystem::path> static_file(const std::filesystem::path& ro
   return full;
 }
 
+std::string_view sv(beast::string_view v) { return {v.data(), v.size()}; }
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
 }  // namespace
 
-HttpSession::HttpSession(boost::asio::ip::tcp::socket&& socket, WorldHost& host, std::filesystem::path web_root)
-    : stream_(std::move(socket)), host_(host), web_root_(std::move(web_root)) {
+bool Door::allows_host(std::string_view host) const {
+  if (anyone || host.empty()) return true;  // no Host (HTTP/1.0): not a browser's request
+  const std::string h = lower(host);
+  return std::find(hosts.begin(), hosts.end(), h) != hosts.end();
+}
+
+bool Door::allows_origin(std::string_view origin) const {
+  if (anyone) return true;
+  const std::string o = lower(origin);
+  return std::find(origins.begin(), origins.end(), o) != origins.end();
+}
+
+std::string Door::names() const {
+  std::string out;
+  for (const std::string& h : hosts) out += (out.empty() ? "" : ", ") + h;
+  return out;
+}
+
+Door make_door(const std::string& bind, unsigned short port, const std::vector<std::string>& allowed) {
+  Door d;
+  const std::string p = ":" + std::to_string(port);
+  std::vector<std::string> names = {"127.0.0.1", "localhost", "[::1]"};
+  boost::system::error_code ec;
+  const auto a = boost::asio::ip::make_address(bind, ec);
+  if (!ec && !a.is_unspecified()) names.push_back(a.is_v6() ? "[" + a.to_string() + "]" : a.to_string());
+  for (const std::string& n : names) {
+    if (std::find(d.hosts.begin(), d.hosts.end(), n + p) != d.hosts.end()) continue;
+    d.hosts.push_back(n + p);
+    d.origins.push_back("http://" + n + p);
+    if (port == 80) d.hosts.push_back(n);  // a browser leaves out the default port
+  }
+  for (const std::string& o : allowed) {
+    if (o == "*") {
+      d.anyone = true;
+      continue;
+    }
+    const std::string l = lower(o);
+    d.origins.push_back(l);
+    const std::size_t scheme = l.find("://");
+    if (scheme != std::string::npos) d.hosts.push_back(l.substr(scheme + 3));
+  }
+  return d;
+}
+
+HttpSession::HttpSession(boost::asio::ip::tcp::socket&& socket, WorldHost& host, std::filesystem::path web_root,
+                         std::shared_ptr<const Door> door)
+    : stream_(std::move(socket)), host_(host), web_root_(std::move(web_root)), door_(std::move(door)) {
+  host_.http_opened();
   boost::system::error_code ec;
   const auto peer = stream_.socket().remote_endpoint(ec);
   loopback_ = !ec && peer.address().is_loopback();
 }
+
+HttpSession::~HttpSession() { host_.http_closed(); }
 
 void HttpSession::run() { read(); }
 
@@ -85,6 +144,13 @@ void HttpSession::read() {
   parser_->header_limit(16 * 1024);
   stream_.expires_after(std::chrono::seconds(30));
   http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+    if (ec == http::error::header_limit) {  // the request line counts: a huge URL lands here too
+      Request req;
+      req.version(11);
+      req.keep_alive(false);
+      return self->write(self->respond(req, http::status::request_header_fields_too_large,
+                                       "the request line and headers may have at most 16 KiB\n", "text/plain"));
+    }
     if (ec) {
       beast::error_code ignored;
       self->stream_.socket().shutdown(boost::asio::ip::tcp::socket::shutdown_both, ignored);
@@ -110,10 +176,24 @@ std::shared_ptr<HttpSession::Response> HttpSession::respond(const Request& req, 
 
 void HttpSession::serve(Request req) {
   const std::string target(req.target());
+  if (target.size() > 8192) {
+    req.keep_alive(false);
+    return write(respond(req, http::status::uri_too_long, "a URL may have at most 8 KiB\n", "text/plain"));
+  }
   const std::string path = target.substr(0, target.find('?'));
+  if (!door_->allows_host(sv(req[http::field::host])))
+    return write(respond(req, http::status::forbidden,
+                         "Host '" + std::string(sv(req[http::field::host]).substr(0, 200)) + "' is not this server (it answers to " +
+                             door_->names() + "); serve with --allow-origin http://NAME:PORT to be reached by another name\n",
+                         "text/plain"));
   if (beast::websocket::is_upgrade(req)) {
+    if (const auto origin = req.find(http::field::origin); origin != req.end() && !door_->allows_origin(sv(origin->value())))
+      return write(respond(req, http::status::forbidden,
+                           "a page from '" + std::string(sv(origin->value()).substr(0, 200)) + "' may not use this server; serve with "
+                               "--allow-origin " + std::string(sv(origin->value()).substr(0, 200)) + " to let it\n",
+                           "text/plain"));
     if (path != "/ws") return write(respond(req, http::status::not_found, "the WebSocket is at /ws\n", "text/plain"));
-    if (host_.clients_open() >= host_.options().limits.max_clients)
+    if (host_.connections_open() > host_.options().limits.max_clients)  // this connection counted once
       return write(respond(req, http::status::service_unavailable,
                            error_text("too_many_clients", "the server has its maximum of connections (--max-clients)") + "\n",
                            "application/json"));
@@ -127,7 +207,7 @@ void HttpSession::serve(Request req) {
     return write(res);
   }
   if (path.rfind("/api/", 0) == 0) {
-    if (host_.options().token && !loopback_ && req[http::field::authorization] != "Bearer " + *host_.options().token)
+    if (host_.options().token && !loopback_ && !same_token(sv(req[http::field::authorization]), "Bearer " + *host_.options().token))
       return write(respond(req, http::status::unauthorized, "send the header Authorization: Bearer TOKEN\n", "text/plain"));
     if (path == "/api/world") return write(respond(req, http::status::ok, host_.world_text(), "application/json"));
     if (path == "/api/state") {
@@ -142,15 +222,46 @@ void HttpSession::serve(Request req) {
     }
     return write(respond(req, http::status::not_found, "no such API: /api/world and /api/state\n", "text/plain"));
   }
-  if (const auto file = static_file(web_root_, path)) {
-    std::ifstream in(*file, std::ios::binary);
-    std::ostringstream body;
-    body << in.rdbuf();
-    return write(respond(req, http::status::ok, body.str(), content_type(*file)));
-  }
+  if (const auto file = static_file(web_root_, path)) return write_file(req, *file);
   if (path == "/" || path == "/index.html")
     return write(respond(req, http::status::ok, std::string(placeholder_page), "text/html; charset=utf-8"));
   write(respond(req, http::status::not_found, "not found\n", "text/plain"));
+}
+
+void HttpSession::write_file(const Request& req, const std::filesystem::path& file) {
+  http::file_body::value_type body;
+  beast::error_code ec;
+  body.open(file.c_str(), beast::file_mode::scan, ec);
+  if (ec) return write(respond(req, http::status::not_found, "not found\n", "text/plain"));
+  const std::uint64_t size = body.size();
+  auto res = std::make_shared<http::response<http::file_body>>(std::piecewise_construct, std::make_tuple(std::move(body)),
+                                                                std::make_tuple(http::status::ok, req.version()));
+  res->set(http::field::server, std::string(server_name));
+  res->set(http::field::content_type, content_type(file));
+  res->set(http::field::cache_control, "no-store");
+  res->keep_alive(req.keep_alive());
+  res->content_length(size);
+  if (req.method() == http::verb::head) {  // the headers alone: an empty body of the file's length
+    auto head = std::make_shared<http::response<http::empty_body>>(http::status::ok, req.version());
+    head->base() = res->base();
+    auto& out = *head;
+    return http::async_write(stream_, out, [self = shared_from_this(), head](beast::error_code e, std::size_t) {
+      self->written(e, head->keep_alive());
+    });
+  }
+  auto& out = *res;
+  http::async_write(stream_, out, [self = shared_from_this(), res](beast::error_code e, std::size_t) {
+    self->written(e, res->keep_alive());
+  });
+}
+
+void HttpSession::written(beast::error_code ec, bool keep_alive) {
+  if (ec || !keep_alive) {
+    beast::error_code ignored;
+    stream_.socket().shutdown(boost::asio::ip::tcp::socket::shutdown_send, ignored);
+    return;
+  }
+  read();
 }
 
 void HttpSession::write(std::shared_ptr<Response> res) {

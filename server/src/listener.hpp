@@ -7,6 +7,7 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 namespace turtlegas::server::detail {
 
@@ -24,6 +25,7 @@ class Listener : public std::enable_shared_from_this<Listener> {
   boost::asio::io_context& ioc_;
   boost::asio::ip::tcp::acceptor acceptor_;
   OnAccept on_accept_;
+  boost::asio::steady_timer backoff_;  ///< after a failed accept (EMFILE): wait, do not spin
 };
 
 }  // namespace turtlegas::server::detail

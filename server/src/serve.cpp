@@ -63,22 +63,28 @@ int serve(ServeOptions options, const turtle::Registry& registry, world::Scene s
                                std::to_string(port) + ": " + e.code().message() + " (choose another port, or 0 for any)");
     }
   };
-  http = listen(options.port, [&host, web_root](asio::ip::tcp::socket&& s) {
-    std::make_shared<detail::HttpSession>(std::move(s), host, web_root)->run();
+  // Filled in once the port is known (port 0), before the first accept.
+  auto door = std::make_shared<detail::Door>();
+  // Over --max-clients: told once, then closed (docs/protocol.md, "Limits").
+  auto refuse = [](asio::ip::tcp::socket&& s, std::string text) {
+    auto sock = std::make_shared<asio::ip::tcp::socket>(std::move(s));
+    auto shared = std::make_shared<std::string>(std::move(text));
+    asio::async_write(*sock, asio::buffer(*shared), [sock, shared](boost::system::error_code, std::size_t) {
+      boost::system::error_code ignored;
+      sock->shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
+    });
+  };
+  const std::string too_many = error_text("too_many_clients", "the server has its maximum of connections (--max-clients)");
+  http = listen(options.port, [&host, web_root, door, refuse, too_many](asio::ip::tcp::socket&& s) {
+    if (host.connections_open() >= host.options().limits.max_clients)
+      return refuse(std::move(s), "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\nContent-Length: " +
+                                      std::to_string(too_many.size() + 1) + "\r\nConnection: close\r\n\r\n" + too_many + "\n");
+    std::make_shared<detail::HttpSession>(std::move(s), host, web_root, door)->run();
   }, "HTTP");
+  *door = detail::make_door(options.bind, http->port(), options.allow_origins);
   const unsigned short line_port = options.line_port ? *options.line_port : options.port == 0 ? 0 : static_cast<unsigned short>(options.port + 1);
-  lines = listen(line_port, [&host](asio::ip::tcp::socket&& s) {
-    if (host.clients_open() >= host.options().limits.max_clients) {
-      // Told once, then closed (docs/protocol.md, "Limits").
-      auto sock = std::make_shared<asio::ip::tcp::socket>(std::move(s));
-      auto text = std::make_shared<std::string>(
-          error_text("too_many_clients", "the server has its maximum of connections (--max-clients)") + "\n");
-      asio::async_write(*sock, asio::buffer(*text), [sock, text](boost::system::error_code, std::size_t) {
-        boost::system::error_code ignored;
-        sock->shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
-      });
-      return;
-    }
+  lines = listen(line_port, [&host, refuse, too_many](asio::ip::tcp::socket&& s) {
+    if (host.connections_open() >= host.options().limits.max_clients) return refuse(std::move(s), too_many + "\n");
     std::make_shared<detail::LineSession>(std::move(s), host)->run();
   }, "TCP lines");
   http->run();

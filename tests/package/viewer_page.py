@@ -13,7 +13,7 @@ from pathlib import Path
 
 def check_installed_viewer(turtlegas, web, world, fail):
     web = Path(web)
-    for name in ("index.html", "viewer.js", "viewer.css"):
+    for name in ("index.html", "viewer.js", "protocol.js", "geometry.js", "panels.js", "draw.js", "viewer.css"):
         if not (web / name).is_file():
             fail("the viewer's " + name + " is not installed in " + str(web))
     mark = "<!-- installed copy: viewer_page.py -->"

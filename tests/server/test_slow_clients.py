@@ -26,8 +26,8 @@ def test_stallers_do_not_slow_a_good_viewer():
         lazy.sendall(b'{"type": "hello", "protocol": "turtlegas/1"}\n{"type": "subscribe", "rate": 120, "events": "all"}\n')
         # Half a WebSocket frame: the upgrade, then 2 bytes of a frame header promising 100 bytes.
         ws_half = socket.create_connection(("127.0.0.1", s.http_port))
-        ws_half.sendall(b"GET /ws HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-                        b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n")
+        ws_half.sendall(b"GET /ws HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                        b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n" % s.http_port)
         check(b"101" in ws_half.recv(4096), "the half-frame client was upgraded")
         ws_half.sendall(bytes([0x81, 0x80 | 100]))
         # Half a line, and half an HTTP request.

@@ -85,16 +85,28 @@ def test_busy_loop_ends_its_world_not_the_process():
         check(s.stop() == 0, "and stops cleanly")
 
 
-def test_lockstep_timeout_ends_its_world():
+def test_lockstep_timeout_releases_the_client():
+    # Issue 32 section 1: the client that holds the world up loses its claims; the world goes on.
     with Server(world("remote_followers.json"), "--lockstep-timeout", "0.5", "--speed", "max") as s:
         w = World.connect("127.0.0.1", s.line_port)
         w.claim("righty")
-        ended = wait_ended(w)
-        check(ended and "lockstep timeout" in ended and "righty" in ended, "the timeout names the turtle: %r" % ended)
+        deadline, err = time.monotonic() + 30, None
+        while time.monotonic() < deadline and err is None:
+            n = w.notices.get(timeout=30)
+            check(not (n.get("type") == "status" and n["status"]["ended"]), "the world does not end: %r" % n)
+            if n.get("type") == "error" and n.get("code") == "lockstep_timeout":
+                err = n
+        check(err and "righty" in err["message"] and "released" in err["message"], "the client is told, the turtle named: %r" % err)
+        v = World.connect("127.0.0.1", s.line_port)
+        t0 = v.ping()["t"]
+        time.sleep(0.3)
+        t1 = v.ping()["t"]
+        check(v.status["ended"] is None and t1 > t0, "the world goes on for everyone: t %s -> %s" % (t0, t1))
+        v.claim("righty")  # released: free to claim again
         check(s.alive() and w.ping()["type"] == "pong", "the process serves on")
         check(s.stop() == 0, "stops cleanly")
 
 
 if __name__ == "__main__":
     main([test_sigint, test_sigterm, test_sigint_during_a_lockstep_wait, test_busy_loop_ends_its_world_not_the_process,
-          test_lockstep_timeout_ends_its_world])
+          test_lockstep_timeout_releases_the_client])

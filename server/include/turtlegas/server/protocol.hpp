@@ -22,9 +22,6 @@ namespace turtlegas::server {
 inline constexpr std::string_view protocol_name = "turtlegas/1";
 inline constexpr std::string_view server_name = "turtlegas serve 1";
 
-/// Every message type the server knows, in docs/protocol.md's order.
-const std::vector<std::string>& message_types();
-
 /// A message that fails: the error reply's code, message and JSON pointer (docs/protocol.md,
 /// "Errors"). Thrown by the readers below and by the host's handlers; nothing has changed.
 struct RequestError : std::runtime_error {
@@ -65,6 +62,10 @@ std::string_view pen_name(bool down, turtle::PenMode mode);
 /// The reply for a report of turtle `turtle_id`: a result (with `id` echoed when given), a touch,
 /// a message or a fault.
 std::string report_text(const turtle::RemoteReport& r, std::string_view turtle_id, const nlohmann::json& id);
+
+/// Whether `given` is `token`, in a time that does not depend on where they differ (a token guessed
+/// byte by byte from reply times would otherwise be possible).
+bool same_token(std::string_view given, std::string_view token);
 
 /// A save/load name: 1 to 100 of A-Z a-z 0-9 . _ -, not starting with '.'. Throws bad_path.
 void check_plain_name(const std::string& name);

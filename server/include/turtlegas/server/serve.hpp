@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "turtlegas/server/world_host.hpp"
 #include "turtlegas/turtle/registry.hpp"
@@ -18,6 +19,9 @@ struct ServeOptions {
   unsigned short port = 8080;           ///< 0: any free port
   std::optional<unsigned short> line_port;  ///< default: port + 1, or any free port when port is 0
   std::filesystem::path web_root;       ///< empty: default_web_root()
+  /// Pages (origins, "http://name:port") that may use the WebSocket and names the HTTP side answers
+  /// to, besides the server's own (docs/protocol.md, "Who gets in"); "*": any.
+  std::vector<std::string> allow_origins;
   HostOptions host;
 };
 

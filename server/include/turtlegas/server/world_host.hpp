@@ -19,6 +19,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -37,9 +38,6 @@
 #include "turtlegas/world/scene.hpp"
 
 namespace turtlegas::server {
-
-/// view_open, view_change or view_close (view_messages.cpp).
-bool is_view_message(const std::string& type);
 
 /// `turtlegas replay` (docs/recording.md): the host plays a recording instead of serving a live
 /// world. The world is the recording's, re-simulated (the run is deterministic, so the states are
@@ -94,9 +92,15 @@ class WorldHost {
   std::string world_text() const;
   const HostOptions& options() const { return options_; }
   std::size_t clients_open() const { return clients_open_.load(); }
+  /// HTTP connections (an HttpSession's life), counted with the clients against --max-clients.
+  void http_opened() { ++http_open_; }
+  void http_closed() { --http_open_; }
+  /// WebSocket, TCP-line and HTTP connections: what --max-clients bounds (docs/protocol.md, "Limits").
+  std::size_t connections_open() const { return clients_open_.load() + http_open_.load(); }
   std::uint64_t next_client_id() { return ++last_client_id_; }
 
-  /// The simulation thread's loop: until a stop (a signal, --until). Returns the exit code.
+  /// The simulation thread's loop: until a stop (a signal, --until, an output that cannot be
+  /// written). Returns the exit code: 0, or 1 when an output failed.
   int run();
   /// Called on the simulation thread once the loop has ended and every client was told.
   std::function<void()> on_finished;
@@ -131,7 +135,7 @@ class WorldHost {
     nlohmann::json id;
     sim::WallDef wall;
   };
-  struct BodyChange {  ///< spawn, remove or teleport (body_changes.cpp)
+  struct BodyChange {  ///< spawn, remove or teleport (host_world_changes.cpp)
     std::uint64_t client = 0;
     nlohmann::json id;
     std::string type;
@@ -154,28 +158,30 @@ class WorldHost {
     std::string file;
   };
 
-  // The simulation thread's side.
-  void build_world(world::Scene scene);
+  // The simulation thread's side. The loop, the inbox and the boundary (world_host.cpp, where the
+  // order of one turn is written down).
   void drain_inbox();
   bool wait_inbox_until(double steady_deadline);  ///< true when something arrived
+  void step_world(double target);
+  /// At each control boundary: the inbox, then takeovers, walls and body changes, in that order.
+  void at_boundary(turtle::WorldServer& server, std::uint64_t step);
+  double now() const;  ///< steady clock, seconds
+  void reanchor();
+
+  // The world (host_world.cpp).
+  void build_world(world::Scene scene);
+
+  // Dispatch (host_messages.cpp): the message table and the handlers every connection reaches.
+  enum class Access;
+  struct Handler;
+  static std::span<const Handler> handlers();
   void handle(Inbound& in);
   void handle_message(ClientState& c, const nlohmann::json& m);
-  /// view_open, view_change, view_close (view_messages.cpp).
-  void handle_view_message(ClientState& c, const nlohmann::json& m, const std::string& type);
-  std::string open_views_list() const;
-  void at_boundary(turtle::WorldServer& server, std::uint64_t step);
-  // spawn, remove, teleport (body_changes.cpp): checked on arrival, applied at the boundary.
-  void queue_body_change(ClientState& c, const nlohmann::json& m, const std::string& type);
-  void apply_body_changes(turtle::WorldServer& server, std::uint64_t step);
-  void refuse_body_changes(const std::string& reason);
-  std::optional<turtle::RemoteCommand> next_command(std::uint64_t step, std::size_t turtle);
-  void on_report(const turtle::RemoteReport& r);
-  void step_world(double target);
-  void fan_out_events();
-  void send_due_frames(double now);
-  void do_file_requests();
-  void end_world(const std::string& reason);
-  void release_all(ClientState& c, const char* why);
+  void on_hello(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void on_ping(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void on_stats(ClientState& c, const nlohmann::json& m, const std::string& type);
+
+  // Replies (host_replies.cpp).
   void reply(ClientState& c, const nlohmann::json& message);
   void reply_text(ClientState& c, std::string text);
   void broadcast(const std::string& text);
@@ -183,19 +189,73 @@ class WorldHost {
   nlohmann::json status_json() const;
   nlohmann::json world_json() const;
   nlohmann::json ok(const nlohmann::json& m, const char* request) const;
-  std::vector<bool> claimed() const;
-  FrameClock clock() const;
   std::size_t turtle_index(const nlohmann::json& m, const char* example) const;
   void require_live() const;
+
+  // Events and frames (host_frames.cpp).
+  void fan_out_events();
+  void send_due_frames(double now);
+  void end_world(const std::string& reason);
+  std::vector<bool> claimed() const;
+  FrameClock clock() const;
+  void on_subscribe(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void on_unsubscribe(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void on_snapshot(ClientState& c, const nlohmann::json& m, const std::string& type);
+
+  // Clock controls (host_control.cpp): pause, resume, step, speed, run_until; play, seek, reverse.
+  void on_pacing(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void on_replay_control(ClientState& c, const nlohmann::json& m, const std::string& type);
+
+  // Remote turtles (host_remote.cpp).
+  std::shared_ptr<turtle::InputSource> remote_input();
+  void on_claim(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void on_release(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void on_command(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void apply_takeovers(turtle::WorldServer& server, std::uint64_t step);
+  std::optional<turtle::RemoteCommand> next_command(std::uint64_t step, std::size_t turtle);
+  void on_report(const turtle::RemoteReport& r);
+  void release_all(ClientState& c, const char* why);
+
+  // World changes (host_world_changes.cpp): checked on arrival, applied at the boundary.
+  void on_add_wall(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void apply_wall_changes(turtle::WorldServer& server, std::uint64_t step);
+  void queue_body_change(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void apply_body_changes(turtle::WorldServer& server, std::uint64_t step);
+  void refuse_body_changes(const std::string& reason);
+
+  // Views (host_views.cpp): view_open, view_change, view_close.
+  void handle_view_message(ClientState& c, const nlohmann::json& m, const std::string& type);
+  std::string open_views_list() const;
+
+  // Files (host_files.cpp): save and load, the input log.
+  void on_file(ClientState& c, const nlohmann::json& m, const std::string& type);
+  void do_file_requests();
   void write_input(const std::string& line);
-  double now() const;  ///< steady clock, seconds
-  void reanchor();
+  /// What `path` is to the server when it reads or writes it ("the served world", "the live event
+  /// log (--events)", ...), else empty: save refuses those.
+  std::string in_use(const std::filesystem::path& path) const;
+  /// A log or the recording could not be written (errno says why): logged with the option and the
+  /// path, the server stops, and run() returns 1.
+  void output_failed(const char* option, const std::string& path);
+  /// output_failed() for each output stream that has gone bad.
+  void check_outputs();
+
+  // A replay's clock (host_recording.cpp).
   void require_not_replay(const std::string& type) const;
   /// A replay to time t: on from now when t is later, else the world rebuilt from its file and
   /// re-simulated from 0 (its events dropped); subscribers get a fresh snapshot after a rebuild.
   void seek(double t);
   /// A replay's next target when it plays, forward or in reverse, and whether it has one.
   bool replay_target(double& target);
+  /// A replay's index and header checked against its keyframes before anything is built: a header
+  /// dt that is no time step is refused (std::invalid_argument), an end beyond the last keyframe
+  /// clamped to it with a warning.
+  void check_replay();
+  /// replay_run_until(t) in chunks of about 50 ms of wall time; between them a stop (SIGINT,
+  /// SIGTERM) is seen and ends the seek there.
+  void seek_run_until(double t);
+  /// A stop waits in the inbox: stopping_ is set (the rest of the inbox waits for the loop).
+  bool stop_requested();
 
   // `serve --record` and a replay's own inputs and views (host_recording.cpp).
   void start_recording();
@@ -235,7 +295,7 @@ class WorldHost {
   world::Scene scene_;
   formats::IdTable ball_ids_;
   std::unique_ptr<turtle::WorldServer> server_;
-  std::shared_ptr<Input> input_;
+  std::shared_ptr<turtle::InputSource> input_;  ///< remote turtles' commands and the boundary (host_remote.cpp)
   std::vector<turtle::LogEvent> events_;
   std::optional<std::ofstream> events_file_, inputs_file_;
   std::optional<formats::EventLogWriter> events_writer_;
@@ -255,6 +315,8 @@ class WorldHost {
   std::uint64_t step_end_ = 0;    ///< the boundary the running step_world ends on
   double anchor_sim_ = 0.0, anchor_wall_ = 0.0;
   std::optional<std::string> ended_;
+  std::string output_error_;  ///< set: an output failed (output_failed)
+  std::filesystem::path served_file_;  ///< the world file served (the original, or the last `load`)
   bool stopping_ = false;
   std::string stop_reason_;
   bool in_step_ = false;
@@ -267,6 +329,7 @@ class WorldHost {
   std::deque<Inbound> inbox_;
   std::atomic<bool> inbox_ready_{false};  ///< inbox_ is not empty (read without the lock, to spin on)
   std::atomic<std::size_t> clients_open_{0};
+  std::atomic<std::size_t> http_open_{0};
   std::atomic<std::uint64_t> last_client_id_{0};
 };
 

@@ -29,10 +29,6 @@ constexpr std::string_view open_example =
 
 }  // namespace
 
-bool is_view_message(const std::string& type) {
-  return type == "view_open" || type == "view_change" || type == "view_close";
-}
-
 void WorldHost::handle_view_message(ClientState& c, const json& m, const std::string& type) {
   const auto v = m.find("view");
   if (v == m.end()) throw RequestError("missing_field", "/view is missing; send e.g. " + std::string(open_example), "/view");

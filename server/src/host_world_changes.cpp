@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The protocol's spawn, remove and teleport (docs/protocol.md, "World changes"): read and checked
+// The protocol's world changes (docs/protocol.md, "World changes"): add_wall, spawn, remove and
+// teleport. add_wall is checked for its fields on arrival and placed at the next boundary. Spawn,
+// remove and teleport are read and checked
 // when they arrive (a bad entry, an unknown body, a turtle another connection has claimed are
 // answered at once), applied at the next control boundary (WorldServer::spawn_ball and the
 // others, which check the placement), recorded in the input log and answered `ok` or `refused`.
@@ -8,6 +10,7 @@
 #include <string>
 #include <utility>
 
+#include "host_text.hpp"
 #include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/server/protocol.hpp"
 #include "turtlegas/server/world_host.hpp"
@@ -189,6 +192,46 @@ void WorldHost::refuse_body_changes(const std::string& reason) {
     reply_text(it->second, error_text("ended", "the world has ended (" + reason + ") before the change was made", &b.id, b.type));
   }
   body_changes_.clear();
+}
+
+void WorldHost::on_add_wall(ClientState& c, const json& m, const std::string& /*type*/) {
+  const json id = message_id(m);
+  require_live();
+  constexpr std::string_view ex = R"({"type": "add_wall", "wall": {"id": "w-new", "from": [100, 300], "to": [200, 300]}})";
+  const auto w = m.find("wall");
+  if (w == m.end()) throw RequestError("missing_field", "/wall is missing; send e.g. " + std::string(ex), "/wall");
+  if (!w->is_object()) throw RequestError("wrong_type", "/wall must be an object; send e.g. " + std::string(ex), "/wall");
+  WallChange change{c.client->id, id, {}};
+  const auto wid = w->find("id");
+  if (wid == w->end()) throw RequestError("missing_field", "/wall/id is missing: a wall needs an id no body has; send e.g. " + std::string(ex), "/wall/id");
+  if (!wid->is_string() || wid->get_ref<const std::string&>().empty() || wid->get_ref<const std::string&>().size() > 200)
+    throw RequestError("wrong_type", "/wall/id must be a non-empty string of at most 200 characters", "/wall/id");
+  change.wall.id = wid->get<std::string>();
+  change.wall.from = point_field(*w, "from", "/wall", ex);
+  change.wall.to = point_field(*w, "to", "/wall", ex);
+  wall_changes_.push_back(std::move(change));
+  // answered at the next boundary
+}
+
+void WorldHost::apply_wall_changes(turtle::WorldServer& server, std::uint64_t step) {
+  while (!wall_changes_.empty()) {
+    WallChange w = std::move(wall_changes_.front());
+    wall_changes_.pop_front();
+    auto it = clients_.find(w.client);
+    try {
+      server.add_wall(w.wall);
+      write_input(formats::input_wall_line(step, w.wall));
+      if (it != clients_.end()) {
+        json m = {{"id", w.id}};
+        reply(it->second, ok(m, "add_wall"));
+      }
+    } catch (const std::invalid_argument& e) {
+      if (it != clients_.end()) {
+        ++it->second.errors;
+        reply_text(it->second, error_text("refused", std::string("/wall: ") + e.what(), &w.id, "add_wall", "/wall"));
+      }
+    }
+  }
 }
 
 }  // namespace turtlegas::server

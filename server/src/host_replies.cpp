@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: MIT
+// The world host's replies: sending to one client or all, the status and world objects every
+// reply and welcome carries, `ok`, and the checks a request's handler starts with.
+#include <string>
+
+#include "host_text.hpp"
+#include "turtlegas/server/protocol.hpp"
+#include "turtlegas/server/world_host.hpp"
+#include "turtlegas/sim/mode_names.hpp"
+
+namespace turtlegas::server {
+
+using nlohmann::json;
+
+void WorldHost::reply(ClientState& c, const json& message) { reply_text(c, dump(message)); }
+
+void WorldHost::reply_text(ClientState& c, std::string text) {
+  c.client->send(std::make_shared<const std::string>(std::move(text)));
+}
+
+void WorldHost::broadcast(const std::string& text) {
+  const auto shared = std::make_shared<const std::string>(text);
+  for (auto& [id, c] : clients_)
+    if (c.hello) c.client->send(shared);
+}
+
+void WorldHost::broadcast_status() { broadcast(dump({{"type", "status"}, {"status", status_json()}})); }
+
+json WorldHost::status_json() const {
+  json st = {{"t", server_->time()},
+          {"step", server_->step()},
+          {"paused", paused_ && steps_left_ == 0},
+          {"speed", speed_ > 0.0 ? json(speed_) : json("max")},
+          {"until", pause_at_ ? json(*pause_at_) : json(nullptr)},
+          {"ended", ended_ ? json(*ended_) : json(nullptr)}};
+  if (options_.replay)
+    st["replay"] = {{"end", options_.replay->end}, {"reverse", reverse_}, {"complete", options_.replay->complete}};
+  return st;
+}
+
+json WorldHost::world_json() const {
+  const sim::WorldDef& def = scene_.def;
+  json turtles = json::array();
+  for (std::size_t i = 0; i < server_->turtle_count(); ++i) {
+    json sensors = json::array();
+    for (const turtle::SensorArc& a : scene_.programs[i].sensors) sensors.push_back(a.name);
+    turtles.push_back({{"id", def.turtles[i].id},
+                       {"index", i},
+                       {"controller", server_->controller(i)},
+                       {"remote", server_->is_remote(i)},
+                       {"claimed", slots_[i].owner != 0},
+                       {"radius", server_->world().turtle_radius(i)},
+                       {"sensors", sensors}});
+  }
+  return {{"name", def.name},
+          {"arena", {{"width", def.arena.width}, {"height", def.arena.height}, {"boundary", std::string(sim::to_string(def.arena.boundary))}}},
+          {"dt", def.dt},
+          {"mode", sim::to_string(options_.mode)},
+          {"remote", options_.realtime ? "realtime" : "lockstep"},
+          {"balls", server_->world().ball_count()},
+          {"walls", server_->world().walls().size()},
+          {"turtles", turtles},
+          {"views", views_json(*server_)}};
+}
+
+json WorldHost::ok(const json& m, const char* request) const {
+  json r = {{"type", "ok"}};
+  if (auto it = m.find("id"); it != m.end() && !it->is_null()) r["id"] = *it;
+  r["request"] = request;
+  r["status"] = status_json();
+  return r;
+}
+
+std::size_t WorldHost::turtle_index(const json& m, const char* example) const {
+  const std::string id = string_field(m, "turtle", example);
+  for (std::size_t i = 0; i < scene_.def.turtles.size(); ++i)
+    if (scene_.def.turtles[i].id == id) return i;
+  std::string known;
+  for (const sim::TurtleDef& t : scene_.def.turtles) known += (known.empty() ? "" : ", ") + t.id;
+  throw RequestError("unknown_turtle", "/turtle: no turtle '" + id + "' in this world (turtles: " +
+                                           (known.empty() ? "none" : known) + ")",
+                     "/turtle");
+}
+
+void WorldHost::require_live() const {
+  if (ended_)
+    throw RequestError("ended", "the world has ended (" + *ended_ + "); `load` a world to go on");
+}
+
+}  // namespace turtlegas::server
