@@ -7,10 +7,12 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <system_error>
 #include <vector>
 
 #include "turtlegas/world/world_file.hpp"
+#include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::apps {
 
@@ -25,8 +27,11 @@ world::Scene load(const std::string& file, const turtle::Registry& registry) {
 nlohmann::ordered_json read_world_json(const std::string& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw BadInput(file + ": cannot read it");
+  std::stringstream text;
+  text << in.rdbuf();
+  if (const auto deep = turtle::json_too_deep(text.str())) throw BadInput(file + ": " + *deep + " (docs/worlds.md)");
   try {
-    return nlohmann::ordered_json::parse(in);
+    return nlohmann::ordered_json::parse(text.str());
   } catch (const nlohmann::json::exception& e) {
     throw BadInput(file + ": not JSON (" + std::string(e.what()) + ")");
   }

@@ -37,6 +37,7 @@
 #include "turtlegas/world/scenario.hpp"
 #include "turtlegas/world/tag_tournament.hpp"
 #include "turtlegas/world/world_file.hpp"
+#include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::apps {
 namespace {
@@ -66,11 +67,19 @@ std::uint64_t fnv1a(const std::string& s) {
   return h;
 }
 
+/// json::parse(text, nullptr, false), with a text nested too deep (turtle::json_too_deep) discarded
+/// as invalid JSON is: a journal line or a child's report that no run wrote.
+json parse_or_discard(const std::string& text) {
+  if (turtle::json_too_deep(text)) return json(json::value_t::discarded);
+  return json::parse(text, nullptr, false);
+}
+
 json read_json_file(const std::string& file, const std::string& what) {
   std::ifstream in(file);
   if (!in) throw BadInput(file + ": no such file (" + what + ")");
   std::stringstream s;
   s << in.rdbuf();
+  if (const auto deep = turtle::json_too_deep(s.str())) throw BadInput(file + ": " + *deep + " (" + what + ")");
   json j = json::parse(s.str(), nullptr, false);
   if (j.is_discarded()) throw BadInput(file + ": invalid JSON (" + what + ")");
   return j;
@@ -85,6 +94,7 @@ Spec parse_spec(const std::string& file) {
     if (!in) throw BadInput(file + ": no such file (the sweep spec)");
     std::stringstream s;
     s << in.rdbuf();
+    if (const auto deep = turtle::json_too_deep(s.str())) throw BadInput(file + ": " + *deep + " (the sweep spec)");
     spec.text = nlohmann::ordered_json::parse(s.str(), nullptr, false);
     if (spec.text.is_discarded()) throw BadInput(file + ": invalid JSON (the sweep spec)");
   }
@@ -278,7 +288,7 @@ class Journal {
       std::string line;
       bool first = true;
       while (std::getline(in, line)) {
-        const json j = json::parse(line, nullptr, false);
+        const json j = parse_or_discard(line);
         if (first) {
           first = false;
           if (j.is_discarded() || j.value("fingerprint", "") != fp)
@@ -453,7 +463,7 @@ int run_local(const SweepOptions& options, const turtle::Registry&, const std::v
     const std::size_t k = pending[i];
     status.clear();
     if (r.stopped) return;  // killed at SIGINT or SIGTERM: left for the resumed sweep
-    const json j = json::parse(r.report, nullptr, false);
+    const json j = parse_or_discard(r.report);
     if (!r.timed_out && r.exited && r.exit_code == 0 && !j.is_discarded() && j.value("run", std::size_t(-1)) == k) {
       std::string line = r.report;
       while (!line.empty() && line.back() == '\n') line.pop_back();
@@ -508,7 +518,7 @@ int mpi_master(const SweepOptions& options, const Spec& spec, const std::string&
     std::string msg(static_cast<std::size_t>(count), '\0');
     MPI_Recv(msg.data(), count, MPI_CHAR, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     if (st.MPI_TAG == tag_result) {
-      const json j = json::parse(msg, nullptr, false);
+      const json j = parse_or_discard(msg);
       if (!j.is_discarded() && j.contains("error")) {
         ++failed;
         spdlog::error("sweep: run {} failed on rank {}: {}", j.value("run", 0), st.MPI_SOURCE, j.value("error", ""));
