@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes each libFuzzer harness (fuzz/) for SECONDS (default 60), one after another or, with
 # JOBS=N, all at once; corpora live in build/fuzz/corpus/NAME (seeded on the first run: the world
-# harnesses from worlds/, cli_fuzz and protocol_fuzz from fuzz/seeds/NAME) and findings in
+# harnesses from worlds/ and fuzz/seeds/worlds/, cli_fuzz and protocol_fuzz from fuzz/seeds/NAME) and findings in
 # build/fuzz/findings/NAME. Prints each harness's executions and coverage.
 #   scripts/fuzz.sh 1800                              # 30 minutes each
 #   JOBS=2 scripts/fuzz.sh 1800                       # all at once
@@ -31,6 +31,9 @@ for h in "${harnesses[@]}"; do
       # Seeds: the repository's world files, but not the benchmarks' (10^4 balls and more: slow,
       # and nothing the small ones do not reach).
       find worlds controllers/examples -name '*.json' -not -path 'worlds/bench/*' -exec cp {} "$corpus/" \;
+      # And inputs no world file of the tree is: JSON nested past the 512-level limit in an x- key,
+      # a recording's header line (docs/recording.md).
+      cp fuzz/seeds/worlds/* "$corpus/"
     fi
   fi
 done

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::apps {
 namespace {
@@ -63,9 +64,12 @@ void write_checkpoint(std::ostream& out, const Checkpoint& c) {
 Checkpoint read_checkpoint(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw BadInput("--resume " + path + ": no such file, or it cannot be read");
+  std::stringstream text;
+  text << in.rdbuf();
+  if (const auto deep = turtle::json_too_deep(text.str())) throw BadInput("--resume " + path + ": not a checkpoint: " + *deep);
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(in);
+    j = nlohmann::json::parse(text.str());
   } catch (const nlohmann::json::exception& e) {
     throw BadInput("--resume " + path + ": not a checkpoint (invalid JSON: " + e.what() + ")");
   }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "cli.hpp"
 
+#include <cstdlib>
 #include <exception>
 #include <ostream>
 
@@ -68,6 +69,9 @@ std::optional<int> parse(CommandLine& line, int argc, const char* const* argv, s
 
 int dispatch(const CommandLine& line, turtle::Registry& registry) {
   try {
+    // The environment's plugins first (docs/controllers.md), then the command line's; a file named
+    // by both is loaded once.
+    load_plugins(plugin_path_entries(std::getenv("TURTLEGAS_PLUGIN_PATH")), registry, "TURTLEGAS_PLUGIN_PATH");
     load_plugins(line.plugins, registry);
     switch (line.command()) {
       case Command::controllers: return controllers_command(registry);

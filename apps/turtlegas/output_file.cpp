@@ -42,6 +42,19 @@ void unregister_temporary(const char* path) {
   }
 }
 
+// The temporaries worth keeping when a busy loop ends the process (keep_on_busy_loop()), with the
+// targets they replace: the same kind of slots.
+struct Kept {
+  std::atomic<const char*> tmp{nullptr};
+  std::atomic<const char*> target{nullptr};
+};
+std::array<Kept, 8> g_kept{};
+
+void unkeep(const char* tmp) {
+  for (Kept& k : g_kept)
+    if (k.tmp.load() == tmp) k.target.store(nullptr), k.tmp.store(nullptr);
+}
+
 /// Follows symlinks (a chain of at most 40, as the kernel does) to the path they end at, which
 /// may not exist yet (a dangling link names the file to create).
 fs::path follow_links(fs::path p, std::string_view option) {
@@ -133,6 +146,7 @@ OutputFile::OutputFile(const std::string& path, std::string_view option, Write h
 
 OutputFile::~OutputFile() {
   if (kind_ != Kind::replaced || committed_) return;  // a growing file's .partial stays
+  unkeep(tmp_.c_str());
   unregister_temporary(tmp_.c_str());
   buf_.close();
   std::error_code ec;
@@ -154,6 +168,17 @@ std::ostream& OutputFile::stream() { return kind_ == Kind::standard_output ? std
 
 void OutputFile::flush() { stream().flush(); }
 
+void OutputFile::keep_on_busy_loop() {
+  if (kind_ != Kind::replaced) return;  // written in place: kept anyway
+  for (Kept& k : g_kept) {
+    const char* expected = nullptr;
+    if (k.tmp.compare_exchange_strong(expected, tmp_.c_str())) {
+      k.target.store(target_.c_str());
+      return;
+    }
+  }
+}
+
 void OutputFile::commit() {
   if (committed_) return;
   committed_ = true;
@@ -172,6 +197,7 @@ void OutputFile::commit() {
     case Kind::replaced: break;
   }
   const std::string why = close();
+  unkeep(tmp_.c_str());
   unregister_temporary(tmp_.c_str());
   std::error_code ec;
   if (!why.empty()) {
@@ -217,6 +243,21 @@ void check_outputs(const std::vector<NamedPath>& outputs, const std::vector<Name
 }
 
 bool any_output_committed() noexcept { return g_committed.load(); }
+
+std::size_t keep_temporaries() noexcept {
+  std::size_t kept = 0;
+  for (Kept& k : g_kept) {
+    const char* tmp = k.tmp.exchange(nullptr);
+    const char* target = k.target.exchange(nullptr);
+    if (tmp == nullptr || target == nullptr) continue;
+    if (::rename(tmp, target) == 0) {
+      ++kept;
+      unregister_temporary(tmp);
+    }
+  }
+  remove_temporaries();
+  return kept;
+}
 
 void remove_temporaries() noexcept {
   for (auto& slot : g_temporaries)

@@ -56,6 +56,9 @@ class OutputFile {
   /// Hands what has been written so far on to the target (a reader of a pipe or of standard
   /// output sees it at once; a replaced file's temporary has it on disk).
   void flush();
+  /// Marks the file as worth keeping as far as it was flushed when a busy loop ends the process
+  /// (keep_temporaries()): an event log, flushed whole lines at a time.
+  void keep_on_busy_loop();
   /// Finishes the file: closes it and, for a replaced or growing file, renames it over the
   /// target. Throws std::runtime_error when a write failed, saying why (strerror: "No space left on
   /// device") and leaving the target as it was.
@@ -95,6 +98,11 @@ void check_outputs(const std::vector<NamedPath>& outputs, const std::vector<Name
 /// Whether an output has been put in place (committed) by this process: async-signal-safe, for
 /// the crash report.
 bool any_output_committed() noexcept;
+
+/// Renames the temporary of every file marked by keep_on_busy_loop() over its target and removes
+/// the others; the number kept. Async-signal-safe (rename and unlink only), for the busy-loop exit
+/// (turtle::set_busy_loop_last_words).
+std::size_t keep_temporaries() noexcept;
 
 /// Removes every OutputFile's temporary file now: async-signal-safe (unlink only), for a fatal
 /// signal's handler and for exit() (crash_report.hpp).

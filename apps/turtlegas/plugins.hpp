@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Controller plugins (`--plugin`): shared modules that add controllers to the registry.
+// Controller plugins (`--plugin`, TURTLEGAS_PLUGIN_PATH, a world file's "plugins"): shared modules
+// that add controllers to the registry.
 #pragma once
 
 #include <string>
@@ -11,8 +12,16 @@ namespace turtlegas::apps {
 
 /// Loads controller plugins: shared modules exporting `extern "C" void turtlegas_register(Registry&)`,
 /// built against the same turtlegas headers and compiler (see docs/controllers.md). They stay loaded
-/// for the life of the program, since the registry holds their code. BadInput for a file that is
-/// not such a plugin.
-void load_plugins(const std::vector<std::string>& paths, turtle::Registry& registry);
+/// for the life of the program, since the registry holds their code. BadInput (naming the file and
+/// `given_by`, e.g. "TURTLEGAS_PLUGIN_PATH", when not empty) for a file that is not such a plugin:
+/// not a regular file (a FIFO is refused, never opened for reading), not a 64-bit shared library
+/// of this machine, cut short (a loadable segment past the file's end, which dlopen would map and
+/// crash on), without turtlegas_register, whose registration throws, or that registers a name
+/// already taken (a built-in controller, `remote`, or another plugin's).
+void load_plugins(const std::vector<std::string>& paths, turtle::Registry& registry, const std::string& given_by = {});
+
+/// The plugins a TURTLEGAS_PLUGIN_PATH value names: colon-separated entries, each a plugin file or
+/// a directory whose `*.so` files are all loaded (in name order). Empty entries are skipped.
+std::vector<std::string> plugin_path_entries(const char* value);
 
 }  // namespace turtlegas::apps

@@ -254,7 +254,10 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     if (const std::string bad = formats::check_observe(observing, 0.0, opt.until); !bad.empty()) throw BadInput(bad);
     observe_file.emplace(opt.observe, "--observe");
   }
-  if (!opt.events.empty()) events_file.emplace(opt.events, "--events");
+  if (!opt.events.empty()) {
+    events_file.emplace(opt.events, "--events");
+    events_file->keep_on_busy_loop();  // whole up to the last chunk: kept when a busy loop ends the process
+  }
   if (!opt.state_out.empty()) state_file.emplace(opt.state_out, "--state-out");
   if (!opt.stats_json.empty()) stats_file.emplace(opt.stats_json, "--stats-json");
   if (!opt.svg.empty()) svg_file.emplace(opt.svg, "--svg");
@@ -420,6 +423,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
       }
       if (write && recorder) recorder->events(server_events);
       server_events.clear();
+      if (write) note_run_time(server->world().time());  // how far the event log is whole
     };
   }
   const sim::World& world = server ? server->world() : *bare;
@@ -487,7 +491,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     }
   }
   if (recorder) recorder->keyframe(world, current_names());  // the first, at the start
-  if (end.first == Stop::until) {
+  if (end.first == Stop::until) try {
     limits.until = opt.until;
     end = run_in_chunks(world.time(), world.stats().events, limits, pace, start, progress, "", advance, [&] { flush(true); },
                         [&](double t, const std::string& why) {
@@ -510,6 +514,11 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
                             sampled.relative = std::max(sampled.relative, o.relative);
                           }
                         });
+  } catch (const turtle::BusyLoopError&) {
+    // A busy loop stopped at a safe point: the event log is kept up to the stop (the run fails).
+    flush(true);
+    if (events_file) events_file->commit();
+    throw;
   }
   progress.clear();
   if (server) {

@@ -166,6 +166,18 @@ void on_exit() {
   ::_exit(1);
 }
 
+/// After the runtime's line naming the busy-looping turtle (turtle::set_busy_loop_last_words).
+void on_busy_loop_exit() {
+  kill_child_groups();
+  Line line;
+  if (keep_temporaries() > 0)
+    line << "turtlegas: the event log is kept up to t = " << g_run_time.load(std::memory_order_relaxed)
+         << " s (the last chunk written); the other outputs are not written\n";
+  else
+    line << "turtlegas: outputs are not written\n";
+  line.write();
+}
+
 }  // namespace
 
 void install_stop_signals(const char* doing) {
@@ -210,6 +222,7 @@ void install_crash_report(const std::string& world) {
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = SA_ONSTACK | SA_RESETHAND;
   for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) sigaction(sig, &sa, nullptr);
+  turtle::set_busy_loop_last_words(&on_busy_loop_exit);
   static bool once = [] { return std::atexit(on_exit) == 0; }();
   (void)once;
 }

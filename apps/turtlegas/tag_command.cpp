@@ -20,6 +20,7 @@
 
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/tag_tournament.hpp"
+#include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::apps {
 
@@ -70,6 +71,7 @@ int run_tag_command(const TagCommandOptions& options, const turtle::Registry& re
     if (dot == std::string::npos || eq == std::string::npos || dot == 0 || eq < dot + 2)
       throw BadInput("--params " + p + ": write controller.key=value, e.g. --params tag_chaser.lunge=30");
     const std::string name = p.substr(0, dot), key = p.substr(dot + 1, eq - dot - 1), text = p.substr(eq + 1);
+    if (const auto deep = turtle::json_too_deep(text)) throw BadInput("--params " + p + ": the value is " + *deep);
     nlohmann::json value = nlohmann::json::parse(text, nullptr, false);
     if (value.is_discarded()) value = text;  // a bare word is a string
     t.params[name][key] = value;

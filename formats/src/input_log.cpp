@@ -12,6 +12,7 @@
 
 #include "turtlegas/formats/json_text.hpp"
 #include "turtlegas/turtle/view.hpp"
+#include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::formats {
 namespace {
@@ -152,6 +153,7 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
     auto fail = [&](const std::string& why) {
       throw std::invalid_argument(file_ + ":" + std::to_string(line) + ": " + why);
     };
+    if (const auto deep = turtle::json_too_deep(text)) fail(*deep);
     const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
     if (!j.is_object()) fail("not a JSON object; an input log has one object per line (docs/protocol.md)");
     if (!header) {

@@ -12,6 +12,7 @@
 #include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/json_text.hpp"
 #include "turtlegas/formats/state_file.hpp"
+#include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::formats {
 namespace {
@@ -107,8 +108,17 @@ void RecordingWriter::finish(double t, const std::string& stopped) {
 
 namespace {
 
+/// json::parse, with a line nested deeper than turtle::max_json_depth thrown out as damaged: it
+/// throws json::parse_error as an unfinished line does (the readers treat both alike).
+json parse_capped(const std::string& line) {
+  if (turtle::json_too_deep(line)) return json::parse("[");
+  return json::parse(line);
+}
+
 RecordingHeader parse_header(const std::string& line, const std::string& path) {
   const std::string where = path + ": ";
+  if (const auto deep = turtle::json_too_deep(line))
+    throw std::invalid_argument(where + "its header (the first line) is " + *deep);
   nlohmann::ordered_json h;
   try {
     h = nlohmann::ordered_json::parse(line);
@@ -180,12 +190,12 @@ Recording read_recording(const std::string& path) {
       const std::string end_line = nl == std::string::npos ? last : last.substr(nl + 1);
       if (starts_with(end_line, "{\"end_of_recording\":")) {
         try {
-          const std::uint64_t at = json::parse(end_line).at("end_of_recording").get<std::uint64_t>();
+          const std::uint64_t at = parse_capped(end_line).at("end_of_recording").get<std::uint64_t>();
           in.clear();
           in.seekg(static_cast<std::streamoff>(at));
           std::string index_line;
           std::getline(in, index_line);
-          const json idx = json::parse(index_line);
+          const json idx = parse_capped(index_line);
           for (const json& e : idx.at("index")) {
             Keyframe k;
             k.t = e.at("t").get<double>();
@@ -215,7 +225,7 @@ Recording read_recording(const std::string& path) {
     if (!whole) break;
     if (starts_with(line, "{\"keyframe\":")) {
       try {
-        Keyframe k = parse_keyframe(json::parse(line));
+        Keyframe k = parse_keyframe(parse_capped(line));
         k.offset = offset;
         r.keyframes.push_back(std::move(k));
       } catch (const json::exception&) {
@@ -255,7 +265,7 @@ Keyframe read_keyframe(const std::string& path, const Keyframe& at) {
   std::string line;
   std::getline(in, line);
   try {
-    const json j = json::parse(line);
+    const json j = parse_capped(line);
     Keyframe k = parse_keyframe(j);
     k.offset = at.offset;
     k.state = j.at("state");

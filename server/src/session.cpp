@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "turtlegas/server/protocol.hpp"
+#include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::server::detail {
 
@@ -104,6 +105,10 @@ void Session::received(std::string_view text) {
   if (text.size() > limits.max_message) {
     refuse("too_large", "a message may have at most " + std::to_string(limits.max_message) + " bytes (this one has " +
                             std::to_string(text.size()) + "); it was skipped");
+    return;
+  }
+  if (const auto deep = turtle::json_too_deep(text)) {
+    refuse("bad_json", "a message " + *deep + " (docs/protocol.md); it was skipped");
     return;
   }
   nlohmann::json m = nlohmann::json::parse(text, nullptr, false);

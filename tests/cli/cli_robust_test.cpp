@@ -883,3 +883,54 @@ TEST_CASE("robust: SIGTERM and --max-wall-seconds stop a run inside one long adv
   CHECK(m_ended->code == 3);
   CHECK(json::parse(read(stats)).at("events") == 5000);
 }
+
+TEST_CASE("robust: JSON nested 100,000 deep is refused, naming the file and the limit, wherever it enters") {
+  // Before (18732e7): `check` passed a world nested 100,000 deep in an ignored x- key (exit 0),
+  // `run --record` died of SIGSEGV, and so did `render` of a recording whose header nests as deep
+  // (nlohmann::json copies and destroys values recursively); the spec of `sweep` and a checkpoint
+  // went the same way. Now each is refused before it is parsed (docs/worlds.md, "Keys").
+  TempDir dir;
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  const fs::path w = dir.write("deep.json", R"({"format": "turtlegas-world/1", "arena": {"width": 100, "height": 100, "boundary": "walls"},
+    "balls": [{"id": "b", "pos": [50, 50], "vel": [10, 3], "radius": 2}], "x-deep": )" + deep + "}");
+  const std::vector<std::vector<std::string>> commands = {
+      {"check", w.string()},
+      {"run", w.string(), "--until", "1"},
+      {"run", w.string(), "--until", "1", "--record", (dir.path / "r.tgrec").string()},
+  };
+  for (const auto& args : commands) {
+    const Result r = run(dir, args);
+    INFO(args[0] << " " << args.size() << " arguments: " << r.err);
+    CHECK(r.code == 2);
+    CHECK(contains(r.err, "deep.json"));
+    CHECK(contains(r.err, "nested more than 512 levels deep"));
+  }
+
+  // A recording whose header line nests as deep.
+  const fs::path good = dir.path / "good.tgrec";
+  const Result rec = run(dir, {"run", worlds + "gas.json", "--until", "0.5", "--record", good.string()});
+  REQUIRE(rec.code == 0);
+  std::string text = read(good);
+  const std::string head = R"({"format":"turtlegas-recording/1",)";
+  REQUIRE(text.rfind(head, 0) == 0);
+  text.insert(head.size(), R"("x-deep":)" + deep + ",");
+  const fs::path bad = dir.write("deep.tgrec", text);
+  const Result render = run(dir, {"render", bad.string(), "--at", "0.2", "--out", (dir.path / "x.svg").string()});
+  INFO(render.err);
+  CHECK(render.code == 2);
+  CHECK(contains(render.err, "deep.tgrec"));
+  CHECK(contains(render.err, "nested more than 512 levels deep"));
+
+  // A sweep spec and a checkpoint.
+  const fs::path spec = dir.write("spec.json", R"({"world": "gas.json", "x-deep": )" + deep + "}");
+  const Result sweep = run(dir, {"sweep", spec.string(), "--out", (dir.path / "out.jsonl").string()});
+  INFO(sweep.err);
+  CHECK(sweep.code == 2);
+  CHECK(contains(sweep.err, "nested more than 512 levels deep"));
+  const fs::path ckpt = dir.write("deep.ckpt", R"({"format": "turtlegas-checkpoint/1", "x-deep": )" + deep + "}");
+  const Result resume = run(dir, {"run", worlds + "gas.json", "--until", "1", "--resume", ckpt.string()});
+  INFO(resume.err);
+  CHECK(resume.code == 2);
+  CHECK(contains(resume.err, "--resume " + ckpt.string()));
+  CHECK(contains(resume.err, "nested more than 512 levels deep"));
+}

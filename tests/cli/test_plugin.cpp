@@ -2,17 +2,26 @@
 // A controller plugin for the CLI tests: programs that misbehave in the ways a run must survive
 // or report.
 //   spinner    drives a little, then loops without ever issuing another command (a busy loop)
+//   allocator  drives a little, then allocates and frees in a loop without a command (a busy loop
+//              that is inside malloc much of the time)
+//   poller     drives a little, then loops reading t.time() without a command (a busy loop that
+//              calls the Turtle API)
 //   swallower  catches every exception around its commands, the one that ends it at teardown too
 //   big_frame  calls a function with a 200 KiB local array (a frame far larger than the guard page)
 //   bad_amount forward(NaN) or right(inf), as params.call says
 //   crasher    after params.after seconds: a null dereference, abort() or exit(7) (params.how)
 //   segfaulter, aborter, exiter: drive a little, then crash in that way (`turtlegas test` fails that world)
+//   (TURTLEGAS_TEST_PLUGIN_THROW set: the registration throws; TURTLEGAS_TEST_PLUGIN_CLASH=NAME: it
+//   also registers NAME, for the loader's tests)
 //   chatty     logs a line, then drives back and forth (a passing world with a log)
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
+#include <memory>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "turtlegas/turtle/registry.hpp"
 #include "turtlegas/turtle/turtle.hpp"
@@ -44,6 +53,10 @@ int* volatile g_nowhere = nullptr;
 extern "C" void turtlegas_register(turtlegas::turtle::Registry& registry) {
   using turtlegas::turtle::Params;
   using turtlegas::turtle::Turtle;
+  // For the loader's tests: a registration that throws, or one that takes a name already taken.
+  if (std::getenv("TURTLEGAS_TEST_PLUGIN_THROW") != nullptr) throw std::runtime_error("asked to throw");
+  if (const char* name = std::getenv("TURTLEGAS_TEST_PLUGIN_CLASH"))
+    registry.add(name, [](Turtle& t, const Params&) { t.forward(1); }, "a clash, for tests");
   registry.add(
       "spinner",
       [](Turtle& t, const Params&) {
@@ -52,6 +65,22 @@ extern "C" void turtlegas_register(turtlegas::turtle::Registry& registry) {
         for (;;) n = n + 1;
       },
       "a busy loop, for tests");
+  registry.add(
+      "allocator",
+      [](Turtle& t, const Params&) {
+        t.forward(10);
+        std::vector<std::unique_ptr<std::string>> held(64);
+        for (std::uint64_t n = 0;; ++n) held[n % held.size()] = std::make_unique<std::string>(100 + n % 300, 'x');
+      },
+      "a busy loop that allocates, for tests");
+  registry.add(
+      "poller",
+      [](Turtle& t, const Params&) {
+        t.forward(10);
+        volatile double sum = 0.0;
+        for (;;) sum = sum + t.time();
+      },
+      "a busy loop that calls the Turtle API, for tests");
   registry.add(
       "swallower",
       [](Turtle& t, const Params&) {

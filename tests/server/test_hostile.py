@@ -26,8 +26,10 @@ COMMON = [
     ('{"type": "explode"}', "unknown_type"), ('{"type": "hello", "protocol": "turtlegas/0"}', "bad_protocol"),
     ('{"type": "hello"}', "missing_field"), ('{"type": "ping", "id": {"a": 1}}', "bad_value"),
     ('{"type": "' + "x" * 5000 + '"}', "unknown_type"),
-    ("[" * 30000 + "]" * 30000, "not_object"), ("[" * 30000, "bad_json"),
-    ('{"type": "ping", "id": ' + "[" * 20000 + "]" * 20000 + "}", "bad_value"),
+    # Nested past 512 levels: refused before parsing (docs/protocol.md), whatever the type.
+    ("[" * 30000 + "]" * 30000, "bad_json"), ("[" * 30000, "bad_json"),
+    ('{"type": "ping", "id": ' + "[" * 20000 + "]" * 20000 + "}", "bad_json"),
+    ("[" * 512 + "]" * 512, "not_object"),
 ]
 NO_HELLO = COMMON + [
     ('{"type": "pause"}', "hello_first"), ('{"type": "claim", "turtle": "t1"}', "hello_first"),
@@ -246,5 +248,26 @@ def test_claim_limit_and_disconnect_release():
         check(s.stop() == 0, "stops")
 
 
+
+def test_deep_json():
+    """A spawn nested 100,000 deep in an ignored x- key (200 KB, under --max-message): before, the
+    server died of SIGSEGV with no word. Now an error reply naming the limit, and the server and
+    the world go on."""
+    with Server(world("protocol_room.json"), "--paused") as s:
+        sock, f = lines_conn(s.line_port)
+        deep = "[" * 100000 + "]" * 100000
+        send_lines(sock, ['{"type": "hello", "protocol": "turtlegas/1"}',
+                          '{"type": "spawn", "id": 7, "ball": {"id": "deep", "pos": [50, 50], "radius": 2}, "x-deep": %s}' % deep,
+                          '{"type": "ping", "id": 8}'])
+        # (bad_json may overtake the welcome: docs/protocol.md, section 3.)
+        replies = {m["type"]: m for m in read_lines(f, 3)}
+        check(set(replies) == {"welcome", "error", "pong"}, "three replies: %r" % replies)
+        err = replies["error"]
+        check(err["code"] == "bad_json" and "512 levels" in err["message"], "the deep message is refused, naming the limit: %r" % err)
+        check(replies["pong"].get("id") == 8, "and the server answers the next: %r" % replies["pong"])
+        check(b'"deep"' not in state(s), "nothing was spawned")
+        check(s.stop() == 0, "stops")
+
+
 if __name__ == "__main__":
-    main([test_thousand_hostile_messages, test_rate_limit, test_connection_limit, test_claim_limit_and_disconnect_release])
+    main([test_deep_json, test_thousand_hostile_messages, test_rate_limit, test_connection_limit, test_claim_limit_and_disconnect_release])

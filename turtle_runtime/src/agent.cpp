@@ -27,6 +27,12 @@ void Agent::not_own_program() const {
 // turtles. So the scheduler does the bookkeeping of a finished command on its own (warm) stack
 // before resuming (WorldServer::Impl::finish_command), and this side only hands the answer back,
 // running the handlers out of line when there is something for them.
+namespace {
+// Where a program that has run past its budget without a command is stopped (fiber.hpp): the
+// Turtle API's queries, which a loop that polls the world calls.
+inline void safe_point() { detail::Fiber::safe_point(); }
+}  // namespace
+
 Result Agent::issue(sim::TurtleCommand c) {
   if (!fiber || detail::Fiber::current() != &*fiber) [[unlikely]] not_own_program();
   if (ending) [[unlikely]] refuse_while_ending(c);
@@ -143,7 +149,9 @@ void Turtle::pen_down(PenMode mode) {
   agent_->pen_mode = mode;
 }
 PenMode Turtle::pen_mode() const { return agent_->pen_mode; }
-bool Turtle::pen_is_down() const { return agent_->pen_down; }
+bool Turtle::pen_is_down() const {
+  safe_point();
+  return agent_->pen_down; }
 void Turtle::on_touch(std::function<void(const Touch&)> handler) {
   if (mirror_.on && handler) {
     agent_->handler = [h = std::move(handler), agent = agent_](const Touch& t) { h(reflected(t, *agent)); };
@@ -152,13 +160,21 @@ void Turtle::on_touch(std::function<void(const Touch&)> handler) {
   }
 }
 void Turtle::on_message(std::function<void(const Message&)> handler) { agent_->message_handler = std::move(handler); }
-bool Turtle::it() const { return agent_->it; }
-double Turtle::odometer() const { return agent_->odometer; }
+bool Turtle::it() const {
+  safe_point();
+  return agent_->it;
+}
+double Turtle::odometer() const {
+  safe_point();
+  return agent_->odometer;
+}
 double Turtle::heading() const {
+  safe_point();
   const double h = sim::to_degrees(agent_->server->world.turtle(agent_->index).heading);
   return sim::wrap_degrees(mirror_.on ? 2.0 * mirror_.axis - h : h);
 }
 std::optional<sim::Vec2> Turtle::position() const {
+  safe_point();
   if (!agent_->program.gps) return std::nullopt;
   const sim::Vec2 p = agent_->server->world.turtle(agent_->index).pos;
   if (!mirror_.on) return p;
@@ -170,10 +186,17 @@ std::optional<sim::Vec2> Turtle::position() const {
   const double along = q.x * d.x + q.y * d.y;
   return sim::Vec2{mirror_.through->x + 2.0 * along * d.x - q.x, mirror_.through->y + 2.0 * along * d.y - q.y};
 }
-double Turtle::time() const { return agent_->server->world.time(); }
+double Turtle::time() const {
+  safe_point();
+  return agent_->server->world.time();
+}
 const std::string& Turtle::id() const { return agent_->id; }
-double Turtle::uniform() { return static_cast<double>(agent_->rng() >> 11) * 0x1.0p-53; }
-void Turtle::log(const std::string& message) { spdlog::info("turtle '{}' t={:.6g}: {}", agent_->id, time(), message); }
+double Turtle::uniform() {
+  safe_point();
+  return static_cast<double>(agent_->rng() >> 11) * 0x1.0p-53; }
+void Turtle::log(const std::string& message) {
+  safe_point();
+  spdlog::info("turtle '{}' t={:.6g}: {}", agent_->id, time(), message); }
 
 double Turtle::radius() const { return agent_->server->def.turtles[agent_->index].radius; }
 double Turtle::speed() const { return agent_->server->def.turtles[agent_->index].speed; }
@@ -185,6 +208,7 @@ nlohmann::json Turtle::game_rules() const {
 }
 
 std::vector<Touch> Turtle::touching() const {
+  safe_point();
   // Contacts in force, with their sensors worked out for the heading the turtle has now.
   std::vector<Touch> out;
   const double heading_deg = sim::to_degrees(agent_->server->world.turtle(agent_->index).heading);

@@ -13,6 +13,7 @@
 #include <atomic>
 #include <chrono>
 #include <pthread.h>
+#include <unistd.h>
 #include <thread>
 #include <vector>
 
@@ -52,6 +53,8 @@ std::atomic<std::uint64_t> g_slice{0};          // odd while a slice with a budg
 std::atomic<std::int64_t> g_budget_ns{0};
 std::atomic<std::uint64_t> g_doomed_slice{0};   // the slice the watchdog condemned
 pthread_t g_scheduler_thread;
+// What a condemned slice that reaches no safe point ends in (set_busy_loop_exit()).
+std::atomic<BusyLoopExit> g_busy_loop_exit{nullptr};
 // Leaves the running slice for resume(). (AddressSanitizer cannot follow this jump from a signal
 // handler across stacks; the tests of fault recovery are skipped in sanitizer builds.)
 [[noreturn]] void jump_back(int code) { siglongjmp(g_slice_start, code); }
@@ -83,16 +86,30 @@ void on_segv(int sig, siginfo_t* info, void* uctx) {
   std::raise(sig);
 }
 
+[[noreturn]] void default_busy_loop_exit(double) {
+  static const char line[] =
+      "turtlegas: a turtle program ran past its budget without issuing a command or calling the Turtle API (a busy "
+      "loop?); the process stops\n";
+  [[maybe_unused]] const ssize_t r = ::write(STDERR_FILENO, line, sizeof line - 1);
+  ::_exit(1);
+}
+
 void on_alarm(int sig, siginfo_t* info, void* uctx) {
   int ours = g_alarms_in_flight.load(std::memory_order_relaxed);
   while (ours > 0 && !g_alarms_in_flight.compare_exchange_weak(ours, ours - 1, std::memory_order_relaxed)) {
   }
   if (ours > 0) {
-    // Ours, sent to the scheduler's thread only: jump out if the slice it condemned still runs (a
-    // late one, for a slice that has since suspended, is dropped).
+    // Ours, sent to the scheduler's thread only, when a condemned slice ran a further budget
+    // without reaching a safe point. It may be anywhere (inside malloc, holding the arena's lock):
+    // jumping out would leave that lock held and the next allocation would wait for ever. So the
+    // process ends here, by async-signal-safe calls only. A late one, for a slice that has since
+    // left, is dropped.
     if (g_running != nullptr && pthread_equal(pthread_self(), g_scheduler_thread) &&
-        g_slice.load(std::memory_order_relaxed) == g_doomed_slice.load(std::memory_order_relaxed))
-      jump_back(2);
+        g_slice.load(std::memory_order_relaxed) == g_doomed_slice.load(std::memory_order_relaxed)) {
+      const double budget = static_cast<double>(g_budget_ns.load(std::memory_order_relaxed)) * 1e-9;
+      if (BusyLoopExit f = g_busy_loop_exit.load(std::memory_order_relaxed)) f(budget);
+      default_busy_loop_exit(budget);
+    }
     return;
   }
   const struct sigaction& prev = g_previous_alarm;
@@ -158,14 +175,17 @@ class GuardedStack {
 };
 
 // The busy-loop watchdog. A resume costs two relaxed stores (no system call): the slice's number
-// and its budget. A thread of our own samples them a few times per budget; when the same slice has
-// been running longer than its budget it sends SIGALRM to the scheduler's thread, whose handler
-// jumps out of the slice if (and only if) that slice is still the one running.
+// and its budget. A thread of our own samples them a few times per budget. When the same slice has
+// been running longer than its budget it condemns it (a relaxed store): the program's next call of
+// the Turtle API (Fiber::safe_point()) leaves the slice there, a point where our own code runs and
+// no lock is held. A slice still running one more budget later never calls the API (a pure busy
+// loop): the watchdog sends SIGALRM to the scheduler's thread, whose handler ends the process
+// (on_alarm) if that slice is still the one running. Nothing ever jumps out of arbitrary code.
 
 void watchdog() {
   using namespace std::chrono;
-  // A process-wide SIGALRM (someone's alarm()) must not land on this thread: the handler may
-  // jump into the scheduler's slice, which only the scheduler's thread may do.
+  // A process-wide SIGALRM (someone's alarm()) must not land on this thread: the handler reads
+  // the scheduler's slice, which only makes sense on the scheduler's thread.
   sigset_t alarm;
   sigemptyset(&alarm);
   sigaddset(&alarm, SIGALRM);
@@ -183,9 +203,12 @@ void watchdog() {
       continue;
     }
     if ((slice & 1) && duration_cast<nanoseconds>(now - since).count() > budget) {
-      g_doomed_slice.store(slice, std::memory_order_relaxed);
-      g_alarms_in_flight.fetch_add(1, std::memory_order_relaxed);
-      if (pthread_kill(g_scheduler_thread, SIGALRM) != 0) g_alarms_in_flight.fetch_sub(1, std::memory_order_relaxed);
+      if (g_doomed_slice.load(std::memory_order_relaxed) != slice) {
+        g_doomed_slice.store(slice, std::memory_order_relaxed);  // first: stop at the next safe point
+      } else {
+        g_alarms_in_flight.fetch_add(1, std::memory_order_relaxed);  // a budget later: end the process
+        if (pthread_kill(g_scheduler_thread, SIGALRM) != 0) g_alarms_in_flight.fetch_sub(1, std::memory_order_relaxed);
+      }
       since = now;
     }
   }
@@ -223,6 +246,7 @@ class alignas(64) Fiber::Impl {
   bool finished = false;
   bool abandoned = false;  // a fault left its stack mid-flight: never resume or unwind it
   bool stopping = false;   // stop() has resumed it to unwind
+  bool over_budget = false;  // it left its slice at a safe point, condemned by the watchdog
   double last_budget = 0.0;
   std::function<void()> body;
   std::exception_ptr error;
@@ -316,17 +340,17 @@ Fiber::Outcome Fiber::resume(double budget_seconds) {
   // unblocks the signal itself.
   const int jumped = sigsetjmp(g_slice_start, 0);
   if (jumped != 0) {
-    // Back from a signal handler: the body faulted mid-slice.
+    // Back from the SIGSEGV handler: the body ran into its guard page mid-slice.
     sigset_t handled;
     sigemptyset(&handled);
-    sigaddset(&handled, jumped == 1 ? SIGSEGV : SIGALRM);
+    sigaddset(&handled, SIGSEGV);
     sigaddset(&handled, SIGBUS);
     sigprocmask(SIG_UNBLOCK, &handled, nullptr);
     end_slice(budget_seconds);
     g_running = nullptr;
     g_current = outer;
     impl_->abandoned = true;
-    return jumped == 1 ? Outcome::stack_overflow : Outcome::over_budget;
+    return Outcome::stack_overflow;
   }
   impl_->started = true;
   impl_->last_budget = budget_seconds;
@@ -342,6 +366,10 @@ Fiber::Outcome Fiber::resume(double budget_seconds) {
   g_running = nullptr;
   g_current = outer;
   if (!impl_->self) impl_->finished = true;
+  if (impl_->over_budget) [[unlikely]] {
+    impl_->abandoned = true;  // left at a safe point: never resumed or unwound again
+    return Outcome::over_budget;
+  }
   return impl_->finished ? Outcome::finished : Outcome::suspended;
 }
 
@@ -355,6 +383,22 @@ void Fiber::suspend() {
   // by stop() and never comes back here.)
   if (impl_->stopping && !was_stopping) throw Stop{};
 }
+
+void Fiber::safe_point() {
+  const std::uint64_t slice = g_slice.load(std::memory_order_relaxed);
+  if (slice != g_doomed_slice.load(std::memory_order_relaxed) || (slice & 1) == 0) [[likely]] return;
+  Fiber* const self = g_current;
+  if (self == nullptr) return;
+  // Condemned: back to resume() for good, by the ordinary switch. The body's frames stay as they
+  // are (never unwound: a program that loops without commands may not unwind cleanly either).
+  Impl& impl = *self->impl_;
+  impl.over_budget = true;
+  TURTLEGAS_ASAN_SWITCH(&impl.inner_fake, impl.outer_bottom, impl.outer_size);
+  impl.caller = std::move(impl.caller).resume();
+  std::abort();  // never resumed again
+}
+
+void set_busy_loop_exit(BusyLoopExit exit) { g_busy_loop_exit.store(exit, std::memory_order_relaxed); }
 
 void Fiber::prefetch_record() const { __builtin_prefetch(impl_.get()); }
 

@@ -11,11 +11,17 @@ namespace turtlegas::turtle::detail {
 /// A cooperative coroutine with its own stack and a guard page below it (Boost.Context's fiber on
 /// a protected stack; this file pair is the only place that includes Boost.Context).
 ///
-/// Two faults are contained rather than left to take the process down: running into the guard
-/// page (a stack overflow) and running past a wall-clock budget without suspending (a busy loop).
-/// Both are caught by a signal handler on an alternate stack, which jumps back to the resume()
-/// that started the slice; the fiber is then abandoned (its stack is leaked, never unwound) and
-/// resume() reports what happened.
+/// Two faults are contained rather than left to take the process down where that is safe:
+/// - running into the guard page (a stack overflow) is caught by a SIGSEGV handler on an
+///   alternate stack, which jumps back to the resume() that started the slice;
+/// - running past a wall-clock budget without suspending (a busy loop) is caught by a watchdog
+///   thread, which condemns the slice: the body's next call of safe_point() (every call of the
+///   Turtle API makes one) switches back to resume() by the ordinary fiber switch. A body that
+///   makes no such call for one more budget cannot be left safely (it may be inside malloc with
+///   the arena's lock held, and no code may run on this thread after a jump out of it): SIGALRM's
+///   handler then ends the process through set_busy_loop_exit()'s function (async-signal-safe).
+/// Either way the fiber is then abandoned (its stack is leaked, never unwound) and resume()
+/// reports what happened.
 ///
 /// A body suspended mid-flight is ended by stop() (the destructor calls it): it resumes the body,
 /// and suspend() then throws Stop, which unwinds the body's frames (running their destructors) up
@@ -72,11 +78,20 @@ class Fiber {
 
   /// The fiber running now, if any.
   static Fiber* current();
+  /// From inside a body (cheap: two relaxed loads): if the watchdog has condemned the running
+  /// slice, leaves it for good; resume() returns over_budget. Otherwise returns at once.
+  static void safe_point();
 
   class Impl;
 
  private:
   std::unique_ptr<Impl> impl_;
 };
+
+/// Called from SIGALRM's handler, on the simulation thread, when a condemned slice has run a
+/// further budget without reaching a safe point: async-signal-safe calls only, and it must not
+/// return (it ends with _exit). The default writes one line on stderr and exits with code 1.
+using BusyLoopExit = void (*)(double budget_seconds);
+void set_busy_loop_exit(BusyLoopExit exit);
 
 }  // namespace turtlegas::turtle::detail

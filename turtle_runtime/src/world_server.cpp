@@ -3,6 +3,9 @@
 // world-file order), a program's turn on its fiber, the end of a command, and running to a time.
 #include "turtlegas/turtle/world_server.hpp"
 
+#include <unistd.h>
+
+#include <atomic>
 #include <cstdint>
 #include <exception>
 #include <memory>
@@ -53,9 +56,62 @@ class InFlight {
   InFlight& operator=(const InFlight&) = delete;
 };
 
+std::atomic<void (*)()> g_busy_loop_last_words{nullptr};
+
+/// A line a signal handler may build: a fixed buffer, no allocation, write(2) only.
+class SafeLine {
+ public:
+  SafeLine& operator<<(const char* s) {
+    while (s != nullptr && *s != '\0' && n_ < sizeof buf_) buf_[n_++] = *s++;
+    return *this;
+  }
+  /// Up to three decimals, trailing zeros dropped (no C library: printf is not signal-safe).
+  SafeLine& operator<<(double v) {
+    if (!(v >= 0.0 && v < 1e15)) return *this << (v < 0.0 ? "(negative)" : "(huge)");
+    auto milli = static_cast<std::uint64_t>(v * 1000.0 + 0.5);
+    char digits[24];
+    int n = 0;
+    do digits[n++] = static_cast<char>('0' + milli % 10), milli /= 10;
+    while (milli > 0 || n < 4);
+    int low = 0;  // trailing zeros of the decimals go
+    while (low < 3 && digits[low] == '0') ++low;
+    for (int k = n - 1; k >= 3; --k) put(digits[k]);
+    if (low < 3) put('.');
+    for (int k = 2; k >= low; --k) put(digits[k]);
+    return *this;
+  }
+  void write() const { [[maybe_unused]] const ssize_t r = ::write(STDERR_FILENO, buf_, n_); }
+
+ private:
+  void put(char c) {
+    if (n_ < sizeof buf_) buf_[n_++] = c;
+  }
+  char buf_[1024];
+  std::size_t n_ = 0;
+};
+
+/// The end of a busy loop that calls no Turtle API (fiber.hpp): from SIGALRM's handler.
+[[noreturn]] void busy_loop_exit(double budget) {
+  const ProgramInFlight& p = g_in_flight;
+  SafeLine line;
+  line << "turtlegas: ";
+  if (p.turtle != nullptr)
+    line << "turtle '" << p.turtle << "' (controller '" << (p.controller ? p.controller : "?") << "'): ";
+  line << "its program ran for more than " << budget << " s of wall time without issuing a command, and "
+       << budget << " s more without calling the Turtle API (a busy loop?); it cannot be stopped safely where it "
+       << "runs, so the process stops at t=" << static_cast<double>(p.t) << "\n";
+  line.write();
+  if (void (*last_words)() = g_busy_loop_last_words.load(std::memory_order_relaxed)) last_words();
+  ::_exit(1);
+}
+
 }  // namespace
 
 const ProgramInFlight& program_in_flight() { return g_in_flight; }
+
+void set_busy_loop_last_words(void (*last_words)()) {
+  g_busy_loop_last_words.store(last_words, std::memory_order_relaxed);
+}
 
 void WorldServer::Impl::finish_command(Agent& a) {
   // The end of the command the program waits on, worked out before it resumes (see issue()).
@@ -121,6 +177,7 @@ WorldServer::WorldServer(const sim::WorldDef& def, std::vector<TurtleProgram> pr
     impl_->agents.push_back(impl_->make_agent(k, std::move(programs[k]), ids));
   impl_->world.set_event_log(&impl_->sim_log);
   impl_->self = this;
+  detail::set_busy_loop_exit(&busy_loop_exit);
 }
 
 WorldServer::~WorldServer() = default;

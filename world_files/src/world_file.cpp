@@ -19,6 +19,7 @@
 #include "turtlegas/turtle/script.hpp"
 #include "turtlegas/world/draw_walker.hpp"
 #include "turtlegas/world/game_file.hpp"
+#include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::world {
 namespace detail {
@@ -377,6 +378,7 @@ std::pair<std::size_t, std::size_t> line_and_column(std::string_view text, std::
 
 Scene parse(std::string_view text, std::string_view file_name, const turtle::Registry* registry) {
   const std::string file(file_name);
+  if (const auto deep = turtle::json_too_deep(text)) throw WorldFileError(file, "", *deep + " (docs/worlds.md)");
   json doc;
   try {
     doc = json::parse(text.begin(), text.end());

@@ -19,8 +19,15 @@
 #include "checkpoint.hpp"
 #include "cli_common.hpp"
 #include "sweep/sweep.hpp"
+#include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::apps::sweep {
+
+json parse_or_discard(const std::string& text) {
+  if (turtle::json_too_deep(text)) return json(json::value_t::discarded);
+  return json::parse(text, nullptr, false);
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -70,7 +77,7 @@ Journal::Journal(const std::string& out, const Spec& spec, Results& results) : p
     std::vector<std::pair<std::size_t, std::string>> runs;
     while (std::getline(in, line)) {
       any = true;
-      const json j = json::parse(line, nullptr, false);
+      const json j = parse_or_discard(line);
       if (++n <= 2 && (n == 1 || j.is_discarded() || j.contains("fingerprint"))) {
         if (!j.is_discarded() && j.contains("fingerprint")) (j.value("fingerprint", "") == fp ? ours : theirs) = true;
         continue;

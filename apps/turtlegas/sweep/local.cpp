@@ -88,7 +88,7 @@ int run_local(const SweepOptions& options, const std::vector<std::string>& plugi
     const std::size_t k = pending[i];
     status.clear();
     if (r.stopped) return;  // killed at SIGINT or SIGTERM: left for the resumed sweep
-    const json j = json::parse(r.report, nullptr, false);
+    const json j = parse_or_discard(r.report);
     if (!r.timed_out && r.exited && r.exit_code == 0 && !j.is_discarded() && j.value("run", std::size_t(-1)) == k) {
       std::string line = r.report;
       while (!line.empty() && line.back() == '\n') line.pop_back();

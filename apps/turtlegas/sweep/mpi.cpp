@@ -48,7 +48,7 @@ int mpi_master(const SweepOptions& options, const Spec& spec, const std::string&
     std::string msg(static_cast<std::size_t>(count), '\0');
     MPI_Recv(msg.data(), count, MPI_CHAR, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     if (st.MPI_TAG == tag_result) {
-      const json j = json::parse(msg, nullptr, false);
+      const json j = parse_or_discard(msg);
       if (!j.is_discarded() && j.contains("error")) {
         ++failed;
         spdlog::error("sweep: run {} failed on rank {}: {}", j.value("run", 0), st.MPI_SOURCE, j.value("error", ""));

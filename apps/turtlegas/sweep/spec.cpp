@@ -11,6 +11,7 @@
 
 #include "cli_common.hpp"
 #include "sweep/sweep.hpp"
+#include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::apps::sweep {
 namespace {
@@ -32,6 +33,7 @@ Spec parse_spec(const std::string& file, const Inputs* given) {
   spec.file = file;
   // The spec's own keys keep their order (grid axes are expanded in the order written).
   spec.bytes.spec = given ? given->spec : read_bytes(file, "the sweep spec");
+  if (const auto deep = turtle::json_too_deep(spec.bytes.spec)) throw BadInput(file + ": " + *deep + " (the sweep spec)");
   spec.text = nlohmann::ordered_json::parse(spec.bytes.spec, nullptr, false);
   if (spec.text.is_discarded()) throw BadInput(file + ": invalid JSON (the sweep spec)");
   const nlohmann::ordered_json& ordered = spec.text;
@@ -47,6 +49,8 @@ Spec parse_spec(const std::string& file, const Inputs* given) {
   const fs::path world_path = fs::path(ordered["world"].get<std::string>());
   spec.world_file = (world_path.is_absolute() ? world_path : fs::path(file).parent_path() / world_path).lexically_normal().string();
   spec.bytes.world = given ? given->world : read_bytes(spec.world_file, "the world of sweep " + file);
+  if (const auto deep = turtle::json_too_deep(spec.bytes.world))
+    throw BadInput(spec.world_file + ": " + *deep + " (the world of sweep " + file + ")");
   spec.world = json::parse(spec.bytes.world, nullptr, false);
   if (spec.world.is_discarded()) throw BadInput(spec.world_file + ": invalid JSON (the world of sweep " + file + ")");
   if (!ordered.contains("until") || !ordered["until"].is_number() || !std::isfinite(ordered["until"].get<double>()) ||

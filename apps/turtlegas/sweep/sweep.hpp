@@ -77,6 +77,10 @@ json run_one(const Spec& spec, std::size_t k, const turtle::Registry& registry, 
 using Results = std::map<std::size_t, std::string>;
 
 /// The spec's and its world's fingerprint: a journal of another spec or world is not resumed.
+/// json::parse(text, nullptr, false), with a text nested too deep (turtle::json_too_deep) discarded
+/// as invalid JSON is: a journal line or a child's report that no run wrote.
+json parse_or_discard(const std::string& text);
+
 std::string fingerprint(const Spec& spec);
 
 /// The journal beside the results (<out>.partial): a header line with the spec's fingerprint,

@@ -96,10 +96,19 @@ struct ServerOptions {
   std::function<void(const RemoteReport&)> remote_reports;
 };
 
-/// The busy-loop stop: a program ran past its budget without issuing a command.
+/// The busy-loop stop: a program ran past its budget without issuing a command, and was stopped
+/// at its next call of the Turtle API (a query: time(), position(), touching(), ...).
 struct BusyLoopError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// A program that runs past its budget and calls no Turtle API for one budget more cannot be
+/// stopped where it runs: it may hold the C library's locks (inside malloc), and no code of this
+/// thread could run after a jump out of it. The process ends there instead: one line on stderr
+/// names the turtle, its controller, the budget and the simulated time; then `last_words` runs,
+/// inside a signal handler (async-signal-safe calls only: rename or unlink the outputs), and the
+/// process exits with code 1. Process-wide; nullptr for none.
+void set_busy_loop_last_words(void (*last_words)());
 
 class Game;  // game.hpp
 
