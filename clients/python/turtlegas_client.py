@@ -1,6 +1,9 @@
 # SPDX-License-Identifier: MIT
 """A client for `turtlegas serve` (docs/protocol.md), Python 3 standard library only.
 
+(Just over 600 lines, in one file on purpose: it is the client a user copies next to a script,
+with nothing to install; split, it would need a package.)
+
 It reads like the C++ controller API:
 
     world = World.connect("127.0.0.1", 8081)          # TCP lines (or World.connect_ws(url))

@@ -63,6 +63,20 @@ std::vector<double> speeds(const World& w, double& kT) {
 }
 
 double mean_of(const nlohmann::json& j) { return j.at("mean").get<double>(); }
+
+/// Runs w under an Observer from `from` in `windows` whole windows of `window` seconds, 4 samples
+/// each; the result's summary.
+nlohmann::json observed_summary(World& w, const sim::WorldDef& def, double from, double window, int windows) {
+  formats::ObserveOptions o;
+  o.from = from;
+  o.window = window;
+  o.samples = 4;
+  const double until = from + windows * window;
+  formats::Observer obs(w, def, o, until);
+  obs.advance_to(until);
+  REQUIRE(obs.windows() == windows);
+  return obs.result().at("summary");
+}
 double error_of(const nlohmann::json& j) { return j.at("error").get<double>(); }
 
 }  // namespace
@@ -139,15 +153,8 @@ TEST_CASE("hard discs: Z = PA/(NkT) from the virial and the collision rate agree
     const double area = def.arena.width * def.arena.height, density = n / area, sigma = 2.0;
     const double kT = 0.5 * (1.0 - 1.0 / n);  // speed 1 each, less the centre of mass's share (about)
     const double nu_h = 2.0 * density * sigma * formats::henderson_contact(eta) * std::sqrt(kPi * kT);
-    formats::ObserveOptions o;
-    o.from = 30.0 / nu_h;     // 30 collisions per ball
-    o.window = 20.0 / nu_h;   // 20 per ball per window, 10 windows
-    o.samples = 4;
-    const double until = o.from + 10.0 * o.window;
-    formats::Observer obs(w, def, o, until);
-    obs.advance_to(until);
-    REQUIRE(obs.windows() == 10);
-    const nlohmann::json s = obs.result().at("summary");
+    // From 30 collisions per ball, 10 windows of 20 per ball.
+    const nlohmann::json s = observed_summary(w, def, 30.0 / nu_h, 20.0 / nu_h, 10);
     const double z = mean_of(s.at("Z_virial")), z_se = error_of(s.at("Z_virial"));
     const double zh = formats::henderson_z(eta);
     const double T = mean_of(s.at("kT"));
@@ -222,15 +229,9 @@ TEST_CASE("near the liquid-hexatic transition: 72 discs in a square box against 
   INFO("seed " << seed);
   const sim::WorldDef def = staggered_square_gas(n, eta, seed);
   World w(def, Mode::exact);
-  formats::ObserveOptions o;
-  o.from = 200.0;      // ~1,300 collisions per disc from the lattice: melted and relaxed
-  o.window = 2500.0;   // ~15,000 per disc per window, far beyond the correlation time
-  o.samples = 4;
-  const double until = o.from + 16.0 * o.window;
-  formats::Observer obs(w, def, o, until);
-  obs.advance_to(until);
-  REQUIRE(obs.windows() == 16);
-  const nlohmann::json s = obs.result().at("summary");
+  // From ~1,300 collisions per disc after the lattice (melted and relaxed), 16 windows of ~15,000
+  // per disc, far beyond the correlation time.
+  const nlohmann::json s = observed_summary(w, def, 200.0, 2500.0, 16);
   const double zc = mean_of(s.at("Z_canonical")), se = std::hypot(error_of(s.at("Z_canonical")), ref_se);
   const double zv = mean_of(s.at("Z_virial"));
   std::printf("N 72, eta 0.65: Z_canonical %.5f +- %.5f, Z_virial %.5f, Li et al. %.5f\n", zc, se, zv, ref);
