@@ -16,6 +16,7 @@
 // costs what a 30-degree one does, and the speed |w| is kept to round-off (energy exact at e = 1).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -60,7 +61,8 @@ inline bool fold(Vec2 v0, Vec2 n_a, Vec2 u_a, Vec2 n_b, Vec2 u_b, Folded& out) {
   // phi_a = 0 and phi_b = d: the even terms (after B, A B, A B A B, ...) are theta0 + j delta, the
   // odd ones (after A, A B A, ...) theta1 - j delta, with delta = 2 d and theta1 = pi - theta0.
   const double delta = d > 0.0 ? -2.0 * width : 2.0 * width;  // 2 d, modulo a turn
-  // The first j >= 0 at which start + j step (step != 0) lies in the cone, or max() if it passes
+  constexpr std::uint64_t kNever = std::numeric_limits<std::uint64_t>::max();
+  // The first j >= 0 at which start + j step (step != 0) lies in the cone, or kNever if it passes
   // the cone in its first turn (then the other sequence gets there first: the unfolding).
   auto first_hit = [&](double start, double step) -> std::uint64_t {
     double x = std::fmod(start - lo, kTwoPi);  // from the cone's start, counter-clockwise, in [0, 2 pi)
@@ -69,16 +71,15 @@ inline bool fold(Vec2 v0, Vec2 n_a, Vec2 u_a, Vec2 n_b, Vec2 u_b, Folded& out) {
     double j = 0.0;
     if (step > 0.0) {
       j = std::ceil((kTwoPi - x - kFoldAngle) / step);
-      if (x + j * step > kTwoPi + width + kFoldAngle) return std::numeric_limits<std::uint64_t>::max();
+      if (x + j * step > kTwoPi + width + kFoldAngle) return kNever;
     } else {
       j = std::ceil((x - width - kFoldAngle) / -step);
-      if (x + j * step < -kFoldAngle) return std::numeric_limits<std::uint64_t>::max();
+      if (x + j * step < -kFoldAngle) return kNever;
     }
     return static_cast<std::uint64_t>(std::max(j, 0.0));
   };
   const double theta1 = kPi - theta0;
   const std::uint64_t je = first_hit(theta0, delta), jo = first_hit(theta1, -delta);
-  constexpr std::uint64_t kNever = std::numeric_limits<std::uint64_t>::max();
   if (je == kNever && jo == kNever) return false;
   const std::uint64_t ke = je == kNever ? kNever : 2 * je, ko = jo == kNever ? kNever : 2 * jo + 1;
   double theta = 0.0;
