@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,7 @@ int check_one(const std::string& file, const turtle::Registry& registry) {
                                                  : std::string("one simulated second"));
     for (std::string& w : scale_warnings(scales, seconds, span)) warnings.push_back(std::move(w));
   }
+  if (std::optional<std::string> w = precision_warning(def)) warnings.push_back(std::move(*w));
   std::printf("%s: ok: \"%s\", %s, arena %s x %s (boundary %s), cell %s (%d x %d), dt %s s\n", file.c_str(),
               def.name.c_str(), count_summary(def, def.balls.size()).c_str(), fmt(def.arena.width).c_str(),
               fmt(def.arena.height).c_str(), sim::to_string(def.arena.boundary).data(), fmt(cell_size).c_str(), cells_x, cells_y,

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <cstdio>
 
@@ -68,6 +69,30 @@ std::vector<std::string> scale_warnings(const SceneScales& scales, double second
                   human_duration(steps / nominal_events_per_second) + " at " + num(nominal_events_per_second) +
                   " steps/s");
   return out;
+}
+
+std::optional<std::string> precision_warning(const sim::WorldDef& def) {
+  double coordinate = std::max(std::abs(def.arena.width), std::abs(def.arena.height));
+  auto reach = [&](sim::Vec2 p) { coordinate = std::max({coordinate, std::abs(p.x), std::abs(p.y)}); };
+  double radius = std::numeric_limits<double>::infinity();
+  std::string smallest;
+  auto body = [&](sim::Vec2 pos, double r, const std::string& what) {
+    reach(pos);
+    if (r < radius) radius = r, smallest = what;
+  };
+  for (const sim::BallDef& b : def.balls) body(b.pos, b.radius, "ball '" + b.id + "'");
+  for (const sim::TurtleDef& t : def.turtles) body(t.pos, t.radius, "turtle '" + t.id + "'");
+  for (const sim::WallDef& w : def.walls) {
+    reach(w.from), reach(w.to);
+    for (const sim::WallKey& k : w.keys) reach(k.from), reach(k.to);
+  }
+  if (!(radius > 0.0) || !(coordinate / radius > precise_coordinate_ratio)) return std::nullopt;
+  const double ratio = coordinate / radius;
+  return "coordinates reach " + num(coordinate) + ", " + num(ratio) + " times the smallest radius (" + num(radius) +
+         ", " + smallest + "): positions carry round-off of a few 1e-16 of the coordinates, so contacts may overlap by " +
+         "about " + num(2.5e-16 * ratio) + " of a radius or more, above the 1e-9 the engine keeps up to a ratio of " +
+         num(precise_coordinate_ratio) + " (docs/physics.md, \"The overlap bound\"); shift the scene towards the origin or "
+         "scale it up";
 }
 
 std::string human_duration(double seconds) {

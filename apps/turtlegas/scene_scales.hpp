@@ -46,6 +46,16 @@ constexpr double nominal_events_per_second = 1e7;
 /// --until 1e308", "the expect list's run to until 1e12", "one simulated second").
 std::vector<std::string> scale_warnings(const SceneScales& scales, double seconds, const std::string& span);
 
+/// The coordinate-to-radius ratio above which contacts may overlap by more than the engine's 1e-9
+/// of a radius: positions carry round-off of a few eps of the coordinates (docs/physics.md, "the
+/// overlap bound"), measured at 1.5e-10 r at a ratio of 1e6 and 2.6e-9 r at 1e7.
+constexpr double precise_coordinate_ratio = 1e6;
+
+/// A warning when the scene's largest coordinate (arena, walls, bodies) exceeds
+/// precise_coordinate_ratio times its smallest body radius, naming both and the overlap to expect;
+/// nothing otherwise.
+std::optional<std::string> precision_warning(const sim::WorldDef& def);
+
 /// "12 s", "3.5 min", "2.1 h", "4.2 days", "3e+134 years".
 std::string human_duration(double seconds);
 

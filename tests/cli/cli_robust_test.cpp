@@ -379,6 +379,27 @@ TEST_CASE("robust: check warns, with numbers, about scenes whose scales predict 
   CHECK(!contains(fine.err, "predicts"));
 }
 
+TEST_CASE("robust: check warns when coordinates outgrow the radii past the overlap bound") {
+  // Before: a scene 1e7 radii from the origin ran with overlaps of 2.6e-9 r (above the 1e-9 r the
+  // engine promises) and check said nothing.
+  TempDir dir;
+  auto far = [](const std::string& width, const std::string& x) {
+    return R"({"format": "turtlegas-world/1", "arena": {"width": )" + width + R"(, "height": 30, "boundary": "walls"},
+      "balls": [{"id": "tiny", "pos": [)" + x + R"(, 15], "radius": 1}, {"id": "big", "pos": [15, 15], "radius": 5}]})";
+  };
+  const Result bad = run(dir, {"check", dir.write("w.json", far("2e7", "19999990")).string()});
+  INFO(bad.out << bad.err);
+  CHECK(bad.code == 0);  // a warning, not an error
+  CHECK(contains(bad.err, "coordinates reach 2e+07, 2e+07 times the smallest radius (1, ball 'tiny')"));
+  CHECK(contains(bad.err, "overlap by about 5e-09 of a radius"));
+  // Within the ratio: no word.
+  const Result near = run(dir, {"check", dir.write("w.json", far("9e5", "899990")).string()});
+  CHECK(near.code == 0);
+  CHECK(!contains(near.err, "coordinates reach"));
+  const Result demo = run(dir, {"check", worlds + "gas.json"});
+  CHECK(!contains(demo.err, "coordinates reach"));
+}
+
 // --- §2: SIGINT and SIGTERM ------------------------------------------------------------------------
 
 TEST_CASE("robust: SIGINT and SIGTERM stop a run at a control boundary with every output written") {
