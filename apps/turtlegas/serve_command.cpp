@@ -52,7 +52,20 @@ void add_door_options(CLI::App& s, ServeCommandOptions& opt) {
   s.add_option("--token-file", opt.token_file, "Read the token from this file (its first line); the environment's TURTLEGAS_TOKEN is the other way");
   s.add_option("--allow-origin", opt.allow_origins,
                "Let the page at this origin (http://name:port) use the WebSocket, and answer HTTP for that name; "
-               "'*' for any (by default only 127.0.0.1, localhost, [::1] and --bind, with the port)");
+               "'*' for any (by default only 127.0.0.1, localhost, [::1] and --bind, with the port)")
+      ->check(
+          [](const std::string& o) -> std::string {
+            // An origin is what a browser sends: scheme://host[:port], nothing after. Before, "" and
+            // "localhost:8080" were taken silently and allowed no page at all.
+            if (o == "*") return {};
+            const std::size_t scheme = o.find("://");
+            const bool ok = scheme != std::string::npos && scheme > 0 && o.size() > scheme + 3 &&
+                            o.find_first_of("/?# ", scheme + 3) == std::string::npos;
+            if (ok) return {};
+            return "'" + o + "' is not an origin: give it as a browser sends it, scheme://name[:port] "
+                   "(e.g. http://robots.lab:8080), or '*' for any";
+          },
+          "ORIGIN");
 }
 
 /// --token, else --token-file's first line, else $TURTLEGAS_TOKEN, else none.

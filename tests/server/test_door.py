@@ -142,5 +142,17 @@ def test_token_from_file_and_environment():
         shutil.rmtree(d)
 
 
+def test_malformed_origin_refused():
+    # Before: --allow-origin "" (or a bare host:port) was taken silently and let no page in.
+    import subprocess
+    from harness import BIN
+    for bad in ("", "localhost:8080", "http://", "http://viewer.example:9000/page"):
+        r = subprocess.run([BIN, "serve", world("protocol_room.json"), "--paused", "--port", "0", "--allow-origin", bad],
+                           capture_output=True, text=True, timeout=30)
+        check(r.returncode == 2 and "is not an origin" in r.stderr,
+              "--allow-origin %r: refused before serving, exit 2 (%d %r)" % (bad, r.returncode, r.stderr[-300:]))
+
+
 if __name__ == "__main__":
-    main([test_foreign_origin_and_host_refused, test_save_never_replaces_a_file_in_use, test_token_from_file_and_environment])
+    main([test_foreign_origin_and_host_refused, test_save_never_replaces_a_file_in_use, test_token_from_file_and_environment,
+          test_malformed_origin_refused])
