@@ -43,6 +43,8 @@ struct Source {
   world::Scene scene;
   sim::Mode mode = sim::Mode::exact;
   std::optional<double> end;  ///< a recording: the last time it vouches for
+  std::string recording;                  ///< a recording: its path
+  std::vector<formats::Keyframe> keyframes;  ///< a recording: its keyframes, checked as the run passes them
 };
 
 bool is_recording(const std::string& path) {
@@ -74,6 +76,8 @@ Source load_source(const std::string& path, const turtle::Registry& registry) {
   s.scene.def.dt = rec.header.dt;
   s.mode = sim::mode_from_string(rec.header.mode).value_or(sim::Mode::exact);
   s.end = rec.end;
+  s.recording = path;
+  s.keyframes = std::move(rec.keyframes);
   return s;
 }
 
@@ -92,11 +96,36 @@ class Renderer {
     pace_ = first_pace(predict_scales(source_.scene.def, source_.mode), server_->world(), source_.scene.def.dt);
   }
   /// Runs the scene to t in chunks, as `run` runs: a stop (a signal, a limit) leaves it short of t.
+  /// A recording's keyframes on the way are reached exactly and compared with the run (cutting a
+  /// run does not change it); the first difference is warned about, once.
   Stopped advance_to(double t, const Limits& limits, Clock::time_point start, Progress& progress,
                      const std::string& doing) {
+    while (next_key_ < source_.keyframes.size() && source_.keyframes[next_key_].t <= t) {
+      const formats::Keyframe& k = source_.keyframes[next_key_];
+      if (k.t > server_->time()) {
+        const Stopped end = run_server_in_chunks(*server_, k.t, 0, limits, pace_, start, progress, doing);
+        if (end.first != Stop::until) return end;
+      }
+      ++next_key_;
+      if (k.t == server_->time()) check_keyframe(k);
+    }
     return run_server_in_chunks(*server_, t, 0, limits, pace_, start, progress, doing);
   }
   double time() const { return server_->time(); }
+  /// Compares the run with keyframe `k` of the recording (the run is at its time); warns once.
+  void check_keyframe(const formats::Keyframe& k) {
+    if (diverged_) return;
+    const formats::IdTable ids = formats::ball_ids(server_->scene());
+    const std::optional<std::string> d =
+        formats::keyframe_difference(formats::read_keyframe(source_.recording, k), server_->world(),
+                                     formats::RunNames{ids, server_->scene(), server_->world()});
+    if (!d) return;
+    diverged_ = true;
+    spdlog::warn("{}: at t = {} s this run differs from the recording's keyframe ({}): the recorded world, a program, "
+                 "or this build differs from the one that recorded it, and the pictures from here on show this run, "
+                 "not the recorded one",
+                 source_.recording, fmt(k.t), *d);
+  }
   /// Warns, with numbers, when running the scene to t predicts a run that will not finish (as run
   /// and check do): `render --at 1e300` otherwise ran for ever without a word.
   void warn_if_absurd(double t, const std::string& span) const {
@@ -170,6 +199,8 @@ class Renderer {
   const RenderOptions& opt_;
   std::unique_ptr<turtle::WorldServer> server_;
   Pace pace_;
+  std::size_t next_key_ = 0;  ///< the recording's first keyframe not yet reached
+  bool diverged_ = false;     ///< a keyframe differed (warned about)
 };
 
 std::string find_on_path(const std::string& program) {

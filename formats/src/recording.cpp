@@ -278,6 +278,41 @@ Keyframe read_keyframe(const std::string& path, const Keyframe& at) {
   }
 }
 
+namespace {
+
+/// The first place where a and b differ, as a path of keys and indices ("" when equal); an array
+/// element with an "id" is named by it too.
+std::optional<std::string> first_difference(const json& a, const json& b, const std::string& at) {
+  if (a == b) return std::nullopt;
+  if (a.is_object() && b.is_object()) {
+    for (const auto& [key, value] : b.items()) {
+      if (!a.contains(key)) return at + key + ": missing here";
+      if (auto d = first_difference(a.at(key), value, at + key + "/")) return d;
+    }
+    for (const auto& [key, value] : a.items())
+      if (!b.contains(key)) return at + key + ": not in the recording";
+  } else if (a.is_array() && b.is_array()) {
+    if (a.size() != b.size())
+      return at.substr(0, at.size() - (at.empty() ? 0 : 1)) + ": " + std::to_string(a.size()) + " here, " +
+             std::to_string(b.size()) + " in the recording";
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      std::string place = at + std::to_string(i);
+      if (b[i].is_object() && b[i].contains("id") && b[i]["id"].is_string()) place += " '" + b[i]["id"].get<std::string>() + "'";
+      if (auto d = first_difference(a[i], b[i], place + "/")) return d;
+    }
+  }
+  return at.substr(0, at.size() - (at.empty() ? 0 : 1)) + ": " + a.dump() + " here, " + b.dump() + " in the recording";
+}
+
+}  // namespace
+
+std::optional<std::string> keyframe_difference(const Keyframe& whole, const sim::World& world, const RunNames& names) {
+  std::ostringstream out;
+  write_state(out, world, names);
+  const json here = parse_capped(out.str());
+  return first_difference(here, whole.state, "");
+}
+
 std::string recording_inputs(const std::string& path, std::uint64_t offset, std::string_view world_name, double dt) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument(path + ": cannot be read");

@@ -286,6 +286,30 @@ def check_render():
     assert b".svg or .png" in p.stderr
 
 
+def check_altered(rec):
+    """A render re-simulates the recording's header world: it checks the run against each keyframe it
+    passes and names the first difference (before: an altered header world drew another run without a
+    word)."""
+    png = path("altered.png")
+    p = run("render", rec, "--at", 2.5, "--out", png)
+    assert b"differs from the recording" not in p.stderr, p.stderr
+    data = read(rec)
+    header, rest = data.split(b"\n", 1)
+    # The same length, so that the index's byte offsets still hold: only the physics changes.
+    for old, new, at in ((b'"restitution":1.0', b'"restitution":0.9', None), (b'"seed":7,', b'"seed":8,', "t = 0 s")):
+        assert old in header, header[:400]
+        altered = path("altered.tgrec")
+        with open(altered, "wb") as f:
+            f.write(header.replace(old, new, 1) + b"\n" + rest)
+        p = run("render", altered, "--at", 2.5, "--out", png)
+        err = p.stderr.decode()
+        assert "this run differs from the recording's keyframe" in err, err
+        assert " here, " in err and " in the recording" in err, err
+        if at:
+            assert at in err, err
+        assert err.count("differs from the recording") == 1, err  # once
+
+
 def main():
     rng = random.Random(SEED)
     try:
@@ -293,6 +317,7 @@ def main():
         rec = check_recording(gas, 3.0, rng)
         check_replay(rec, gas, 3.0, rng)
         check_cut(rec)
+        check_altered(rec)
         tag = os.path.join(ROOT, "worlds", "tag.json")
         rec = check_recording(tag, 4.0, rng)
         check_replay(rec, tag, 4.0, rng)

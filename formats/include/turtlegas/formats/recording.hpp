@@ -130,6 +130,14 @@ Recording read_recording(const std::string& path);
 /// The keyframe at `k.offset`, whole (state and walls filled in).
 Keyframe read_keyframe(const std::string& path, const Keyframe& k);
 
+/// Where `world` (re-simulated to the keyframe's time) differs from the keyframe `whole` (as
+/// read_keyframe() gives it), in words: the first value that differs, by its place in the state
+/// file ("balls/3 'b3' vel: [1, 2] here, [1, 2.5] in the recording"); nothing when they agree bit
+/// for bit. A replay or render that re-simulates a recording checks each keyframe with it, so that
+/// an altered header world, a program that changed, or another build's different arithmetic is
+/// named instead of drawn as if it were the recorded run.
+std::optional<std::string> keyframe_difference(const Keyframe& whole, const sim::World& world, const RunNames& names);
+
 /// The input lines ({"step": ...}) of a served run's recording that precede byte `offset` (a
 /// keyframe's), as an input log (its header line first) for formats::ReplayInput.
 std::string recording_inputs(const std::string& path, std::uint64_t offset, std::string_view world_name, double dt);
