@@ -114,6 +114,16 @@ std::uint64_t state_hash(const sim::World& world, const formats::RunNames& names
   return fnv1a64(s.str());
 }
 
+/// The first program of `scene` whose controller does not declare itself restartable: a checkpoint
+/// of the scene cannot be resumed (resuming replays every program from the start).
+std::optional<std::size_t> first_unrestartable(const world::Scene& scene, const turtle::Registry& registry) {
+  for (std::size_t i = 0; i < scene.programs.size(); ++i) {
+    const turtle::ControllerInfo* info = registry.info(scene.programs[i].controller);
+    if (!info || !info->restartable) return i;
+  }
+  return std::nullopt;
+}
+
 /// The checks a resumed run makes before it starts: the same world (`world_hash`, of the bytes
 /// loaded), mode and dt, and programs that replay.
 void check_resumable(const Checkpoint& c, const RunOptions& opt, std::uint64_t world_hash, const world::Scene& scene,
@@ -130,15 +140,11 @@ void check_resumable(const Checkpoint& c, const RunOptions& opt, std::uint64_t w
   if (!(opt.until > c.t))
     throw BadInput(where + "the checkpoint is at t = " + fmt(c.t) + " s; --until must be later (got " + fmt(opt.until) +
                    ")");
-  for (std::size_t i = 0; i < scene.programs.size(); ++i) {
-    const std::string& name = scene.programs[i].controller;
-    const turtle::ControllerInfo* info = registry.info(name);
-    if (info && info->restartable) continue;
-    throw BadInput(where + "turtle '" + scene.def.turtles[i].id + "' runs controller '" + name +
+  if (const std::optional<std::size_t> i = first_unrestartable(scene, registry))
+    throw BadInput(where + "turtle '" + scene.def.turtles[*i].id + "' runs controller '" + scene.programs[*i].controller +
                    "', which does not declare itself restartable. A checkpoint holds no program state (coroutines "
                    "cannot be saved); resuming replays every program from the start, which only a restartable "
                    "controller does exactly (docs/controllers.md, \"Checkpoints\"). Rerun from the start instead");
-  }
 }
 
 }  // namespace
@@ -278,6 +284,12 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   } else if (opt.dt) {
     def.dt = *opt.dt;
   }
+  if (!opt.checkpoint.empty())
+    if (const std::optional<std::size_t> i = first_unrestartable(scene, registry))
+      spdlog::warn("--checkpoint {}: turtle '{}' runs controller '{}', which is not restartable: the checkpoint will "
+                   "be written but can never be resumed (--resume replays every program from the start, which only "
+                   "restartable controllers do exactly: docs/controllers.md, \"Checkpoints\")",
+                   opt.checkpoint, scene.def.turtles[*i].id, scene.programs[*i].controller);
   const std::size_t ball_count = def.balls.size();
   // For the event log and the state file, kept apart from the scene, which the World may take
   // the balls of (World(WorldDef&&)).

@@ -583,12 +583,17 @@ TEST_CASE("robust: resume refuses a world with a controller that is not restarta
   const Result first = run(dir, {"run", w.string(), "--until", "1", "--plugin", TEST_PLUGIN, "--checkpoint", c});
   INFO(first.err);
   REQUIRE(first.code == 0);
+  // Said when the checkpoint is asked for, not only when it is resumed (before: written without a word).
+  CHECK(contains(first.err, "--checkpoint " + c + ": turtle 'rogue' runs controller 'swallower', which is not "
+                            "restartable: the checkpoint will be written but can never be resumed"));
   const Result resumed = run(dir, {"run", w.string(), "--until", "2", "--plugin", TEST_PLUGIN, "--resume", c});
   CHECK(resumed.code == 2);
   CHECK(contains(resumed.err, "turtle 'rogue' runs controller 'swallower', which does not declare itself restartable"));
 
   const fs::path g = dir.write("g.json", long_gas);
-  REQUIRE(run(dir, {"run", g.string(), "--until", "0.5", "--checkpoint", c}).code == 0);
+  const Result gas = run(dir, {"run", g.string(), "--until", "0.5", "--checkpoint", c});
+  REQUIRE(gas.code == 0);
+  CHECK_FALSE(contains(gas.err, "can never be resumed"));
   dir.write("g.json", long_gas + " ");
   const Result changed = run(dir, {"run", g.string(), "--until", "1", "--resume", c});
   CHECK(changed.code == 2);
