@@ -30,10 +30,35 @@ def run(cmd, cwd, env=None, ok=(0,)):
     return r
 
 
+def check_mpi_crash(mpirun, tg, plugin, tmp, env):
+    """Under mpirun a run that crashes (a plugin's segfault) is named and the other runs finish, as on
+    one machine. Before: the rank died, mpirun aborted every rank without naming the run, and every
+    resume met the same run and died again."""
+    world = {"format": "turtlegas-world/1", "name": "crash sweep", "arena": {"width": 200, "height": 200},
+             "turtles": [{"id": "t", "pos": [100, 100], "controller": "wander"}]}
+    (tmp / "crash_world.json").write_text(json.dumps(world))
+    spec = {"format": "turtlegas-sweep/1", "world": "crash_world.json", "until": 2, "mode": "exact", "seeds": [1, 2],
+            "grid": {"/turtles/0/controller": ["wander", "segfaulter", "wander"]}}
+    (tmp / "crash.json").write_text(json.dumps(spec))
+    out = tmp / "crash.jsonl"
+    cmd = [mpirun, "--oversubscribe", "-n", "3", tg, "sweep", "crash.json", "--out", out, "--plugin", plugin]
+    for attempt in ("first", "resumed"):
+        res = run(cmd, tmp, env=env, ok=(1,))
+        for k in (2, 3):
+            if "sweep: run {} failed".format(k) not in res.stderr or "signal 11" not in res.stderr:
+                fail("{} mpirun sweep did not name crashed run {}:\n{}".format(attempt, k, res.stderr[-3000:]))
+        journal = [json.loads(l) for l in Path(str(out) + ".partial").read_text().splitlines()[2:]]
+        if sorted(j["run"] for j in journal) != [0, 1, 4, 5]:
+            fail("{} mpirun sweep did not finish the runs that do not crash: {}".format(attempt, [j["run"] for j in journal]))
+        if attempt == "resumed" and "resuming: 4 of 6 runs" not in res.stderr:
+            fail("the second mpirun sweep did not resume:\n" + res.stderr[-2000:])
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--turtlegas", required=True, type=Path)
     ap.add_argument("--source", required=True, type=Path)
+    ap.add_argument("--test-plugin", type=Path, help="tests/cli's plugin (its segfaulter crashes a run)")
     a = ap.parse_args()
     tg = a.turtlegas.resolve()
     tmp = Path(tempfile.mkdtemp(prefix="turtlegas-sweep-test-"))
@@ -134,6 +159,9 @@ def main():
             if mpi_out.read_bytes() != ref.read_bytes():
                 fail("mpirun -n 3 gave another results file")
             note = "; mpirun -n 3 gives the same file"
+            if a.test_plugin:
+                check_mpi_crash(mpirun, tg, a.test_plugin.resolve(), tmp, env)
+                note += "; a crashing run is named and the rest finish"
         else:
             res = run([tg, "sweep", spec, "--out", tmp / "nompi.jsonl"], tmp)
             if "libopenmpi-dev" not in res.stderr:

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -63,6 +64,27 @@ Inputs read_inputs(int fd) {
   return {text.substr(eol + 1, size), text.substr(eol + 1 + size)};
 }
 
+std::vector<std::string> child_args(const SweepOptions& options, const std::vector<std::string>& plugins,
+                                    const Spec& spec, std::size_t k, int inputs_fd) {
+  std::vector<std::string> a = {"sweep", spec.file, "--run", std::to_string(k), "--inputs-fd", std::to_string(inputs_fd),
+                                "--stack-kib", std::to_string(options.stack_kib), "--program-budget",
+                                json(options.program_budget).dump()};
+  for (const std::string& p : plugins) a.insert(a.end(), {"--plugin", p});
+  return a;
+}
+
+std::optional<std::string> child_failure(const ChildResult& r, std::size_t k, std::string& line) {
+  const json j = parse_or_discard(r.report);
+  if (!r.timed_out && r.exited && r.exit_code == 0 && !j.is_discarded() && j.value("run", std::size_t(-1)) == k) {
+    line = r.report;
+    while (!line.empty() && line.back() == '\n') line.pop_back();
+    return std::nullopt;
+  }
+  std::string why = r.timed_out ? "ran past --timeout" : r.how_it_ended();
+  if (!r.err.empty()) why += "\n" + r.err;
+  return why;
+}
+
 int run_local(const SweepOptions& options, const std::vector<std::string>& plugins, const Spec& spec,
               const std::string& out) {
   Results results;
@@ -75,30 +97,21 @@ int run_local(const SweepOptions& options, const std::vector<std::string>& plugi
   // Every run is of the bytes read here, not of the files as they may be by the time it starts.
   const int inputs_fd = share_inputs(spec.bytes);
   std::vector<std::vector<std::string>> args;
-  for (std::size_t k : pending) {
-    std::vector<std::string> a = {"sweep", spec.file, "--run", std::to_string(k), "--inputs-fd", std::to_string(inputs_fd),
-                                  "--stack-kib", std::to_string(options.stack_kib), "--program-budget",
-                                  json(options.program_budget).dump()};
-    for (const std::string& p : plugins) a.insert(a.end(), {"--plugin", p});
-    args.push_back(std::move(a));
-  }
+  for (std::size_t k : pending) args.push_back(child_args(options, plugins, spec, k, inputs_fd));
   std::size_t failed = 0;
   StatusLine status(!options.quiet);
   auto on_done = [&](std::size_t i, ChildResult&& r) {
     const std::size_t k = pending[i];
     status.clear();
     if (r.stopped) return;  // killed at SIGINT or SIGTERM: left for the resumed sweep
-    const json j = parse_or_discard(r.report);
-    if (!r.timed_out && r.exited && r.exit_code == 0 && !j.is_discarded() && j.value("run", std::size_t(-1)) == k) {
-      std::string line = r.report;
-      while (!line.empty() && line.back() == '\n') line.pop_back();
+    std::string line;
+    if (std::optional<std::string> why = child_failure(r, k, line)) {
+      ++failed;
+      spdlog::error("sweep: run {} failed: {}", k, *why);
+    } else {
       journal.record(line);
       results[k] = std::move(line);
       if (!options.quiet) spdlog::info("sweep: run {} done ({} of {})", k, results.size(), spec.runs);
-    } else {
-      ++failed;
-      std::string why = r.timed_out ? "ran past --timeout" : r.how_it_ended();
-      spdlog::error("sweep: run {} failed: {}{}{}", k, why, r.err.empty() ? "" : "\n", r.err);
     }
   };
   // "12 of 40 runs done; running: run 12 (4 s), run 13 (1 s)".

@@ -7,12 +7,15 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <spdlog/spdlog.h>
 
 #ifdef TURTLEGAS_HAVE_MPI
 #include <mpi.h>
 #endif
 
+#include "child_processes.hpp"
 #include "cli_common.hpp"
 #include "sweep/sweep.hpp"
 
@@ -38,6 +41,8 @@ int mpi_master(const SweepOptions& options, const Spec& spec, const std::string&
   std::vector<std::size_t> pending;
   for (std::size_t k = 0; k < spec.runs; ++k)
     if (!results.count(k)) pending.push_back(k);
+  if (!results.empty() && !options.quiet)
+    spdlog::info("sweep: resuming: {} of {} runs already recorded in {}.partial", results.size(), spec.runs, out);
   std::size_t next = 0, failed = 0;
   int active = size - 1;
   while (active > 0) {
@@ -93,8 +98,12 @@ void share_rank0_inputs(int rank, const Spec& spec) {
 
 Spec rank0_spec(const Spec& spec) { return parse_spec(spec.file, &g_rank0_inputs); }
 
-/// Ranks 1 ... K-1: ask for a run, run it here, send its line, until told to stop.
-int mpi_worker(const SweepOptions& options, const Spec& spec, const turtle::Registry& registry) {
+/// Ranks 1 ... K-1: ask for a run, run it in a child process of this rank (as run_local does), send
+/// its line or why it failed, until told to stop. A run that crashes (a plugin's segfault, an
+/// abort) ends its child, named in the reply, not the rank: under mpirun a rank that dies takes
+/// every rank with it, and each resume met the same run and died again.
+int mpi_worker(const SweepOptions& options, const Spec& spec, const std::vector<std::string>& plugins) {
+  const int inputs_fd = share_inputs(g_rank0_inputs);
   std::string msg;
   int tag = tag_ready;
   for (;;) {
@@ -102,14 +111,27 @@ int mpi_worker(const SweepOptions& options, const Spec& spec, const turtle::Regi
     std::uint64_t k = 0;
     MPI_Status st;
     MPI_Recv(&k, 1, MPI_UINT64_T, 0, MPI_ANY_TAG, MPI_COMM_WORLD, &st);
-    if (st.MPI_TAG == tag_stop) return exit_ok;
+    if (st.MPI_TAG == tag_stop) break;
+    const std::size_t run = static_cast<std::size_t>(k);
+    msg.clear();
     try {
-      msg = run_one(spec, static_cast<std::size_t>(k), registry, server_options(options)).dump();
+      run_children({child_args(options, plugins, spec, run, inputs_fd)}, 1, options.timeout,
+                   {[&](std::size_t, ChildResult&& r) {
+                      std::string line;
+                      if (std::optional<std::string> why = child_failure(r, run, line))
+                        msg = json{{"run", k}, {"error", *why}}.dump();
+                      else
+                        msg = std::move(line);
+                    },
+                    nullptr});
     } catch (const std::exception& e) {
       msg = json{{"run", k}, {"error", e.what()}}.dump();
     }
+    if (msg.empty()) msg = json{{"run", k}, {"error", "stopped before it ended"}}.dump();
     tag = tag_result;
   }
+  ::close(inputs_fd);
+  return exit_ok;
 }
 #endif
 
@@ -132,7 +154,8 @@ int run_launched(const SweepOptions& options, const turtle::Registry& registry, 
       if (!options.quiet) spdlog::info("sweep: {} runs over {} MPI ranks (rank 0 hands them out)", spec.runs, size);
       rc = mpi_master(options, spec, out, size);
     } else {
-      rc = mpi_worker(options, rank0_spec(spec), registry);
+      rc = mpi_worker(options, rank0_spec(spec), plugins);
+      (void)registry;
     }
     MPI_Finalize();
     return rank == 0 ? rc : exit_ok;

@@ -12,12 +12,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "child_processes.hpp"
 #include "sweep_command.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/turtle/registry.hpp"
@@ -116,6 +118,12 @@ std::vector<std::string> summary_not_found(const Spec& spec, const Results& resu
 /// summary pointer is in no result line (the results are written all the same).
 int finish(const std::string& out, const Spec& spec, Results& results, Journal& journal, std::size_t failed);
 
+/// The command line of the child that runs run k (`sweep SPEC --run k --inputs-fd FD ...`).
+std::vector<std::string> child_args(const SweepOptions& options, const std::vector<std::string>& plugins,
+                                    const Spec& spec, std::size_t k, int inputs_fd);
+/// Why the child that ran run k failed (a crash, a timeout, no report: its stderr appended), or
+/// nothing when it reported run k; then `line` is its result line.
+std::optional<std::string> child_failure(const ChildResult& r, std::size_t k, std::string& line);
 /// Runs the sweep's runs as child processes of this machine, --jobs at once.
 int run_local(const SweepOptions& options, const std::vector<std::string>& plugins, const Spec& spec,
               const std::string& out);
