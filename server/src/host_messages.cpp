@@ -87,6 +87,16 @@ void WorldHost::handle(Inbound& in) {
       if (it == clients_.end()) return;
       release_all(it->second, "disconnected");
       clients_.erase(it);
+      if (clients_.empty() && runs_away_alone()) {
+        // Nobody watches, and the files would grow without bound: `serve --speed max --record R`
+        // wrote 240 MB in 10 s after its client left. A client's `resume` goes on.
+        paused_ = true;
+        steps_left_ = 0;
+        pause_at_.reset();
+        spdlog::warn("the last client left at t = {} s: paused (at --speed max with no --until the files written would "
+                     "grow without bound); a client's resume goes on",
+                     fmt(server_->time()));
+      }
       return;
     }
     case Inbound::Kind::state: {

@@ -120,6 +120,10 @@ bool WorldHost::wait_inbox_until(double deadline) {
 
 int WorldHost::run() {
   reanchor();
+  if (runs_away_alone())
+    spdlog::warn("--speed max with no --until: the files this server writes grow as fast as the world runs "
+                 "(hundreds of MB a minute for a gas), whether or not anyone is connected; it pauses when the last "
+                 "client leaves. Give --until T to bound the run");
   if (options_.until && server_->time() >= *options_.until) {
     stopping_ = true;
     stop_reason_ = "until";
@@ -185,6 +189,11 @@ int WorldHost::run() {
   spdlog::info("stopped at t={} ({})", fmt(server_->time()), stop_reason_);
   if (on_finished) on_finished();
   return output_error_.empty() ? 0 : 1;
+}
+
+bool WorldHost::runs_away_alone() const {
+  const bool files = !options_.events_path.empty() || !options_.inputs_path.empty() || !options_.record_path.empty();
+  return files && speed_ == 0.0 && !options_.until && !options_.replay && !ended_;
 }
 
 void WorldHost::step_world(double target) {

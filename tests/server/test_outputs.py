@@ -57,5 +57,40 @@ def test_inputs_survive_sigkill():
         shutil.rmtree(d)
 
 
+def test_runaway_pauses_when_alone():
+    """serve --speed max with no --until and a file output warns at the start and pauses when its last
+    client leaves (before: 240 MB in 10 s after the client left); a client's resume goes on."""
+    import time
+    d = tempfile.mkdtemp()
+    try:
+        events = os.path.join(d, "events.jsonl")
+        with Server(world("gas_1000.json"), "--speed", "max", "--events", events) as s:
+            w = World.connect(port=s.line_port)
+            t0 = w.request({"type": "ping"})["t"]
+            w.close()
+            deadline = time.time() + 30
+            while time.time() < deadline and "the last client left" not in s.err():
+                time.sleep(0.05)
+            check("the last client left" in s.err(), "no pause when the last client left: %s" % s.err())
+            check("--speed max with no --until" in s.err(), "no warning at the start: %s" % s.err())
+            time.sleep(0.3)
+            size = os.path.getsize(events)
+            time.sleep(1.0)
+            check(os.path.getsize(events) == size, "the event log grew while paused with nobody connected")
+            w = World.connect(port=s.line_port)
+            t1 = w.request({"type": "ping"})["t"]
+            w.request({"type": "resume"})
+            time.sleep(0.5)
+            t2 = w.request({"type": "ping"})["t"]
+            check(t1 > t0 and t2 > t1, "the world ran, paused and went on after resume: %r %r %r" % (t0, t1, t2))
+            w.close()
+        # With --until the run is bounded: no warning, and leaving does not pause it.
+        with Server(world("gas_1000.json"), "--speed", "max", "--until", "0.2", "--events", events) as s:
+            code = s.wait(60)
+            check(code == 0 and "--speed max with no --until" not in s.err(), "a bounded run was warned about: %s" % s.err())
+    finally:
+        shutil.rmtree(d)
+
+
 if __name__ == "__main__":
-    main([test_full_disk_exits_non_zero, test_inputs_survive_sigkill])
+    main([test_full_disk_exits_non_zero, test_inputs_survive_sigkill, test_runaway_pauses_when_alone])

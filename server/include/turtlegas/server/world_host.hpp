@@ -167,6 +167,10 @@ class WorldHost {
   void at_boundary(turtle::WorldServer& server, std::uint64_t step);
   double now() const;  ///< steady clock, seconds
   void reanchor();
+  /// Whether this world, left alone, writes files that grow without bound: a live world (not a
+  /// replay) at --speed max with no --until and an event log, input log or recording. It pauses
+  /// when its last client leaves.
+  bool runs_away_alone() const;
 
   // The world (host_world.cpp).
   void build_world(world::Scene scene);
