@@ -308,6 +308,13 @@ def check_altered(rec):
         if at:
             assert at in err, err
         assert err.count("differs from the recording") == 1, err  # once
+    # A header re-written with spaces after the colons is still a recording (before: read as a world
+    # file and refused, exit 2).
+    spaced = path("spaced.tgrec")
+    with open(spaced, "wb") as f:
+        f.write(json.dumps(json.loads(header)).encode() + b"\n" + rest)
+    p = run("render", spaced, "--at", 1.0, "--out", path("spaced.svg"))
+    assert b"not a world" not in p.stderr and os.path.getsize(path("spaced.svg")) > 1000, p.stderr
 
 
 def main():
