@@ -172,7 +172,9 @@ Recording read_recording(const std::string& path) {
   r.bytes = static_cast<std::uint64_t>(in.tellg());
   in.seekg(0);
   std::string line;
-  if (!std::getline(in, line) || in.eof())
+  // Every line of a recording opens with '{': anything else (a zero-filled tail a crash left) is not
+  // read as a line, which for an unterminated tail of GB took all memory.
+  if (in.peek() != '{' || !std::getline(in, line) || in.eof())
     throw std::invalid_argument(path + ": not a recording, or cut before the end of its header (line 1)");
   r.header = parse_header(line, path);
   const std::uint64_t header_end = line.size() + 1;
@@ -220,7 +222,7 @@ Recording read_recording(const std::string& path) {
   in.clear();
   in.seekg(static_cast<std::streamoff>(header_end));
   std::uint64_t offset = header_end, lines = 0;
-  while (std::getline(in, line)) {
+  while (in.peek() == '{' && std::getline(in, line)) {
     const bool whole = !in.eof();  // a last line without its newline was cut
     if (!whole) break;
     if (starts_with(line, "{\"keyframe\":")) {
