@@ -11,6 +11,7 @@
 
 #include "cli_common.hpp"
 #include "output_file.hpp"
+#include "signals.hpp"
 #include "sweep/sweep.hpp"
 
 namespace turtlegas::apps {
@@ -51,6 +52,8 @@ int sweep_command(const SweepOptions& options, const turtle::Registry& registry,
     const sweep::Spec spec = sweep::parse_spec(options.spec, &given);
     if (*options.child_run >= spec.runs)
       throw BadInput("sweep --run is for turtlegas itself: it runs one run of the sweep and reports on descriptor 3");
+    // A crash names the run, the turtle and its controller, as `run` does (the parent shows it).
+    install_crash_report(spec.world_file + " (sweep run " + std::to_string(*options.child_run) + ")");
     const std::string line = sweep::run_one(spec, *options.child_run, registry, sweep::server_options(options)).dump() + "\n";
     for (std::size_t done = 0; done < line.size();) {
       const ssize_t n = ::write(3, line.data() + done, line.size() - done);

@@ -47,6 +47,9 @@ def check_mpi_crash(mpirun, tg, plugin, tmp, env):
         for k in (2, 3):
             if "sweep: run {} failed".format(k) not in res.stderr or "signal 11" not in res.stderr:
                 fail("{} mpirun sweep did not name crashed run {}:\n{}".format(attempt, k, res.stderr[-3000:]))
+            if "(sweep run {})".format(k) not in res.stderr or "'segfaulter'" not in res.stderr:
+                fail("{} mpirun sweep: crashed run {}'s turtle and controller not named:\n{}".format(
+                    attempt, k, res.stderr[-3000:]))
         journal = [json.loads(l) for l in Path(str(out) + ".partial").read_text().splitlines()[2:]]
         if sorted(j["run"] for j in journal) != [0, 1, 4, 5]:
             fail("{} mpirun sweep did not finish the runs that do not crash: {}".format(attempt, [j["run"] for j in journal]))
