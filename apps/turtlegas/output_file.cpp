@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "output_file.hpp"
 
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -13,6 +14,8 @@
 #include <string>
 #include <system_error>
 #include <utility>
+
+#include <spdlog/spdlog.h>
 
 #include "cli_common.hpp"
 
@@ -105,6 +108,38 @@ int CheckedFileBuf::sync() {
 
 }  // namespace detail
 
+namespace {
+
+/// The temporaries `.NAME.tmp-PID` beside `target` left by runs that were killed (SIGKILL, a power
+/// cut: nothing of theirs ran to remove them) and whose process is gone: an empty one is removed, one
+/// with something in it (an event log up to its last flushed line) is renamed to NAME.killed-PID,
+/// where a user sees it, and named. Before, they piled up hidden.
+void tidy_killed_temporaries(const fs::path& dir, const fs::path& target, const std::string& opt) {
+  const std::string prefix = "." + target.filename().string() + ".tmp-";
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;  // its run may still be going
+    std::error_code e;
+    if (!it->is_regular_file(e)) continue;
+    if (fs::file_size(it->path(), e) == 0) {
+      fs::remove(it->path(), e);
+      continue;
+    }
+    const fs::path kept = target.string() + ".killed-" + digits;
+    fs::rename(it->path(), kept, e);
+    if (!e)
+      spdlog::warn("{}: a run that was killed (process {}, gone) left what it had written of {} hidden in {}; kept as {}",
+                   opt, digits, target.filename().string(), name, kept.string());
+  }
+}
+
+}  // namespace
+
 OutputFile::OutputFile(const std::string& path, std::string_view option, Write how) : path_(path), option_(option) {
   const std::string opt(option);
   if (path == "-") {
@@ -136,6 +171,7 @@ OutputFile::OutputFile(const std::string& path, std::string_view option, Write h
     if (fs::is_regular_file(st)) fs::permissions(tmp_, st.permissions(), ec);
     return;
   }
+  tidy_killed_temporaries(dir, target_, opt);
   tmp_ = dir / ("." + target_.filename().string() + ".tmp-" + std::to_string(::getpid()));
   buf_.open(tmp_, std::ios::binary | std::ios::out | std::ios::trunc);
   if (!buf_.is_open()) throw BadInput(opt + ": cannot write in '" + dir.string() + "'; check its permissions");

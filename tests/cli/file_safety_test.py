@@ -355,7 +355,33 @@ def check_full_disk_checkpoint():
     assert json.loads(read(state))["t"] == 1.0
 
 
+def check_killed_temporaries():
+    """A run killed with SIGKILL leaves its event log in a hidden temporary (.ev.jsonl.tmp-PID); the next
+    run writing that file keeps it as ev.jsonl.killed-PID, says so, and leaves no hidden temporary
+    (before: they piled up, hidden)."""
+    d = path("killed")
+    os.makedirs(d, exist_ok=True)
+    w = gas_world("killed/w.json")
+    p = subprocess.Popen([BIN, "run", w, "--until", "1e9", "--events", "ev.jsonl", "--state-out", "st.json"], cwd=d,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    hidden = os.path.join(d, ".ev.jsonl.tmp-%d" % p.pid)
+    try:
+        wait_for(lambda: os.path.exists(hidden) and os.path.getsize(hidden) > 10000, 60, "the event log to grow")
+    finally:
+        p.kill()
+        p.wait()
+    written = read(hidden)
+    r = run("run", w, "--until", "0.1", "--events", "ev.jsonl", "--state-out", "st.json", ok=(0,), cwd=d)
+    err = r.stderr.decode()
+    kept = os.path.join(d, "ev.jsonl.killed-%d" % p.pid)
+    assert os.path.exists(kept) and read(kept) == written, "the killed run's event log was not kept as %s" % kept
+    assert "a run that was killed (process %d, gone)" % p.pid in err, err
+    left = [f for f in os.listdir(d) if ".tmp-" in f]
+    assert not left, "hidden temporaries left: %s" % left
+
+
 CASES = {
+    "killed_temporaries": check_killed_temporaries,
     "record": check_record_not_truncated,
     "checkpoint": check_checkpoint_world_hash,
     "checkpoint_damaged": check_checkpoint_damaged,
