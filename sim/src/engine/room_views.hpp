@@ -133,7 +133,10 @@ struct Parts {
   }
   /// Body `id`, a turtle, touched `other` (see Turtles::touch).
   void touch(std::uint32_t id, EventKind kind, std::uint32_t other, Vec2 normal) const {
-    turtles.touch(id - bodies.balls(), bodies.body[id], bodies.end[id], now, t_base, dt, kind, other, normal);
+    const std::size_t k = id - bodies.balls();
+    turtles.touch(k, bodies.body[id], bodies.end[id], now, t_base, dt, kind, other, normal);
+    if (const std::uint64_t j = turtles.end_step[k]; j != kNoStep)
+      bodies.end[id] = internal_boundary(j, t_base, dt, kStep, step.index);
   }
   /// The bounce of ball i (at the contact, its velocity not yet changed) off an obstacle, v its
   /// velocity relative to the obstacle (Restitution::bounce, under the ball's field, plus `press`:
