@@ -331,8 +331,21 @@ Changed apply_moving_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, st
   const double dist = norm(F);
   p.record.note_contact(a.r - dist, a.r);
   if (p.is_turtle(i)) {
+    const Vec2 n = F / dist;
     p.count(p.record.stats.turtle_wall_end, EventKind::turtle_wall_end, i - p.bodies.balls(), m.wall);
-    p.touch(i, EventKind::turtle_wall_end, m.wall, F / dist);
+    p.touch(i, EventKind::turtle_wall_end, m.wall, n);
+    // The end does for a turtle what the face does (apply_wall): both have infinite mass, so the
+    // turtle cannot stop dead in its way (it did, and the end swept through it, issue 28 item 7).
+    // A translating wall's end carries it at its normal speed, the perfectly inelastic contact:
+    // head on it pushes it along as a face would; off its line the end then slides past it
+    // (relative to the end the turtle moves along the tangent, and the gap opens), and the turtle
+    // goes on at that speed, knocked off, until the wall's next keyframe ends the push
+    // (contacts/carried.hpp). A turning wall's end knocks it off at twice its normal speed, as
+    // the turning face does.
+    const double un = dot(ue, n);
+    double knock = m.rigid() ? un : 2.0 * un;
+    if (!m.rigid() && knock > 0.0) knock = std::max(knock, kDepartFloor * norm(ue));
+    if (knock > 0.0) carry(p.turtles, i - p.bodies.balls(), a, knock * n, code / 2, kNone);
   } else {
     const Vec2 va = a.v;
     a.v = ue + p.bounce(i, a.v - ue, F / dist);
