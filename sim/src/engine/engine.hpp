@@ -181,6 +181,7 @@ class Engine final : public EngineBase {
     else return detail::energy(look(), motion_.flight());
   }
   const Stats& stats() const override { return record_.stats; }
+  const std::vector<double>& energy_taken() const override { return record_.taken; }
   Overlap measure_overlap() const override { return detail::measure_overlap<kBallBall>(look(), arena_); }
   Overlap max_contact_overlap() const override { return record_.max_contact; }
   double cell_size() const override { return std::min(grid_.cell_w(), grid_.cell_h()); }
@@ -498,6 +499,10 @@ void Engine<F, kBallBall, kStep, kExtras>::crush(std::uint32_t i, const Side& A,
   record_.note(t_base_ + now_, EventKind::crushed, turtle ? i - nb : i, A.name, B.name,
                squeeze_flags(turtle, A, B));
   ++record_.stats.crushed;
+  if (!turtle) {  // the ledger: a ball leaves with its energy (checks.hpp's, as energy() counts it)
+    if constexpr (kStep) record_.take_energy(record_.stats.energy_crushed, i, ball_energy(look(), kick_, i));
+    else record_.take_energy(record_.stats.energy_crushed, i, ball_energy(look(), motion_.flight(), i));
+  }
   unlink(i);
   retire(i);
 }

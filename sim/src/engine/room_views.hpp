@@ -52,6 +52,14 @@ struct EventRecord {
   void note(double t, EventKind kind, std::uint32_t a, std::uint32_t b, std::uint32_t c = 0, std::uint8_t flags = 0) {
     if (log) log->push_back({t, kind, a, b, c, flags});
   }
+  /// Per ball: the energy the zero-time rules took from it (World::energy_taken).
+  std::vector<double> taken;
+  /// A zero-time rule took energy e from ball `ball`: into its rule's total (a Stats::energy_*).
+  void take_energy(double& rule_total, std::uint32_t ball, double e) {
+    rule_total += e;
+    if (taken.size() <= ball) taken.resize(ball + 1, 0.0);
+    taken[ball] += e;
+  }
 };
 
 /// What a prediction reads.
