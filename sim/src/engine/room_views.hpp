@@ -149,9 +149,11 @@ struct Parts {
   /// The bounce of ball i (at the contact, its velocity not yet changed) off an obstacle, v its
   /// velocity relative to the obstacle (Restitution::bounce, under the ball's field, plus `press`:
   /// the ball's acceleration along n relative to the obstacle that the obstacle's own motion adds,
-  /// a turning wall's; negative presses).
-  Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n, double press = 0.0) const {
-    const double a_n = motion.flight().normal_accel(i, bodies.body[i].v, n) + press;
+  /// a turning wall's; negative presses). `curve`: what the obstacle's own curvature adds to the
+  /// second derivative of the gap for the ball as it moves (a point at distance d: |v_t|² / d, the
+  /// normal turning as the ball passes it), which a ball at rest does not have.
+  Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n, double press = 0.0, double curve = 0.0) const {
+    const double a_n = motion.flight().normal_accel(i, bodies.body[i].v, n) + press + curve;
     // A ball at rest feels no magnetic part (only the charged flight has one).
     if constexpr (F::kBoundedHorizon) return restitution.bounce(v, n, a_n, motion.flight().normal_accel(i, Vec2{}, n) + press);
     else return restitution.bounce(v, n, a_n, a_n);
