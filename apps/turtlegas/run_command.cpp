@@ -99,6 +99,10 @@ void print_summary(const formats::RunFigures& run, const sim::World& world, cons
   if (st.folded > 0)
     std::printf("  folded       %llu elastic wedges, energy kept (docs/physics.md, \"The elastic wedge\")\n",
                 ull(st.folded));
+  if (st.wedged + st.crushed + st.folded > 0)
+    std::printf("  energy rules %s taken (wedged %s, crushed %s, folded %s; docs/physics.md, \"The energy ledger\")\n",
+                fmt(st.energy_rules()).c_str(), fmt(st.energy_wedged).c_str(), fmt(st.energy_crushed).c_str(),
+                fmt(st.energy_folded).c_str());
   std::printf("  events       %llu  (cell crossings %llu, stale %llu, steps %llu)\n", ull(st.events),
               ull(st.cell_crossings), ull(st.stale), ull(st.steps));
   std::printf("  wall time    %.3f s  (%s collisions/s)\n", run.wall_seconds, fmt(run.collisions_per_second(st)).c_str());
@@ -575,6 +579,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     state_file->commit();
   }
   if (stats_file) {
+    run.ball_name = [&](std::size_t i) { return std::string(current_names().ball(i)); };
     formats::write_stats(stats_file->stream(), run, world);
     stats_file->commit();
   }

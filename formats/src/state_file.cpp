@@ -36,9 +36,14 @@ void write_state(std::ostream& out, const sim::World& world, const RunNames& nam
     }
   }
   buf += first ? "], \"turtles\": [" : "\n], \"turtles\": [";
+  // A turtle that has left the world (crushed, out of an open arena, removed) is not in it, as an
+  // exited ball is not.
+  first = true;
   for (std::size_t i = 0; i < world.turtle_count(); ++i) {
+    if (!world.turtle_alive(i)) continue;
     const sim::TurtleState tu = world.turtle(i);
-    buf += i == 0 ? "\n  " : ",\n  ";
+    buf += first ? "\n  " : ",\n  ";
+    first = false;
     buf += "{\"id\": ";
     append_json_string(buf, names.turtle(i));
     buf += ", \"pos\": [";
@@ -51,7 +56,7 @@ void write_state(std::ostream& out, const sim::World& world, const RunNames& nam
     append_number(buf, heading);
     buf += "}";
   }
-  buf += world.turtle_count() == 0 ? "]}\n" : "\n]}\n";
+  buf += first ? "]}\n" : "\n]}\n";
   out << buf;
 }
 

@@ -1,9 +1,33 @@
 // SPDX-License-Identifier: MIT
 #include "turtlegas/formats/stats_file.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
 #include "turtlegas/sim/mode_names.hpp"
 
 namespace turtlegas::formats {
+
+nlohmann::json energy_rules_json(const RunFigures& run, const sim::World& world) {
+  const sim::Stats& st = world.stats();
+  // The balls the rules took most from, by the size of what they took: at most kShown of them.
+  constexpr std::size_t kShown = 20;
+  const std::vector<double>& taken = world.energy_taken();
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < taken.size(); ++i)
+    if (taken[i] != 0.0) order.push_back(i);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return std::abs(taken[a]) > std::abs(taken[b]); });
+  nlohmann::json bodies = nlohmann::json::array();
+  for (std::size_t k = 0; k < std::min(order.size(), kShown); ++k) {
+    const std::size_t i = order[k];
+    bodies.push_back({{"id", run.ball_name ? run.ball_name(i) : "#" + std::to_string(i)}, {"taken", taken[i]}});
+  }
+  return {{"wedged", st.energy_wedged}, {"crushed", st.energy_crushed}, {"folded", st.energy_folded},
+          {"total", st.energy_rules()}, {"bodies_count", order.size()}, {"bodies", bodies}};
+}
 
 nlohmann::json stats_json(const RunFigures& run, const sim::World& world) {
   const sim::Stats& st = world.stats();
@@ -48,6 +72,7 @@ nlohmann::json stats_json(const RunFigures& run, const sim::World& world) {
       {"overlap_samples", run.overlap_samples},
   };
   if (!run.stopped.empty()) j["stopped"] = run.stopped;
+  j["energy_rules"] = energy_rules_json(run, world);
   return j;
 }
 

@@ -356,7 +356,7 @@ std::shared_ptr<const std::string> FrameStream::build(const turtle::WorldServer&
     put<float>(s, static_cast<float>(heading_degrees(info.state)));
     flags[i] = (info.pen_down ? 1u : 0u) | (info.pen_down && info.pen_mode == turtle::PenMode::wall ? 2u : 0u) |
                (info.it ? 4u : 0u) | (info.remote ? 8u : 0u) | (i < claimed.size() && claimed[i] ? 16u : 0u) |
-               (info.finished ? 32u : 0u);
+               (info.finished ? 32u : 0u) | (info.gone ? 64u : 0u);
   }
   for (std::uint32_t f : flags) put<std::uint32_t>(s, f);
   s += tail;

@@ -92,6 +92,7 @@ export function drawPanel(p, now) {
   }
   if (layers & 4) {  // turtles
     for (const t of S.turtles) {
+      if (t.gone) continue;  // crushed, out of the arena or removed: no longer in the world
       if (t.x + t.radius < x0 || t.x - t.radius > x1 || t.y + t.radius < y0 || t.y - t.radius > y1) continue;
       ctx.fillStyle = (layers & 32) && t.it ? COLOURS.it : t.remote ? COLOURS.remote : COLOURS.turtle;
       ctx.beginPath();
@@ -137,6 +138,7 @@ export function drawPanel(p, now) {
     ctx.font = `${(11 * dpr).toFixed(0)}px system-ui, sans-serif`;
     ctx.textAlign = 'center';
     for (const t of S.turtles) {
+      if (t.gone) continue;
       const [qx, qy] = apply(M, t.x, t.y);
       if (qx < -20 || qx > W + 20 || qy < -20 || qy > H + 20) continue;
       const label = (layers & 32) && t.it ? t.id + ' (it)' : t.id;

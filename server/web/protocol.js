@@ -111,7 +111,7 @@ function onSnapshot(m) {
   for (const t of (S.world && S.world.turtles) || []) names.set(t.id, t.sensors);
   S.turtles = m.turtles.map((t) => ({
     id: t.id, radius: t.radius, x: t.pos[0], y: t.pos[1], heading: t.heading, pen: t.pen, it: t.it,
-    remote: t.remote, claimed: t.claimed, finished: t.finished,
+    remote: t.remote, claimed: t.claimed, finished: t.finished, gone: !!t.gone,
     cat: t.layers ? t.layers[0] >>> 0 : 1, mask: t.layers ? t.layers[1] >>> 0 : 0xffffffff,
     arcs: t.arcs || [], sensorNames: names.get(t.id) || [], flash: new Map(),
     trail: t.trail.slice(),
@@ -188,7 +188,7 @@ function onJsonFrame(m) {
     const t = S.turtles[i];
     if (!t) return;
     Object.assign(t, {x: u.pos[0], y: u.pos[1], heading: u.heading, pen: u.pen, it: u.it, remote: u.remote,
-                      claimed: u.claimed, finished: u.finished});
+                      claimed: u.claimed, finished: u.finished, gone: !!u.gone});
   });
   applyParts(m.turtles.map((u) => ({from: u.trail_from, points: u.trail})), m.walls_from, m.walls);
   applyEvents(m.events);
@@ -223,7 +223,7 @@ function onBinaryFrame(buf) {
     const t = S.turtles[i], f = tflags[i];
     t.x = tur[3 * i]; t.y = tur[3 * i + 1]; t.heading = tur[3 * i + 2];
     t.pen = (f & 1) ? ((f & 2) ? 'wall' : 'line') : 'up';
-    t.it = !!(f & 4); t.remote = !!(f & 8); t.claimed = !!(f & 16); t.finished = !!(f & 32);
+    t.it = !!(f & 4); t.remote = !!(f & 8); t.claimed = !!(f & 16); t.finished = !!(f & 32); t.gone = !!(f & 64);
   }
   applyClock(dv.getFloat64(24, true), Number(dv.getBigUint64(40, true)), !!(flags & 1), undefined, tail.sim_events);
   applyParts(tail.trails, tail.walls_from, tail.walls);

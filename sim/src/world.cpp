@@ -68,6 +68,7 @@ void World::command_turtle(std::size_t i, const TurtleCommand& command) { impl_-
 std::vector<TurtleContact> World::take_turtle_contacts() { return impl_->engine->take_turtle_contacts(); }
 double World::energy() const { return impl_->engine->energy(); }
 const Stats& World::stats() const { return impl_->engine->stats(); }
+const std::vector<double>& World::energy_taken() const { return impl_->engine->energy_taken(); }
 Overlap World::measure_overlap() const { return impl_->engine->measure_overlap(); }
 Overlap World::max_contact_overlap() const { return impl_->engine->max_contact_overlap(); }
 

@@ -484,3 +484,33 @@ TEST_CASE("cli: --observe writes the gas observables and --svg-trails the balls'
     CHECK(contains(b.err, "step mode"));
   }
 }
+
+TEST_CASE("cli: --stats and --stats-json report the energy the zero-time rules took, by rule and by ball") {
+  // issue 28, Accounting: worlds/tests/wedged_ball.json wedges ball b moving across a corridor
+  // exactly its width; the rule takes its transverse energy, 0.5 of E = 0.53125, and says so.
+  TempDir dir;
+  const fs::path stats = dir.path / "stats.json";
+  const Result r = run(dir, {"run", std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/tests/wedged_ball.json", "--until",
+                             "5", "--stats", "--stats-json", stats.string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(contains(r.out, "energy rules 0.5 taken (wedged 0.5, crushed 0, folded 0"));
+  const json st = json::parse(read(stats));
+  const json& rules = st.at("energy_rules");
+  CHECK(rules.at("wedged").get<double>() == Approx(0.5).epsilon(1e-12));
+  CHECK(rules.at("crushed").get<double>() == 0.0);
+  CHECK(rules.at("folded").get<double>() == 0.0);
+  CHECK(rules.at("total").get<double>() == Approx(0.5).epsilon(1e-12));
+  CHECK(rules.at("total").get<double>() ==
+        Approx(st.at("energy_start").get<double>() - st.at("energy_end").get<double>()).epsilon(1e-12));
+  REQUIRE(rules.at("bodies").size() == 1);
+  CHECK(rules.at("bodies").at(0).at("id") == "b");
+  CHECK(rules.at("bodies").at(0).at("taken").get<double>() == Approx(0.5).epsilon(1e-12));
+  // A scene no rule acts on reports zeros and no bodies.
+  const Result plain = run(dir, {"run", std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/tests/box_bounce.json", "--until",
+                                 "5", "--stats-json", stats.string()});
+  REQUIRE(plain.code == 0);
+  const json z = json::parse(read(stats)).at("energy_rules");
+  CHECK(z.at("total").get<double>() == 0.0);
+  CHECK(z.at("bodies").empty());
+}

@@ -81,3 +81,39 @@ TEST_CASE("the state file holds live balls and turtles, headings in [0, 360) as 
   formats::write_state(out, world, formats::RunNames{ids, def, world});
   CHECK(nlohmann::json::parse(out.str())["turtles"][0].at("heading") == 0.375);
 }
+
+TEST_CASE("a crushed turtle is not in the state file, as an exited ball is not", "[formats][regression]") {
+  // Issue 28 item 4: the state file listed a crushed turtle where it was, with the piston that
+  // crushed it then passing through it.
+  sim::WorldDef d;
+  d.arena.width = 300;
+  d.arena.height = 200;
+  d.arena.boundary = sim::Boundary::walls;
+  sim::WallDef w;
+  w.id = "piston";
+  w.from = {20, 10};
+  w.to = {20, 190};
+  w.keys.push_back({10.0, {290, 10}, {290, 190}});
+  d.walls.push_back(w);
+  sim::TurtleDef t;
+  t.id = "crushed";
+  t.pos = {150, 150};
+  t.radius = 8;
+  d.turtles.push_back(t);
+  t.id = "kept";  // above the piston's top end (y = 190): it passes by
+  t.pos = {150, 196};
+  t.radius = 3;
+  d.turtles.push_back(t);
+  for (sim::Mode mode : {sim::Mode::exact, sim::Mode::step}) {
+    sim::World world(d, mode);
+    world.advance_to(12.0);
+    CHECK_FALSE(world.turtle_alive(0));
+    CHECK(world.turtle_alive(1));
+    const formats::IdTable ids = formats::ball_ids(d);
+    std::ostringstream out;
+    formats::write_state(out, world, formats::RunNames{ids, d, world});
+    const nlohmann::json j = nlohmann::json::parse(out.str());
+    REQUIRE(j.at("turtles").size() == 1);
+    CHECK(j["turtles"][0].at("id") == "kept");
+  }
+}

@@ -509,3 +509,73 @@ TEST_CASE("check_params: unknown keys with did-you-mean, types, ranges, comments
   // A controller that declares nothing is not checked.
   CHECK_FALSE(check_params("c", ControllerInfo{}, nlohmann::json::parse(R"({"anything": 1})")).has_value());
 }
+
+namespace {
+/// A piston (x = 20 -> 390 in 10 s, y in [10, 390]) that carries turtles at x = 200 into the right
+/// wall: a turtle of radius 10 is met at t = 170 / 37 and crushed at x = 390 at t = 360 / 37.
+sim::WorldDef piston_scene(std::size_t turtles) {
+  sim::WorldDef d = arena();
+  sim::WallDef w;
+  w.id = "piston";
+  w.from = {20, 10};
+  w.to = {20, 390};
+  w.keys.push_back({10.0, {390, 10}, {390, 390}});
+  d.walls.push_back(w);
+  for (std::size_t k = 0; k < turtles; ++k)
+    d.turtles.push_back(body("t" + std::to_string(k), {200, 100.0 + 100.0 * static_cast<double>(k)}, 0));
+  return d;
+}
+}  // namespace
+
+TEST_CASE("a crushed turtle's program is told (TurtleGone), and the turtle leaves the world", "[runtime][regression]") {
+  // Issue 28 item 4: a crushed turtle stayed listed where it was, its touch arrived after the
+  // crush, and its program went on commanding a body that was no longer there.
+  const sim::WorldDef d = piston_scene(2);
+  Registry r = base_registry();
+  int told = 0, told_again = 0;
+  double told_at = -1.0;
+  r.add("waiter", [&](Turtle& t, const Params&) {
+    try {
+      for (;;) t.wait(0.25);
+    } catch (const TurtleGone& e) {
+      ++told;
+      told_at = t.time();
+      CHECK_THAT(e.what(), Catch::Contains("turtle 't0'") && Catch::Contains("no longer in the world"));
+    }
+    try {
+      t.forward(10);  // every later command throws it again
+    } catch (const TurtleGone&) {
+      ++told_again;
+    }
+  });
+  r.add("plain", [](Turtle& t, const Params&) {
+    for (;;) t.wait(0.25);  // TurtleGone is not caught: the program ends, without a fault
+  });
+  WorldServer s(d, {program("waiter"), program("plain")}, r);
+  std::vector<LogEvent> log;
+  s.set_event_log(&log);
+  s.run_until(12.0);
+  const double t_crush = 360.0 / 37.0;
+  CHECK(told == 1);
+  CHECK(told_again == 1);
+  CHECK(told_at == Approx(9.8).margin(1e-12));  // the first control boundary after the crush
+  for (std::size_t k = 0; k < 2; ++k) {
+    CAPTURE(k);
+    const auto info = s.turtle(k);
+    CHECK(info.gone);
+    CHECK(info.finished);
+    CHECK(info.fault.empty());
+    CHECK_FALSE(s.world().turtle_alive(k));
+  }
+  int crushed = 0;
+  for (const auto& e : log) {
+    CAPTURE(e.kind, e.a, e.t);
+    CHECK(e.kind != "fault");
+    if (e.kind == "crushed") {
+      ++crushed;
+      CHECK(e.t == Approx(t_crush).epsilon(1e-12));
+    }
+    if (e.kind == "touch") CHECK(e.t < t_crush);  // the piston's touch at 4.6; none after the crush
+  }
+  CHECK(crushed == 2);
+}

@@ -587,14 +587,14 @@ void compare_with_reference(const WorldDef& d, double T, std::size_t min_events)
   compare_runs(d, T, min_events, field_reference(d, T), "reference");
 }
 
-/// Issue 28, item 5 (hidden until it passes: run it with "[issue28]"): a charged disc gyrating in
+/// Issue 28, item 5 (hidden until it passed): a charged disc gyrating in
 /// B whose circle dips 1e-9 of a radius into a wall end from inside (the end inside its circle).
 /// The first contact (t = 3.1415610308) is on time; the engine's second comes at 9.424646338, 3.7e-5
 /// s before the brute-force reference's 9.4246830924, and every later one a further 3.7e-5 s early
 /// (10 contacts in 10 periods). The long-double oracle (below) agrees with the reference to 1e-10,
 /// so the fault is the engine's, not toi_field_disc_point's.
 TEST_CASE("a circle dipping 1e-9 of a radius into a wall end from inside meets it on time, every time",
-          "[.][fields][engine][issue28]") {
+          "[fields][engine][issue28]") {
   WorldDef d = tangent_scene();
   d.walls.push_back({"pin", {10.0, 8.5 - 0.5e-9}, {10.0, 9.0}});
   compare_with_reference(d, 10.25 * gyration_period(1.0), 3);
@@ -905,7 +905,7 @@ void compare_with_oracle(const WorldDef& d, double T, std::size_t min_events) {
 }  // namespace
 
 TEST_CASE("a circle dipping 1e-9 of a radius into a wall end from inside, against the long-double oracle",
-          "[.][fields][engine][issue28]") {
+          "[fields][engine][issue28]") {
   WorldDef d = tangent_scene();
   d.walls.push_back({"pin", {10.0, 8.5 - 0.5e-9}, {10.0, 9.0}});
   compare_with_oracle(d, 10.25 * gyration_period(1.0), 3);

@@ -744,3 +744,50 @@ TEST_CASE("three discs pressed onto the held disc, or any at e = 1, are crushed 
     }
   }
 }
+
+TEST_CASE("the energy ledger: what the wedged and crushed rules take, by rule and by ball, adds up", "[squeeze][ledger]") {
+  // docs/physics.md, "The energy ledger" (issue 28, Accounting). Without fields or moving walls the
+  // world's energy changes only by what the rules take: E_start - E_end = the ledger's total.
+  for (Mode mode : kModes) {
+    INFO("mode " << (mode == Mode::exact ? "exact" : "step"));
+    {
+      // A 2r corridor at e = 1 (issue 28 item 2): the transverse energy is taken, 0.5 (1e-3)^2,
+      // and reported, all of it, by rule and by ball; the second ball, free, gives nothing.
+      WorldDef d = box(100, 1000);
+      d.walls.push_back({"l", {40, 0}, {40, 1000}});
+      d.walls.push_back({"r", {42, 0}, {42, 1000}});
+      d.balls.push_back(ball("free", {80, 500}, {3, 4}, 1));
+      d.balls.push_back(ball("b", {41, 10}, {1e-3, 1}, 1, 2.0));
+      World w(d, mode);
+      const double e0 = w.energy();
+      Run run;
+      run_to(w, run, 100.0);
+      REQUIRE(run.count(EventKind::wedged) >= 1);
+      const Stats& st = w.stats();
+      CHECK(st.energy_wedged == Approx(0.5 * 2.0 * 1e-6).epsilon(1e-9));
+      CHECK(st.energy_crushed == 0.0);
+      CHECK(std::abs((e0 - w.energy()) - st.energy_rules()) <= 1e-12 * e0);
+      REQUIRE(w.energy_taken().size() == 2);
+      CHECK(w.energy_taken()[0] == 0.0);
+      CHECK(w.energy_taken()[1] == st.energy_wedged);
+    }
+    {
+      // The piston crushes a ball that drifts along it at 1 unit/s. The rules take speed along the
+      // squeeze on the way (wedged); at the last instant the piston (u = 27) has just reflected the
+      // ball at e = 1, to 2u along x with its 1 along y, and the crush takes that kinetic energy,
+      // 0.5 m (54^2 + 1^2) (crushed).
+      WorldDef d = piston_scene();
+      d.balls.push_back(ball("b", {150, 150}, {0, 1}, 8, 3.0));
+      World w(d, mode);
+      Run run;
+      run_to(w, run, 12.0);
+      REQUIRE(run.count(EventKind::crushed) == 1);
+      const Stats& st = w.stats();
+      CHECK(st.energy_crushed == Approx(0.5 * 3.0 * (54.0 * 54.0 + 1.0)).epsilon(1e-12));
+      CHECK(st.energy_wedged > 0.0);  // the ride on the right wall took the speed the piston gave
+      REQUIRE(!w.energy_taken().empty());
+      CHECK(w.energy_taken()[0] == Approx(st.energy_wedged + st.energy_crushed).epsilon(1e-15));
+      CHECK(w.energy() == 0.0);
+    }
+  }
+}

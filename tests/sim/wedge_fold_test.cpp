@@ -132,6 +132,10 @@ TEST_CASE("an elastic disc along the bisector of a wedge whose angle divides pi 
       CHECK(b.pos.x == Approx(apex - 100.0).epsilon(1e-9));
       CHECK(std::abs(w.energy() - e0) <= 1e-12 * e0);
       CHECK(w.stats().wedged == 0);
+      // The energy ledger: an e = 1 scene without a crush reports 0 to round-off.
+      CHECK(w.stats().folded >= 1);
+      CHECK(std::abs(w.stats().energy_folded) <= 1e-12 * e0);
+      CHECK(std::abs(w.stats().energy_rules()) <= 1e-12 * e0);
     }
   }
 }

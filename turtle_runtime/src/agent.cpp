@@ -33,9 +33,14 @@ namespace {
 inline void safe_point() { detail::Fiber::safe_point(); }
 }  // namespace
 
+void Agent::throw_gone() const {
+  throw TurtleGone("turtle '" + id + "' is no longer in the world (crushed, out of the arena, or removed)");
+}
+
 Result Agent::issue(sim::TurtleCommand c) {
   if (!fiber || detail::Fiber::current() != &*fiber) [[unlikely]] not_own_program();
   if (ending) [[unlikely]] refuse_while_ending(c);
+  if (gone) [[unlikely]] throw_gone();
   command = c;
   waiting_on = c.kind;
   waiting = true;
@@ -45,6 +50,7 @@ Result Agent::issue(sim::TurtleCommand c) {
   fiber->suspend();
   // Resumed by the scheduler: the command has ended. The answer is taken first, since a handler's
   // own command leaves the next one; then interrupts, then messages.
+  if (gone) [[unlikely]] throw_gone();
   Result r = std::move(answer);
   if (!inbox.empty() || !messages.empty()) [[unlikely]] deliver();
   return r;

@@ -42,6 +42,7 @@ class alignas(64) Agent {
   bool remote = false;       // runs the remote program (remote.hpp, remote.cpp)
   bool wants_input = false;  // the remote program is suspended in await_remote()
   bool ending = false;     // end_program() is unwinding the program: a command now abandons it
+  bool gone = false;       // the turtle has left the world: every command throws TurtleGone
   sim::TurtleCommand::Kind waiting_on = sim::TurtleCommand::Kind::stop;
   bool pen_down = false;
   bool it = false;                            // the game's role, as Turtle::it() reports it
@@ -80,6 +81,8 @@ class alignas(64) Agent {
   /// The touch and message handlers, on the program's stack (they may issue commands).
   [[gnu::noinline]] void deliver();
   [[noreturn, gnu::noinline, gnu::cold]] void not_own_program() const;
+  /// Tells the program its turtle has left the world (TurtleGone).
+  [[noreturn, gnu::noinline, gnu::cold]] void throw_gone() const;
   /// Contact c as this turtle's program sees it now (server_impl.hpp).
   Touch make_touch(const sim::TurtleContact& c) const;
   /// Cache hint: the hot lines above (everything up to and including the generator's index).

@@ -116,6 +116,13 @@ void set_busy_loop_last_words(void (*last_words)()) {
 void WorldServer::Impl::finish_command(Agent& a) {
   // The end of the command the program waits on, worked out before it resumes (see issue()).
   a.waiting = false;
+  // A turtle that has left the world (crushed, out of an open arena) hears of it from the command
+  // it waited in (TurtleGone, issue()).
+  if (!world.turtle_alive(a.index)) [[unlikely]] {
+    a.gone = true;
+    a.inbox.clear();
+    return;
+  }
   const sim::TurtleState s = world.turtle(a.index);
   if (a.waiting_on == sim::TurtleCommand::Kind::move) a.odometer += s.done;
   if (a.pen_down) a.trail.push_back(s.pos);
@@ -236,6 +243,9 @@ bool WorldServer::Impl::resume(Agent& a) {
         std::string what = "its program threw a non-standard exception";
         try {
           std::rethrow_exception(err);
+        } catch (const TurtleGone&) {
+          park({});  // the turtle is gone, and its program with it: not a fault
+          return false;
         } catch (const std::exception& e) {
           what = std::string("its program threw: ") + e.what();
         } catch (...) {
@@ -278,6 +288,8 @@ void WorldServer::Impl::control_step() {
     }
     const sim::TurtleContact& c = contacts[k];
     Agent& a = *agents[c.turtle];
+    // A turtle crushed at its contact (or gone since) has no sensors left to fire.
+    if (!world.turtle_alive(c.turtle)) [[unlikely]] continue;
     Touch t = a.make_touch(c);
     if (log) {
       LogEvent e{now, "touch", a.id, t.what, {}, t.bearing, {}, {}, {}};

@@ -12,20 +12,26 @@
 namespace turtlegas::sim::detail {
 namespace {
 
+/// Kinetic plus potential energy of ball i at internal time l.now (`field` as energy()'s).
+template <Flight F, bool kExtras, class Field>
+double ball_energy(const Look<F, kExtras>& l, const Field& field, std::uint32_t i) {
+  const F& f = l.motion.flight();
+  const Body& b = l.bodies.body[i];
+  const double dt = l.now - b.t;
+  const Vec2 x = f.pos(i, b.x, b.v, dt);
+  const Vec2 v = f.vel(i, b.v, dt);
+  const double m = l.bodies.mass[i];
+  return 0.5 * m * norm2(v) + m * field.potential(i, x);
+}
+
 /// Kinetic plus potential energy of the balls still in the arena at internal time l.now. `field`
 /// gives the potential per unit mass: the flight in exact mode, the kick in step mode.
 template <Flight F, bool kExtras, class Field>
 double energy(const Look<F, kExtras>& l, const Field& field) {
-  const F& f = l.motion.flight();
   double e = 0.0;
   for (std::uint32_t i = 0; i < l.bodies.balls(); ++i) {
-    const Body& b = l.bodies.body[i];
-    if (b.cell == kNone) continue;
-    const double dt = l.now - b.t;
-    const Vec2 x = f.pos(i, b.x, b.v, dt);
-    const Vec2 v = f.vel(i, b.v, dt);
-    const double m = l.bodies.mass[i];
-    e += 0.5 * m * norm2(v) + m * field.potential(i, x);
+    if (l.bodies.body[i].cell == kNone) continue;
+    e += ball_energy(l, field, i);
   }
   return e;
 }

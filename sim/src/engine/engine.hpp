@@ -76,6 +76,7 @@
 
 #include "../cell_grid.hpp"
 #include "../event_queue.hpp"
+#include "turtlegas/sim/control_steps.hpp"
 #include "arena.hpp"
 #include "body_store.hpp"
 #include "cell_size.hpp"
@@ -180,6 +181,7 @@ class Engine final : public EngineBase {
     else return detail::energy(look(), motion_.flight());
   }
   const Stats& stats() const override { return record_.stats; }
+  const std::vector<double>& energy_taken() const override { return record_.taken; }
   Overlap measure_overlap() const override { return detail::measure_overlap<kBallBall>(look(), arena_); }
   Overlap max_contact_overlap() const override { return record_.max_contact; }
   double cell_size() const override { return std::min(grid_.cell_w(), grid_.cell_h()); }
@@ -220,6 +222,18 @@ class Engine final : public EngineBase {
     predict_crossing(i, c.ix, c.iy);
   }
   void predict_crossing(std::uint32_t i, int ix, int iy);
+  /// The internal time of control boundary j (internal_boundary: in step mode the step's end is dt).
+  double boundary_end(std::uint64_t j) const { return internal_boundary(j, t_base_, dt_, kStep, step_.index); }
+  /// Internal time has moved by -shift (t_base_ already moved): the turtles' command ends follow,
+  /// those on a control boundary recomputed from it rather than shifted (two roundings).
+  void shift_turtle_ends(double shift) {
+    const std::size_t nb = bodies_.balls();
+    for (std::size_t k = 0; k < turtles_.size(); ++k) {
+      const std::uint64_t j = turtles_.end_step[k];
+      double& end = bodies_.end[nb + k];
+      end = j == kNoStep ? end - shift : boundary_end(j);
+    }
+  }
   /// When a turtle's command ends (kNever for a ball, or a turtle with no command running).
   double command_end(std::uint32_t i) const {
     if constexpr (kExtras) return is_turtle(i) ? bodies_.end[i] : kNever;
@@ -485,6 +499,10 @@ void Engine<F, kBallBall, kStep, kExtras>::crush(std::uint32_t i, const Side& A,
   record_.note(t_base_ + now_, EventKind::crushed, turtle ? i - nb : i, A.name, B.name,
                squeeze_flags(turtle, A, B));
   ++record_.stats.crushed;
+  if (!turtle) {  // the ledger: a ball leaves with its energy (checks.hpp's, as energy() counts it)
+    if constexpr (kStep) record_.take_energy(record_.stats.energy_crushed, i, ball_energy(look(), kick_, i));
+    else record_.take_energy(record_.stats.energy_crushed, i, ball_energy(look(), motion_.flight(), i));
+  }
   unlink(i);
   retire(i);
 }
@@ -518,7 +536,13 @@ void Engine<F, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, const T
   const auto id = static_cast<std::uint32_t>(bodies_.balls() + k);
   if (bodies_.body[id].cell == kNone) return;  // it has left the arena
   sync(id);
-  if (!turtles_.command(k, c, bodies_.body[id], bodies_.end[id], now_)) {
+  const bool moved = turtles_.command(k, c, bodies_.body[id], bodies_.end[id], now_);
+  if constexpr (kExtras) {
+    // A command lasting a whole number of control steps ends on that boundary, exactly.
+    if (const std::uint64_t j = turtles_.snap_end(k, bodies_.end[id], t_base_, dt_); j != kNoStep)
+      bodies_.end[id] = boundary_end(j);
+  }
+  if (!moved) {
     // The predictions made with it still hold; only its key takes the command's end.
     schedule(id);
     return;
@@ -578,7 +602,8 @@ void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
   if constexpr (kStep) {
     for (;;) {
       const double target = t - t_base_;
-      if (target >= dt_) {
+      // A t on the step's closing boundary closes the step, though t - t_base_ may round below dt.
+      if (target >= dt_ || t >= control_boundary(step_.index + 1, dt_)) {
         process(dt_);
         finish_step();
         continue;

@@ -29,6 +29,7 @@ class EngineBase {
   virtual const std::vector<WallDef>& walls() const = 0;
   virtual double energy() const = 0;
   virtual const Stats& stats() const = 0;
+  virtual const std::vector<double>& energy_taken() const = 0;
   virtual Overlap measure_overlap() const = 0;
   virtual Overlap max_contact_overlap() const = 0;
   virtual std::size_t turtle_count() const = 0;

@@ -83,10 +83,10 @@ double Engine<F, kBallBall, kStep, kExtras>::rebase() {
     if (restitution_.inelastic) restitution_.last_time[i] -= shift;
   }
   turtles_.shift_times(shift);
-  for (std::size_t k = 0; k < turtles_.size(); ++k) bodies_.end[bodies_.balls() + k] -= shift;
   schedule_.shift_times(shift);
   bodies_.shift_held(shift);
   t_base_ += shift;
+  shift_turtle_ends(shift);
   schedule_.refresh_next_key(walls_, t_base_);
   now_ = 0.0;
   heap_.shift_keys(shift);

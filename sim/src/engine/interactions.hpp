@@ -243,6 +243,18 @@ Changed apply_wall(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uin
 // ---------------------------------------------------------------------------------------------
 // Body-wall end: a fixed wall's end point, one per distinct point
 
+/// What a point's curvature adds to the gap's second derivative for a ball passing it with
+/// velocity v (relative to the point) at distance `dist` along the unit normal n: |v_t|² / dist.
+/// The gap to a face bends only with the ball's own acceleration; the gap to a point also because
+/// the normal turns as the ball goes by, always away. The rest threshold must count it (issue 28
+/// item 5): without it a charged ball whose circle dips 1e-9 of a radius into an end from inside,
+/// pressed towards the end by B, was lifted off it at the threshold's speed instead of its own
+/// grazing one, and met it again 3.7e-5 s early, every turn.
+inline double end_curvature(Vec2 v, Vec2 n, double dist) {
+  const Vec2 vt = v - dot(v, n) * n;
+  return dot(vt, vt) / dist;
+}
+
 template <Flight F, bool kExtras>
 [[gnu::always_inline]] inline void predict_end(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t e, Vec2 shift,
                  Pending& p) {
@@ -272,7 +284,7 @@ Changed apply_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, std::uint
     p.touch(i, EventKind::turtle_wall_end, end.wall, F / dist);
   } else {
     const Vec2 va = a.v;
-    a.v = p.bounce(i, a.v, F / dist);
+    a.v = p.bounce(i, a.v, F / dist, 0.0, end_curvature(a.v, F / dist, dist));
     if (p.record.impulses) [[unlikely]] p.impulse(EventKind::ball_wall_end, i, end.wall, p.bodies.mass[i] * (a.v - va), F);
     p.count(p.record.stats.ball_wall_end, EventKind::ball_wall_end, i, end.wall);
   }
@@ -331,11 +343,24 @@ Changed apply_moving_end(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, st
   const double dist = norm(F);
   p.record.note_contact(a.r - dist, a.r);
   if (p.is_turtle(i)) {
+    const Vec2 n = F / dist;
     p.count(p.record.stats.turtle_wall_end, EventKind::turtle_wall_end, i - p.bodies.balls(), m.wall);
-    p.touch(i, EventKind::turtle_wall_end, m.wall, F / dist);
+    p.touch(i, EventKind::turtle_wall_end, m.wall, n);
+    // The end does for a turtle what the face does (apply_wall): both have infinite mass, so the
+    // turtle cannot stop dead in its way (it did, and the end swept through it, issue 28 item 7).
+    // A translating wall's end carries it at its normal speed, the perfectly inelastic contact:
+    // head on it pushes it along as a face would; off its line the end then slides past it
+    // (relative to the end the turtle moves along the tangent, and the gap opens), and the turtle
+    // goes on at that speed, knocked off, until the wall's next keyframe ends the push
+    // (contacts/carried.hpp). A turning wall's end knocks it off at twice its normal speed, as
+    // the turning face does.
+    const double un = dot(ue, n);
+    double knock = m.rigid() ? un : 2.0 * un;
+    if (!m.rigid() && knock > 0.0) knock = std::max(knock, kDepartFloor * norm(ue));
+    if (knock > 0.0) carry(p.turtles, i - p.bodies.balls(), a, knock * n, code / 2, kNone);
   } else {
     const Vec2 va = a.v;
-    a.v = ue + p.bounce(i, a.v - ue, F / dist);
+    a.v = ue + p.bounce(i, a.v - ue, F / dist, 0.0, end_curvature(a.v - ue, F / dist, dist));
     if (p.record.impulses) [[unlikely]] p.impulse(EventKind::ball_wall_end, i, m.wall, p.bodies.mass[i] * (a.v - va), F);
     p.count(p.record.stats.ball_wall_end, EventKind::ball_wall_end, i, m.wall);
   }

@@ -52,6 +52,14 @@ struct EventRecord {
   void note(double t, EventKind kind, std::uint32_t a, std::uint32_t b, std::uint32_t c = 0, std::uint8_t flags = 0) {
     if (log) log->push_back({t, kind, a, b, c, flags});
   }
+  /// Per ball: the energy the zero-time rules took from it (World::energy_taken).
+  std::vector<double> taken;
+  /// A zero-time rule took energy e from ball `ball`: into its rule's total (a Stats::energy_*).
+  void take_energy(double& rule_total, std::uint32_t ball, double e) {
+    rule_total += e;
+    if (taken.size() <= ball) taken.resize(ball + 1, 0.0);
+    taken[ball] += e;
+  }
 };
 
 /// What a prediction reads.
@@ -133,14 +141,19 @@ struct Parts {
   }
   /// Body `id`, a turtle, touched `other` (see Turtles::touch).
   void touch(std::uint32_t id, EventKind kind, std::uint32_t other, Vec2 normal) const {
-    turtles.touch(id - bodies.balls(), bodies.body[id], bodies.end[id], now, t_base, dt, kind, other, normal);
+    const std::size_t k = id - bodies.balls();
+    turtles.touch(k, bodies.body[id], bodies.end[id], now, t_base, dt, kind, other, normal);
+    if (const std::uint64_t j = turtles.end_step[k]; j != kNoStep)
+      bodies.end[id] = internal_boundary(j, t_base, dt, kStep, step.index);
   }
   /// The bounce of ball i (at the contact, its velocity not yet changed) off an obstacle, v its
   /// velocity relative to the obstacle (Restitution::bounce, under the ball's field, plus `press`:
   /// the ball's acceleration along n relative to the obstacle that the obstacle's own motion adds,
-  /// a turning wall's; negative presses).
-  Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n, double press = 0.0) const {
-    const double a_n = motion.flight().normal_accel(i, bodies.body[i].v, n) + press;
+  /// a turning wall's; negative presses). `curve`: what the obstacle's own curvature adds to the
+  /// second derivative of the gap for the ball as it moves (a point at distance d: |v_t|² / d, the
+  /// normal turning as the ball passes it), which a ball at rest does not have.
+  Vec2 bounce(std::uint32_t i, Vec2 v, Vec2 n, double press = 0.0, double curve = 0.0) const {
+    const double a_n = motion.flight().normal_accel(i, bodies.body[i].v, n) + press + curve;
     // A ball at rest feels no magnetic part (only the charged flight has one).
     if constexpr (F::kBoundedHorizon) return restitution.bounce(v, n, a_n, motion.flight().normal_accel(i, Vec2{}, n) + press);
     else return restitution.bounce(v, n, a_n, a_n);

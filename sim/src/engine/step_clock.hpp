@@ -57,12 +57,12 @@ void Engine<F, kBallBall, kStep, kExtras>::finish_step() {
   ++record_.stats.steps;
   ++record_.stats.events;
   turtles_.shift_times(dt_);
-  for (std::size_t k = 0; k < turtles_.size(); ++k) bodies_.end[bodies_.balls() + k] -= dt_;
   schedule_.shift_times(dt_);
   bodies_.shift_held(dt_);
   if (restitution_.inelastic)
     for (double& t : restitution_.last_time) t -= dt_;
   t_base_ = static_cast<double>(step_.index) * dt_;
+  shift_turtle_ends(dt_);
   schedule_.refresh_next_key(walls_, t_base_);
   now_ = 0.0;
   begin_step();

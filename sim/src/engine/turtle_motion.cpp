@@ -24,6 +24,7 @@ Vec2 heading_vector(double heading) {
 Turtles::Turtles(const std::vector<TurtleDef>& defs) {
   run_.resize(defs.size());
   busy_.assign(defs.size(), 0);
+  end_step.assign(defs.size(), kNoStep);
   for (std::size_t k = 0; k < defs.size(); ++k) {
     const TurtleDef& d = defs[k];
     TurtleRun& r = run_[k];
@@ -64,6 +65,7 @@ bool Turtles::command(std::size_t k, const TurtleCommand& c, Body& b, double& en
   r.amount = 0.0;
   const bool was_at_rest = at_rest(b);
   b.v = {};
+  end_step[k] = kNoStep;
   bool busy = false;
   switch (c.kind) {
     case TurtleCommand::Kind::stop:
@@ -95,8 +97,21 @@ bool Turtles::command(std::size_t k, const TurtleCommand& c, Body& b, double& en
   return !(was_at_rest && at_rest(b));
 }
 
+std::uint64_t Turtles::snap_end(std::size_t k, double end, double t_base, double dt) {
+  end_step[k] = kNoStep;
+  if (busy_[k] == 0 || !(end < kNever)) return kNoStep;
+  const double t = t_base + end;
+  const double j = std::round(t / dt);
+  if (j < 1.0) return kNoStep;
+  const auto step = static_cast<std::uint64_t>(j);
+  if (std::abs(t - control_boundary(step, dt)) > kCommandSnap * std::max(t, dt)) return kNoStep;
+  end_step[k] = step;
+  return step;
+}
+
 bool Turtles::finish(std::size_t k, Body& b, double& end) {
   TurtleRun& r = run_[k];
+  end_step[k] = kNoStep;
   // A completed turn ends exactly where it was told to, not where omega * time rounds to.
   if (busy_[k] != 0) {
     if (r.kind == TurtleCommand::Kind::turn) r.heading0 += r.amount;
@@ -131,13 +146,14 @@ void Turtles::touch(std::size_t k, Body& b, double& end, double now, double t_ba
     b.v = b.v - ((1.0 + r.bounce) * vn) * normal;
     // Coast until the next control step, where the program decides again.
     const double t_ext = t_base + now;
-    const double next_step = control_boundary(next_control_step(t_ext, dt), dt);
     r.coasting = true;
-    end = next_step - t_base;
+    end_step[k] = next_control_step(t_ext, dt);
+    end = control_boundary(end_step[k], dt) - t_base;  // (the caller makes it a step's end in step mode)
   } else {
     b.v = {};
     r.coasting = false;
     end = kNever;
+    end_step[k] = kNoStep;
   }
   contacts_.push_back({t_base + now, static_cast<std::uint32_t>(k), kind, other, normal});
 }
@@ -150,6 +166,7 @@ void Turtles::add(const TurtleDef& d) {
   r.bounce = d.bounce;
   run_.push_back(r);
   busy_.push_back(0);
+  end_step.push_back(kNoStep);
   pushed_by.push_back(kNone);
   pushed_via.push_back(kNone);
 }
@@ -169,6 +186,7 @@ void Turtles::place(std::size_t k, double heading, Body& b, double& end, double 
   r.t_start = now;
   r.heading0 = heading;
   end = kNever;
+  end_step[k] = kNoStep;
   b.v = {};
   pushed_by[k] = kNone;
   pushed_via[k] = kNone;
@@ -177,6 +195,7 @@ void Turtles::place(std::size_t k, double heading, Body& b, double& end, double 
 void Turtles::exit(std::size_t k, Body& b, double& end) {
   busy_[k] = 0;
   end = kNever;
+  end_step[k] = kNoStep;
   b.v = {};
 }
 

@@ -11,6 +11,7 @@
 
 #include "records.hpp"
 #include "turtlegas/sim/events.hpp"
+#include "turtlegas/sim/control_steps.hpp"
 #include "turtlegas/sim/vec2.hpp"
 #include "turtlegas/sim/world.hpp"
 
@@ -29,6 +30,26 @@ struct TurtleRun {
   double turn_rate = 0.0;
   double bounce = -1.0;
 };
+
+/// No control boundary: a command whose end is not on one.
+inline constexpr std::uint64_t kNoStep = ~std::uint64_t{0};
+
+/// How close, in ulps of the end's external time (or of dt, whichever is larger), a command's end
+/// must come to a control boundary to end on it. A duration that is a whole number of control
+/// steps (forward 60 at speed 60, dt = 1/30) gives an end a few ulps off its boundary, and which
+/// side of it the end falls then decided whether the program went on at that boundary or one
+/// control step later (issue 28 item 8). 64 ulps is 1.4e-12 s at t = 100; a command shortened or
+/// lengthened by that moves a turtle by its speed times it.
+inline constexpr double kCommandSnap = 64.0 * 0x1p-52;
+
+/// The internal time of control boundary j, internal zero being external time t_base. In step mode
+/// (`steps`, with `step_index` steps done, so t_base = step_index * dt) the boundary that ends the
+/// current step is the step's end, dt itself: j * dt - t_base can fall an ulp after it, and what
+/// ends there would end a step late.
+inline double internal_boundary(std::uint64_t j, double t_base, double dt, bool steps, std::uint64_t step_index) {
+  if (steps && j == step_index + 1) return dt;
+  return static_cast<double>(j) * dt - t_base;
+}
 
 /// The unit vector of a Logo heading (radians; 0 is +y, clockwise). Headings within 1e-9 degrees
 /// of a multiple of 90 give the exact axis: cos(pi/2) is 6e-17, not 0, and a turtle that has
@@ -62,6 +83,11 @@ class Turtles {
   /// `end`. Returns whether the body's course changed (false: it stood still and still does, so
   /// every prediction made with it holds).
   bool command(std::size_t k, const TurtleCommand& c, Body& b, double& end, double now);
+  /// Turtle k's command, just started, ends at internal time `end` (t_base: the external time of
+  /// internal zero). If that end is a control boundary to round-off (kCommandSnap) the command
+  /// ends on it: returns its index, kept in end_step[k] (the caller sets `end` to its internal
+  /// time, internal_boundary). kNoStep otherwise.
+  std::uint64_t snap_end(std::size_t k, double end, double t_base, double dt);
   /// Turtle k's command (or its coasting after a bounce) has run its course at `now`. Returns
   /// whether the body was moving (it now stands still: its course changed).
   bool finish(std::size_t k, Body& b, double& end);
@@ -87,6 +113,10 @@ class Turtles {
     return out;
   }
 
+  /// Per turtle: the control boundary its command (or its coast after a bounce) ends on, or
+  /// kNoStep. The engine recomputes the end's internal time from it whenever internal time moves
+  /// (internal_boundary), so that it stays the very double the control boundary is.
+  std::vector<std::uint64_t> end_step;
   /// Per turtle: the mover (WallSchedule::movers) pushing it, or kNone.
   std::vector<std::uint32_t> pushed_by;
   /// Per turtle pushed: the turtle through which that mover pushes it (a carried turtle pushing

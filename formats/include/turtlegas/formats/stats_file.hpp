@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <ostream>
 #include <string>
 
@@ -40,11 +41,18 @@ struct RunFigures {
   double max_overlap_relative = 0.0;  ///< of the smaller radius
   /// Instants of the run (besides every contact and the end) the overlap was measured at.
   std::uint64_t overlap_samples = 0;
+  /// The id of ball i, for the per-body lines of `energy_rules` (absent: "#i", its index).
+  std::function<std::string(std::size_t)> ball_name;
   /// Collisions per wall-clock second (0 for a run that took no measurable time).
   double collisions_per_second(const sim::Stats& st) const {
     return wall_seconds > 0.0 ? static_cast<double>(st.collisions()) / wall_seconds : 0.0;
   }
 };
+
+/// The energy ledger of the zero-time rules (sim::Stats::energy_wedged...): {"wedged", "crushed",
+/// "folded", "total", "bodies_count", "bodies": [{"id", "taken"}...]}, the bodies the rules took
+/// most from first (at most 20; bodies_count says how many gave or took anything).
+nlohmann::json energy_rules_json(const RunFigures& run, const sim::World& world);
 
 /// The statistics object of a run that ended in `world`.
 nlohmann::json stats_json(const RunFigures& run, const sim::World& world);

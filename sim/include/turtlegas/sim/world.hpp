@@ -22,6 +22,14 @@ struct Stats {
   std::uint64_t wedged = 0;   ///< the squeeze rule took a body's velocity (docs/physics.md)
   std::uint64_t crushed = 0;  ///< bodies removed by the squeeze rule
   std::uint64_t folded = 0;   ///< elastic wedges served in closed form (their reflections count as ball_wall*)
+  /// The energy ledger of the zero-time rules (docs/physics.md, "The energy ledger"): the kinetic
+  /// energy each rule took from the balls it acted on (negative: gave), and for `crushed` the
+  /// energy (kinetic plus potential) of the balls it removed. Turtles have no energy to count.
+  /// World::energy_taken gives it per ball. At e = 1 with no crush every figure is 0 to round-off.
+  double energy_wedged = 0.0;
+  double energy_crushed = 0.0;
+  double energy_folded = 0.0;
+  double energy_rules() const { return energy_wedged + energy_crushed + energy_folded; }
   std::uint64_t turtle_wall = 0;
   std::uint64_t turtle_wall_end = 0;
   std::uint64_t turtle_turtle = 0;
@@ -243,6 +251,9 @@ class World {
   /// -m g.x, zero at the origin.
   double energy() const;
   const Stats& stats() const;
+  /// Per ball index: the energy the zero-time rules took from it (Stats::energy_wedged and the
+  /// others, summed by ball); shorter than ball_count() when the last balls gave nothing.
+  const std::vector<double>& energy_taken() const;
   /// Deepest ball-ball or ball-wall overlap right now (brute force over grid neighbours).
   Overlap measure_overlap() const;
   /// Largest overlap seen at any collision so far.

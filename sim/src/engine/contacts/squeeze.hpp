@@ -349,6 +349,9 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
     if (!parallel && p.restitution.e == 1.0 && p.schedule.movers.empty() && p.motion.straight(i) && !p.is_turtle(i) &&
         !A.turtle && !B.turtle && !A.ball && !B.ball && !touches_a_body()) {
       if (Folded f; fold(v0, A.n, A.u, B.n, B.u, f)) {
+        // The ledger: the fold keeps |v| in the frame of both contacts, so at standing walls this is
+        // the round-off of the closed form.
+        p.record.take_energy(p.record.stats.energy_folded, i, 0.5 * p.bodies.mass[i] * (norm2(body.v) - norm2(f.v)));
         body.v = f.v;
         p.record.note(p.t_base + p.now, EventKind::folded, i, A.name, B.name, 0);
         ++p.record.stats.folded;
@@ -444,9 +447,10 @@ Squeeze squeeze(const Parts<Fl, kStep, kExtras>& p, std::uint32_t i, LastPartner
     held = false;  // it must meet A at t*: no mark
   }
 done:
-  body.v = v;
   const std::uint32_t nb = p.bodies.balls();
   const bool turtle = p.is_turtle(i);
+  if (!turtle) p.record.take_energy(p.record.stats.energy_wedged, i, 0.5 * p.bodies.mass[i] * (norm2(body.v) - norm2(v)));
+  body.v = v;
   p.record.note(p.t_base + p.now, EventKind::wedged, turtle ? i - nb : i, A.name, B.name,
                 squeeze_flags(turtle, A, B));
   ++p.record.stats.wedged;

@@ -153,6 +153,16 @@ enum class PenMode { line, wall };
 
 class Agent;  // the runtime's side of a turtle
 
+/// Thrown by a command (forward, back, left, right, wait, yield) of a turtle that is no longer in
+/// the world: crushed (docs/physics.md, "Wedged and crushed bodies"), out of an open arena, or
+/// removed. The command it cuts short has ended where the turtle went; every later command throws
+/// it again. A program may catch it to tidy up, then return; uncaught, it ends the program without
+/// a fault (the turtle's status is `gone`, the event log already has its `crushed` or `exit`).
+class TurtleGone : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// The handle a controller program drives its turtle with. Valid for the program's lifetime.
 class Turtle {
  public:
