@@ -69,8 +69,11 @@ RayHit Engine<F, kBallBall, kStep, kExtras>::cast_ray(const Ray& ray) const {
       const std::uint32_t index = target == RayTarget::ball ? i : i - nb;
       if (target == RayTarget::turtle && index == ray.self) continue;
       if (!sees_body(i)) continue;
-      const Vec2 p = motion_.pos(b, i, now_ - b.t) + shift;
-      consider(ray_disc(p - o, u, b.r), target, index);
+      const Vec2 rel = motion_.pos(b, i, now_ - b.t) + shift - o;
+      // Most discs listed near a ray pass wide of it: |rel x u| >= r is a miss (or a graze), and
+      // ray_disc's other arithmetic is not needed. (An origin inside the disc has |rel x u| < r.)
+      if (!(std::fabs(sim::cross(rel, u)) < b.r)) continue;
+      consider(ray_disc(rel, u, b.r), target, index);
     }
   };
   auto test_wall = [&](std::uint32_t w, Vec2 shift) {
@@ -112,7 +115,8 @@ RayHit Engine<F, kBallBall, kStep, kExtras>::cast_ray(const Ray& ray) const {
   };
   // A cell (kx, ky) of the unbounded coordinates: the table's cell that lists its objects, and the
   // shift that brings them to where the ray sees them.
-  auto search = [&](long long kx, long long ky) {
+  // Inlined at its four call sites: out of line it took 20 % more time a ray (ray_bench).
+  auto search = [&](long long kx, long long ky) __attribute__((always_inline)) {
     int ix, iy;
     Vec2 shift{};
     if (periodic) {

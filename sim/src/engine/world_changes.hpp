@@ -88,7 +88,7 @@ void Engine<F, kBallBall, kStep, kExtras>::place(std::uint32_t i, Vec2 pos) {
   b.x = pos;
   b.t = now_;
   link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(pos)));
-  if constexpr (kStep) step_.rmax = std::max(step_.rmax, b.r);
+  step_.rmax = std::max(step_.rmax, b.r);  // step mode's neighbourhoods, and the reach of a ray (rays.hpp)
   // Its course is new: predictions made against it are stale, and it has collided with nothing.
   new_course(i);
 }
