@@ -88,7 +88,7 @@ void Engine<F, kBallBall, kStep, kExtras>::place(std::uint32_t i, Vec2 pos) {
   b.x = pos;
   b.t = now_;
   link(i, static_cast<std::uint32_t>(grid_.arena_cell_of(pos)));
-  step_.rmax = std::max(step_.rmax, b.r);  // step mode's neighbourhoods, and the reach of a ray (rays.hpp)
+  if constexpr (kStep) step_.rmax = std::max(step_.rmax, b.r);
   // Its course is new: predictions made against it are stale, and it has collided with nothing.
   new_course(i);
 }
