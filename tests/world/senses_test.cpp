@@ -178,3 +178,53 @@ TEST_CASE("expect {\"sense\": ...} passes on the closed-form world and fails a r
   REQUIRE(r2.failures.size() == 1);
   CHECK(contains(r2.failures.front(), "reads 96"));
 }
+
+TEST_CASE("sensor noise: Gaussian on the distance and dropouts, from the turtle's seeded stream", "[senses]") {
+  // 4000 rays of a ring at a wall 100 away (the ring of 1 ray, read 4000 times by the program):
+  // the errors have mean ~0 and standard deviation ~sd, about `dropout` of them read nothing, and
+  // the same seed gives the same log, another seed another.
+  const std::string text = R"({"format": "turtlegas-world/1", "seed": SEED, "arena": {"width": 400, "height": 300, "boundary": "walls"},
+    "turtles": [{"id": "t", "pos": [300, 150], "heading": 90, "senses": [{"name": "nose", "range": 500, "noise": {"sd": 0.5, "dropout": 0.1}}],
+                 "controller": "script", "params": {"commands": [CMDS]}}]})";
+  std::string cmds;
+  for (int k = 0; k < 4000; ++k) cmds += std::string(k ? ", " : "") + "[\"sense\", \"nose\"]";
+  auto run = [&](int seed) {
+    std::string t = text;
+    t.replace(t.find("SEED"), 4, std::to_string(seed));
+    t.replace(t.find("CMDS"), 4, cmds);
+    const tw::Scene s = parse(t);
+    tt::WorldServer server(s.def, s.programs, registry());
+    std::vector<tt::LogEvent> log;
+    server.set_event_log(&log);
+    server.run_until(0.1);
+    std::vector<nlohmann::json> out;
+    for (const tt::LogEvent& e : log)
+      if (e.kind == "sense") out.push_back(nlohmann::json::parse("{" + e.extra + "}")["range"][0]);
+    return out;
+  };
+  const std::vector<nlohmann::json> a = run(5), b = run(5), c = run(6);
+  REQUIRE(a.size() == 4000);
+  CHECK(a == b);
+  CHECK(a != c);
+  double sum = 0.0, sum2 = 0.0;
+  int dropped = 0, n = 0;
+  for (const nlohmann::json& d : a) {
+    if (d.is_null()) {
+      ++dropped;
+      continue;
+    }
+    const double e = d.get<double>() - 100.0;  // the wall x = 400 is 100 ahead
+    sum += e;
+    sum2 += e * e;
+    ++n;
+  }
+  const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+  INFO("mean " << mean << ", sd " << sd << ", dropped " << dropped);
+  CHECK(std::fabs(mean) < 5 * 0.5 / std::sqrt(n));  // 5 standard errors
+  CHECK(std::fabs(sd - 0.5) < 0.05);
+  CHECK(std::fabs(dropped / 4000.0 - 0.1) < 5 * std::sqrt(0.1 * 0.9 / 4000));
+  CHECK_ERROR(one(R"(, "senses": [{"name": "a", "range": 5, "noise": {"dropout": 1.5}}])"), "/turtles/0/senses/0/noise/dropout",
+              "probability");
+  CHECK_ERROR(one(R"(, "senses": [{"name": "a", "range": 5, "noise": {"sigma": 1}}])"), "/turtles/0/senses/0/noise/sigma",
+              "unknown key");
+}

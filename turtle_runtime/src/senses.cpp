@@ -2,6 +2,7 @@
 // Range sensors (the world file's `"senses"`): each ray cast from the turtle's centre through the
 // engine's grid (sim::World::cast_ray), as the turtle's layers see the world, at the control
 // boundary the program runs at; every reading is logged as a `sense` event.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -58,7 +59,19 @@ void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& 
     // Behind a mirror the program's bearing b looks along 360 - b (Turtle::mirrored).
     const double heading = st.heading + sim::to_radians(mirrored ? -b : b);
     ray.dir = {std::sin(heading), std::cos(heading)};  // Logo: 0 is +y, clockwise
-    const sim::RayHit hit = w.cast_ray(ray);
+    sim::RayHit hit = w.cast_ray(ray);
+    if (hit.hit() && (sensor->noise > 0.0 || sensor->dropout > 0.0)) {
+      // From the program's own stream, only for noisy sensors: noiseless runs draw nothing.
+      auto uniform = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+      if (sensor->dropout > 0.0 && uniform() < sensor->dropout) {
+        hit = {};
+      } else if (sensor->noise > 0.0) {
+        // Box-Muller: 1 - u is in (0, 1], so the logarithm is finite.
+        const double g = std::sqrt(-2.0 * std::log(1.0 - uniform())) * std::cos(2.0 * M_PI * uniform());
+        hit.distance = std::max(0.0, hit.distance + sensor->noise * g);
+        if (hit.distance > sensor->range) hit = {};
+      }
+    }
     Reading r;
     r.bearing = b;
     if (k > 0) {

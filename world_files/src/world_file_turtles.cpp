@@ -154,11 +154,22 @@ std::vector<turtle::RangeSensor> Reader::read_senses(const json& v, const std::s
     const std::string p = at(path, k);
     const json& s = v[k];
     expect_object(s, p, "a range sensor");
-    check_keys(s, p, "a range sensor", {"name", "bearing", "range", "ring", "lidar"});
+    check_keys(s, p, "a range sensor", {"name", "bearing", "range", "ring", "lidar", "noise"});
     turtle::RangeSensor sensor;
     sensor.name = string(require(s, p, "name", "a range sensor"), at(p, "name"));
     if (sensor.name.empty()) fail(at(p, "name"), "a sensor's name must not be empty");
     if (!names.insert(sensor.name).second) fail(at(p, "name"), "duplicate sensor name \"" + sensor.name + "\"");
+    if (const json* noise = find(s, "noise")) {
+      const std::string np = at(p, "noise");
+      expect_object(*noise, np, "a sensor's noise");
+      check_keys(*noise, np, "a sensor's noise", {"sd", "dropout"});
+      if (const json* x = find(*noise, "sd")) sensor.noise = non_negative(*x, at(np, "sd"));
+      if (const json* x = find(*noise, "dropout")) {
+        sensor.dropout = number(*x, at(np, "dropout"));
+        if (!(sensor.dropout >= 0.0 && sensor.dropout <= 1.0))
+          fail(at(np, "dropout"), "a dropout is a probability in [0, 1] (got " + num(sensor.dropout) + ")");
+      }
+    }
     const json* ring = find(s, "ring");
     const json* lidar = find(s, "lidar");
     if (ring && lidar) fail(p, "a range sensor is a ray (\"bearing\"), a \"ring\" or a \"lidar\": not both a ring and a lidar");

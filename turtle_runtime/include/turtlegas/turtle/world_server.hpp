@@ -66,6 +66,9 @@ struct RangeSensor {
   std::string name;
   std::vector<double> bearings;  ///< one per ray: degrees clockwise from the heading
   double range = 100.0;          ///< world units from the turtle's centre
+  /// Noise, drawn from the turtle's own seeded stream (Turtle::uniform's), so noisy runs repeat:
+  double noise = 0.0;    ///< standard deviation of a Gaussian added to each hit's distance, units
+  double dropout = 0.0;  ///< probability that a hit reads as nothing
 };
 
 /// How a turtle's program is set up (the world file's turtle entry, beyond its body).
