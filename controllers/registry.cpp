@@ -20,6 +20,8 @@ void tag_random(turtle::Turtle&, const turtle::Params&);
 turtle::ControllerInfo tag_random_info();
 void tag_camera(turtle::Turtle&, const turtle::Params&);
 turtle::ControllerInfo tag_camera_info();
+void braitenberg(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo braitenberg_info();
 
 turtle::Registry builtin_registry() {
   turtle::Registry r = turtle::base_registry();
@@ -31,6 +33,7 @@ turtle::Registry builtin_registry() {
   r.add("tag_evader", tag_evader, tag_evader_info());
   r.add("tag_random", tag_random, tag_random_info());
   r.add("tag_camera", tag_camera, tag_camera_info());
+  r.add("braitenberg", braitenberg, braitenberg_info());
   return r;
 }
 

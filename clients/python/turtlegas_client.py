@@ -95,6 +95,25 @@ class Result:
         return "Result(done=%g, touched=%s, t=%g)" % (self.done, self.touched, self.t)
 
 
+class Reading:
+    """One ray of a range sensor, as Reading in turtle.hpp: distance (world units from the turtle's
+    centre; math.inf when nothing is within range), bearing (degrees clockwise from the heading),
+    what (an id) and kind ("wall", "wall-end", "ball", "turtle"; None when nothing is hit)."""
+
+    def __init__(self, d):
+        self.bearing = d["bearing"]
+        self.distance = d["distance"] if d.get("distance") is not None else float("inf")
+        self.what = d.get("what")
+        self.kind = d.get("kind")
+
+    @property
+    def hit(self):
+        return self.kind is not None
+
+    def __repr__(self):
+        return "Reading(bearing=%g, distance=%g, what=%r)" % (self.bearing, self.distance, self.what)
+
+
 # ---- transports ---------------------------------------------------------------------------------
 
 def _wait_readable(sock, deadline):
@@ -622,6 +641,12 @@ class RemoteTurtle:
 
     def pen_down(self, mode="line"):
         return self._command({"type": "pen", "down": True, "mode": mode})
+
+    def sense(self, sensor):
+        """Reads range sensor `sensor` (the turtle's "senses" in the world file) at the next control
+        boundary, taking no simulated time: a list of Reading, one per ray, as Turtle::scan."""
+        r = self._command({"type": "sense", "sensor": sensor})
+        return [Reading(d) for d in r.reply.get("readings", [])]
 
     @property
     def heading(self):

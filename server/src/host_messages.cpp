@@ -36,7 +36,7 @@ struct WorldHost::Handler {
 std::span<const WorldHost::Handler> WorldHost::handlers() {
   using A = Access;
   // In docs/protocol.md's order (an unknown type's error lists them so).
-  static constexpr std::array<Handler, 32> table = {{
+  static constexpr std::array<Handler, 33> table = {{
       {"hello", A::anyone, true, &WorldHost::on_hello},
       {"subscribe", A::viewer, true, &WorldHost::on_subscribe},
       {"unsubscribe", A::viewer, true, &WorldHost::on_unsubscribe},
@@ -55,6 +55,7 @@ std::span<const WorldHost::Handler> WorldHost::handlers() {
       {"wait", A::controller, false, &WorldHost::on_command},
       {"yield", A::controller, false, &WorldHost::on_command},
       {"pen", A::controller, false, &WorldHost::on_command},
+      {"sense", A::controller, false, &WorldHost::on_command},
       {"add_wall", A::controller, false, &WorldHost::on_add_wall},
       {"save", A::controller, false, &WorldHost::on_file},
       {"load", A::controller, false, &WorldHost::on_file},

@@ -104,7 +104,7 @@ void WorldHost::on_release(ClientState& c, const json& m, const std::string& /*t
 void WorldHost::on_command(ClientState& c, const json& m, const std::string& type) {
   const json id = message_id(m);
   require_live();
-  const std::string ex = "{\"type\": \"" + type + "\", \"turtle\": \"t1\"" + (type == "pen" ? ", \"down\": true}" : type == "yield" ? "}" : ", \"amount\": 100}");
+  const std::string ex = "{\"type\": \"" + type + "\", \"turtle\": \"t1\"" + (type == "pen" ? ", \"down\": true}" : type == "yield" ? "}" : type == "sense" ? ", \"sensor\": \"ir\"}" : ", \"amount\": 100}");
   const std::size_t i = turtle_index(m, ex.c_str());
   const turtle::RemoteCommand cmd = read_command(m, type);  // the message first, then the turtle's state
   Slot& s = slots_[i];
@@ -113,6 +113,20 @@ void WorldHost::on_command(ClientState& c, const json& m, const std::string& typ
     throw RequestError("unknown_turtle", "/turtle: '" + tid + "' is no longer in the world (removed, crushed or out of an open arena)", "/turtle");
   if (s.owner != c.client->id)
     throw RequestError("not_claimed", "/turtle: claim '" + tid + "' first: {\"type\": \"claim\", \"turtle\": \"" + tid + "\"}", "/turtle");
+  if (cmd.kind == turtle::RemoteCommand::Kind::sense && i < scene_.programs.size()) {
+    // Refused here rather than faulting the turtle's program, as Turtle::scan would throw.
+    std::string names;
+    bool found = false;
+    for (const turtle::RangeSensor& r : scene_.programs[i].senses) {
+      found = found || r.name == cmd.sensor;
+      names += (names.empty() ? "" : ", ") + r.name;
+    }
+    if (!found)
+      throw RequestError("bad_value", "/sensor: '" + tid + "' has no range sensor \"" + cmd.sensor + "\"" +
+                                          (names.empty() ? std::string("; declare it under the turtle's \"senses\" in the world file")
+                                                         : "; its senses: " + names),
+                         "/sensor");
+  }
   if (s.busy)
     throw RequestError("busy", "/turtle: '" + tid + "' has not finished its previous command; wait for its result", "/turtle");
   if (server_->turtle_status(i).finished)

@@ -114,6 +114,11 @@ turtle::RemoteCommand read_command(const json& m, std::string_view type) {
     }
     return c;
   }
+  if (type == "sense") {
+    c.kind = K::sense;
+    c.sensor = string_field(m, "sensor", R"({"type": "sense", "turtle": "t1", "sensor": "ir"})");
+    return c;
+  }
   c.kind = *turtle::remote_command_kind(type);
   if (turtle::takes_amount(c.kind)) {
     const std::string ex = "{\"type\": \"" + std::string(type) + "\", \"turtle\": \"t1\", \"amount\": " +
@@ -209,6 +214,31 @@ std::string report_text(const turtle::RemoteReport& r, std::string_view turtle_i
       if (!id.is_null()) {
         append_key(out, "id");
         out += id.dump(-1, ' ', false, json::error_handler_t::replace);
+        out += ',';
+      }
+      if (r.command.kind == turtle::RemoteCommand::Kind::sense) {
+        // Every ray, as Turtle::scan reads it: distance null past the range, what and kind then null too.
+        append_key(out, "readings");
+        out += '[';
+        for (std::size_t k = 0; k < r.readings.size(); ++k) {
+          const turtle::Reading& rd = r.readings[k];
+          if (k > 0) out += ',';
+          out += "{\"bearing\":";
+          append_double(out, rd.bearing);
+          out += ",\"distance\":";
+          if (rd.hit()) append_double(out, rd.distance);
+          else out += "null";
+          out += ",\"kind\":";
+          if (rd.hit()) formats::append_json_string(out, rd.kind);
+          else out += "null";
+          out += ",\"what\":";
+          if (rd.hit()) formats::append_json_string(out, rd.what);
+          else out += "null";
+          out += '}';
+        }
+        out += "],";
+        append_key(out, "sensor");
+        formats::append_json_string(out, r.command.sensor);
         out += ',';
       }
       append_key(out, "state");

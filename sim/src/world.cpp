@@ -55,6 +55,7 @@ void World::teleport_ball(std::size_t i, Vec2 pos, Vec2 vel) { impl_->engine->te
 void World::teleport_turtle(std::size_t i, Vec2 pos, double heading) {
   impl_->engine->teleport_turtle(i, pos, heading);
 }
+RayHit World::cast_ray(const Ray& ray) const { return impl_->engine->cast_ray(ray); }
 void World::balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const {
   impl_->engine->balls_in_rect(lo, hi, out);
 }

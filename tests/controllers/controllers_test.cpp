@@ -254,3 +254,44 @@ TEST_CASE("wander: never leaves the arena, never overlaps, keeps moving", "[cont
     CHECK(s.turtle(i).fault.empty());
   }
 }
+
+TEST_CASE("braitenberg: wanders a convex room on its IR ring and never touches; a slimmer bound would", "[controllers]") {
+  // A room with a corner cut off (still convex); the vehicle keeps its distance to every wall above
+  // its radius and travels. The same vehicle with a ring too short to see a wall before it touches
+  // (range 9, below its radius: every wall reads as nothing) does touch: the readings are what
+  // keep it off.
+  for (const double range : {60.0, 9.0}) {
+    INFO("ring range " << range);
+    sim::WorldDef d = room(400, 300);
+    d.walls.push_back({"cut", {0, 240}, {60, 300}});
+    d.turtles.push_back(body("v", {200, 150}, 30, 30, 180));
+    TurtleProgram p = program("braitenberg");
+    p.senses.push_back({"ir", {0, 45, 90, 135, 180, 225, 270, 315}, range});
+    WorldServer s(d, {p}, registry());
+    std::vector<LogEvent> log;
+    s.set_event_log(&log);
+    double travelled = 0.0, closest = 1e300;
+    sim::Vec2 last = d.turtles[0].pos;
+    for (int step = 1; step <= 30 * 300; ++step) {  // 300 s
+      s.run_until(step * d.dt);
+      const sim::Vec2 pos = s.turtle(0).state.pos;
+      travelled += sim::norm(pos - last);
+      last = pos;
+      closest = std::min(closest, wall_distance(s.world(), pos) - 10.0);
+    }
+    std::size_t touches = 0, senses = 0;
+    for (const LogEvent& e : log) {
+      touches += e.kind == "touch" ? 1 : 0;
+      senses += e.kind == "sense" ? 1 : 0;
+    }
+    CHECK(s.turtle(0).fault.empty());
+    if (range == 60.0) {
+      CHECK(touches == 0);
+      CHECK(closest > 0.0);
+      CHECK(travelled > 1500.0);  // of at most 30 * 300 = 9000
+      CHECK(senses > 4500);  // about one reading a control step
+    } else {
+      CHECK(touches > 0);
+    }
+  }
+}

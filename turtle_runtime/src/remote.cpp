@@ -8,8 +8,8 @@
 namespace turtlegas::turtle {
 namespace {
 
-constexpr std::array<std::string_view, 8> kind_names = {"forward", "back", "left", "right",
-                                                         "wait", "yield", "pen_up", "pen_down"};
+constexpr std::array<std::string_view, 9> kind_names = {"forward", "back",  "left",     "right", "wait",
+                                                         "yield",   "pen_up", "pen_down", "sense"};
 
 }  // namespace
 
@@ -23,7 +23,7 @@ std::optional<RemoteCommand::Kind> remote_command_kind(std::string_view name) {
 
 bool takes_amount(RemoteCommand::Kind kind) {
   return kind != RemoteCommand::Kind::yield && kind != RemoteCommand::Kind::pen_up &&
-         kind != RemoteCommand::Kind::pen_down;
+         kind != RemoteCommand::Kind::pen_down && kind != RemoteCommand::Kind::sense;
 }
 
 }  // namespace turtlegas::turtle

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "agent.hpp"
 #include "server_impl.hpp"
@@ -28,9 +29,11 @@ void remote_program(Agent& a) {
     r.message = m;
     a.server->reports.push_back(std::move(r));
   });
+  std::vector<Reading> readings;
   for (;;) {
     const RemoteCommand c = a.await_remote();
     Result result;
+    readings.clear();
     switch (c.kind) {
       case RemoteCommand::Kind::forward: result = t.forward(c.amount); break;
       case RemoteCommand::Kind::back: result = t.back(c.amount); break;
@@ -40,10 +43,12 @@ void remote_program(Agent& a) {
       case RemoteCommand::Kind::yield: t.yield(); break;
       case RemoteCommand::Kind::pen_up: t.pen_up(); break;
       case RemoteCommand::Kind::pen_down: t.pen_down(c.pen); break;  // a wall pen without builder throws, as in C++
+      case RemoteCommand::Kind::sense: t.scan(c.sensor, readings); break;  // an unknown sensor throws, as in C++
     }
     RemoteReport r = a.server->report_of(a, RemoteReport::Kind::result);
     r.command = c;
     r.result = std::move(result);
+    r.readings = readings;
     a.server->reports.push_back(std::move(r));
   }
 }

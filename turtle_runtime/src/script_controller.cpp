@@ -19,6 +19,7 @@ void script_controller(Turtle& t, const Params& p) {
   using Op = ScriptCommand::Op;
   const nlohmann::json& commands = p.json().contains("commands") ? p.json().at("commands") : nlohmann::json::array();
   if (!commands.is_array()) throw std::invalid_argument("params.commands must be a list of [command, amount]");
+  std::vector<Reading> readings;
   for (std::size_t k = 0; k < commands.size(); ++k) {
     const nlohmann::json& c = commands[k];
     const std::string where = "params.commands[" + std::to_string(k) + "]";
@@ -36,6 +37,12 @@ void script_controller(Turtle& t, const Params& p) {
     }
     if (command && op == Op::pendown) { t.pen_down(); continue; }
     if (command && op == Op::penup) { t.pen_up(); continue; }
+    if (command && op == Op::sense) {
+      if (c.size() != 2 || !c[1].is_string())
+        throw std::invalid_argument(where + ": 'sense' needs a sensor's name, e.g. [\"sense\", \"front\"]");
+      t.scan(c[1].get<std::string>(), readings);  // logged as a `sense` event
+      continue;
+    }
     if (c.size() != 2 || !c[1].is_number())
       throw std::invalid_argument(where + ": '" + name + "' needs one number, e.g. [\"" + name + "\", 100]");
     if (!command) {
@@ -50,7 +57,8 @@ void script_controller(Turtle& t, const Params& p) {
       case Op::right: t.right(amount); break;
       case Op::wait: t.wait(amount); break;
       case Op::pendown:
-      case Op::penup: break;  // handled above
+      case Op::penup:
+      case Op::sense: break;  // handled above
     }
   }
 }

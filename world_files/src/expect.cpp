@@ -29,10 +29,10 @@ std::string at(const std::string& path, std::string_view key) { return json_at(p
 std::string at(const std::string& path, std::size_t index) { return json_at(path, index); }
 
 /// The event kinds a run's log carries (sim's kinds, plus the runtime's touch and fault).
-constexpr std::array<std::string_view, 16> event_kinds = {
+constexpr std::array<std::string_view, 17> event_kinds = {
     "ball-ball",       "ball-wall",     "ball-wall-end", "exit",       "turtle-wall",  "turtle-wall-end", "turtle-turtle",
     "turtle-ball",     "touch",         "fault",         "wall-drawn", "wall-refused", "tag",             "wedged",
-    "crushed",         "folded"};
+    "crushed",         "folded",        "sense"};
 
 /// Whether `id` is `<turtle id>-w<digits>`: the id of a wall a turtle's pen may lay at run time.
 bool drawn_wall_id(const std::string& id, const sim::WorldDef& def) {

@@ -572,6 +572,102 @@ std::shared_ptr<const Assertion> parse_wall(const json& e, const std::string& pa
   return std::make_shared<WallExistsAssertion>(std::move(id), exists);
 }
 
+// ---- range sensors: {"sense": NAME, "who": turtle, "reading": n, "range": [...], "hit": [...]} or
+// {"sense": NAME, "who": turtle, "min": d, "max": d}
+
+class SenseAssertion final : public Assertion {
+ public:
+  struct Spec {
+    std::string sensor, who;
+    std::size_t reading = 0;
+    std::optional<json> range, hit;  // lists, an entry per ray (null: nothing within range)
+    double within = 1e-9;
+    std::optional<double> min, max;
+  };
+  explicit SenseAssertion(Spec s) : s_(std::move(s)) {}
+  std::unique_ptr<Check> start(const RunView&) const override {
+    struct C final : Check {
+      const Spec& s;
+      std::size_t seen = 0;
+      std::optional<std::string> failure;
+      explicit C(const Spec& spec) : s(spec) {}
+      void on_event(const turtle::LogEvent& e, const RunView&) override {
+        if (failure || e.kind != "sense" || e.a != s.who) return;
+        const json r = json::parse("{" + e.extra + "}", nullptr, false);
+        if (!r.is_object() || r.value("sensor", std::string()) != s.sensor) return;
+        const std::size_t k = seen++;
+        const json& got_range = r["range"];
+        const json& got_hit = r["hit"];
+        const std::string where = "sense " + s.sensor + " of " + s.who + ", reading " + std::to_string(k) + " at t = " + num(e.t);
+        if (s.min || s.max) {
+          for (std::size_t j = 0; j < got_range.size(); ++j) {
+            const double d = got_range[j].is_number() ? got_range[j].get<double>() : std::numeric_limits<double>::infinity();
+            if ((s.min && d < *s.min) || (s.max && d > *s.max)) {
+              failure = where + ": ray " + std::to_string(j) + " reads " + (got_range[j].is_number() ? num(d) : "null") +
+                        ", wanted " + (s.min ? ">= " + num(*s.min) : std::string()) + (s.min && s.max ? " and " : "") +
+                        (s.max ? "<= " + num(*s.max) : std::string());
+              return;
+            }
+          }
+        }
+        if (k != s.reading || !(s.range || s.hit)) return;
+        if (s.range) {
+          bool ok = got_range.size() == s.range->size();
+          for (std::size_t j = 0; ok && j < got_range.size(); ++j) {
+            const json& want = (*s.range)[j];
+            const json& got = got_range[j];
+            if (want.is_null() || got.is_null()) ok = want.is_null() && got.is_null();
+            else ok = std::fabs(got.get<double>() - want.get<double>()) <= s.within;
+          }
+          if (!ok) failure = where + ": range " + got_range.dump() + ", wanted " + s.range->dump() + " within " + num(s.within);
+        }
+        if (!failure && s.hit && got_hit != *s.hit) failure = where + ": hit " + got_hit.dump() + ", wanted " + s.hit->dump();
+      }
+      std::optional<std::string> finish(const RunView& v) override {
+        if (failure) return failure;
+        if ((s.range || s.hit) && seen <= s.reading)
+          return "sense " + s.sensor + " of " + s.who + ": " + std::to_string(seen) + " readings by t = " + num(v.time()) +
+                 ", wanted reading " + std::to_string(s.reading);
+        if (seen == 0) return "sense " + s.sensor + " of " + s.who + ": no reading by t = " + num(v.time());
+        return std::nullopt;
+      }
+    };
+    return std::make_unique<C>(s_);
+  }
+
+ private:
+  Spec s_;
+};
+
+std::shared_ptr<const Assertion> parse_sense(const json& e, const std::string& path, const ExpectParser& p) {
+  p.check_keys(e, path, "sense", {"who", "reading", "range", "hit", "within", "min", "max"});
+  SenseAssertion::Spec s;
+  s.sensor = p.string(e.at("sense"), at(path, "sense"));
+  if (!e.contains("who")) p.fail(path, "a sense expectation names its turtle: \"who\": \"t1\"");
+  s.who = p.turtle_id(e.at("who"), at(path, "who"));
+  if (auto it = e.find("reading"); it != e.end()) s.reading = whole(*it, at(path, "reading"), p);
+  auto list = [&](const char* key, bool numbers) -> std::optional<json> {
+    auto it = e.find(key);
+    if (it == e.end()) return std::nullopt;
+    const std::string lp = at(path, key);
+    if (!it->is_array()) p.fail(lp, std::string(key) + " must be a list with an entry per ray (null: nothing within range)");
+    for (std::size_t j = 0; j < it->size(); ++j) {
+      const json& x = (*it)[j];
+      if (!x.is_null() && !(numbers ? x.is_number() : x.is_string()))
+        p.fail(at(lp, j), std::string("expected ") + (numbers ? "a distance" : "an id") + " or null, got " + x.dump());
+    }
+    return *it;
+  };
+  s.range = list("range", true);
+  s.hit = list("hit", false);
+  if (auto it = e.find("within"); it != e.end()) s.within = p.non_negative(*it, at(path, "within"));
+  if (auto it = e.find("min"); it != e.end()) s.min = p.non_negative(*it, at(path, "min"));
+  if (auto it = e.find("max"); it != e.end()) s.max = p.non_negative(*it, at(path, "max"));
+  if (!s.range && !s.hit && !s.min && !s.max)
+    p.fail(path, "a sense expectation checks \"range\" and/or \"hit\" of one reading, or bounds \"min\"/\"max\" on every ray");
+  return std::make_shared<SenseAssertion>(std::move(s));
+}
+
 }  // namespace
 
 // ---- the table of kinds
@@ -591,6 +687,7 @@ const std::vector<AssertionKind>& assertion_kinds() {
       {"it", "the game's \"it\" is this turtle at the end (or at t)", parse_it},
       {"walls", "the number of walls (all, or drawn_by a turtle) at the end", parse_walls},
       {"wall", "a wall with this id exists (or, with \"exists\": false, does not) at the end", parse_wall},
+      {"sense", "a range sensor's reading (range, hit) or every reading's bounds (min, max)", parse_sense},
   };
   return kinds;
 }

@@ -74,7 +74,9 @@ class Reader : public JsonReader {
   void read_walls(const json& v, std::vector<sim::WallDef>& walls);
   void read_draw(const json& v, std::vector<sim::WallDef>& walls);
   std::vector<turtle::SensorArc> read_sensors(const json& v, const std::string& path) const;
-  void check_script(const json& params, const std::string& path) const;
+  std::vector<turtle::RangeSensor> read_senses(const json& v, const std::string& path) const;
+  /// `senses`: the turtle's range sensors, which ["sense", NAME] must name.
+  void check_script(const json& params, const std::string& path, const std::vector<turtle::RangeSensor>& senses) const;
   std::vector<turtle::View> read_views(const json& v, const sim::WorldDef& def);
   std::vector<GasSpec> read_gases(const json& v, const sim::WorldDef& def);
   std::string path_of(const sim::DefProblem& p) const;

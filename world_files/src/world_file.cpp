@@ -34,7 +34,7 @@ constexpr std::array<std::string_view, 0> reserved_keys = {};
 std::vector<std::string_view> draw_commands() {
   std::vector<std::string_view> names;
   for (const turtle::ScriptCommand& c : turtle::script_commands)
-    if (!c.timed_only()) names.push_back(c.name);
+    if (!c.timed_only() && !c.senses()) names.push_back(c.name);
   return names;
 }
 

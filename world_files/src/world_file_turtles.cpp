@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The loader's turtles: bodies, programs, sensor arcs, and the `script` controller's commands
 // checked before the run against the runtime's table (turtle/script.hpp).
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <string>
@@ -26,7 +27,7 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
     expect_object(t, p, "a turtle");
     check_keys(t, p, "a turtle",
                {"id", "pos", "heading", "radius", "speed", "turn_rate", "controller", "params", "sensors", "pen", "gps",
-                "bounce", "category", "collides_with", "builder"});
+                "bounce", "category", "collides_with", "builder", "senses"});
     sim::TurtleDef body;
     turtle::TurtleProgram program;
     body.id = id(t, p, "a turtle");
@@ -61,8 +62,9 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
       expect_object(*x, at(p, "params"), "params");
       program.params = *x;
     }
+    if (const json* x = find(t, "senses")) program.senses = read_senses(*x, at(p, "senses"));
     if (program.controller == "script") {
-      check_script(program.params, at(p, "params"));
+      check_script(program.params, at(p, "params"), program.senses);
     } else if (const turtle::ControllerInfo* info = registry_ ? registry_->info(program.controller) : nullptr) {
       // A controller that declares its parameters (registry.hpp): a typo ("stpe") or a value out
       // of range would otherwise silently take the default or fault at run time.
@@ -139,7 +141,72 @@ std::vector<turtle::SensorArc> Reader::read_sensors(const json& v, const std::st
   return arcs;
 }
 
-void Reader::check_script(const json& params, const std::string& path) const {
+std::vector<turtle::RangeSensor> Reader::read_senses(const json& v, const std::string& path) const {
+  constexpr std::uint64_t max_rays = 100000;
+  const std::string shape =
+      "senses must be a list of range sensors, e.g. [{\"name\": \"front\", \"bearing\": 0, \"range\": 80}, "
+      "{\"name\": \"ir\", \"ring\": 8, \"range\": 40}, {\"name\": \"lidar\", \"lidar\": {\"rays\": 360, "
+      "\"fov\": 270, \"range\": 100}}], got ";
+  if (!v.is_array()) fail(path, shape + json_kind(v));
+  std::vector<turtle::RangeSensor> out;
+  std::set<std::string> names;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const std::string p = at(path, k);
+    const json& s = v[k];
+    expect_object(s, p, "a range sensor");
+    check_keys(s, p, "a range sensor", {"name", "bearing", "range", "ring", "lidar", "noise"});
+    turtle::RangeSensor sensor;
+    sensor.name = string(require(s, p, "name", "a range sensor"), at(p, "name"));
+    if (sensor.name.empty()) fail(at(p, "name"), "a sensor's name must not be empty");
+    if (!names.insert(sensor.name).second) fail(at(p, "name"), "duplicate sensor name \"" + sensor.name + "\"");
+    if (const json* noise = find(s, "noise")) {
+      const std::string np = at(p, "noise");
+      expect_object(*noise, np, "a sensor's noise");
+      check_keys(*noise, np, "a sensor's noise", {"sd", "dropout"});
+      if (const json* x = find(*noise, "sd")) sensor.noise = non_negative(*x, at(np, "sd"));
+      if (const json* x = find(*noise, "dropout")) {
+        sensor.dropout = number(*x, at(np, "dropout"));
+        if (!(sensor.dropout >= 0.0 && sensor.dropout <= 1.0))
+          fail(at(np, "dropout"), "a dropout is a probability in [0, 1] (got " + num(sensor.dropout) + ")");
+      }
+    }
+    const json* ring = find(s, "ring");
+    const json* lidar = find(s, "lidar");
+    if (ring && lidar) fail(p, "a range sensor is a ray (\"bearing\"), a \"ring\" or a \"lidar\": not both a ring and a lidar");
+    double bearing = 0.0;
+    if (const json* x = find(s, "bearing")) bearing = number(*x, at(p, "bearing"));
+    if (lidar) {
+      if (find(s, "range")) fail(at(p, "range"), "a lidar's range goes inside it: \"lidar\": {\"rays\": 360, \"fov\": 270, \"range\": 100}");
+      const std::string lp = at(p, "lidar");
+      expect_object(*lidar, lp, "a lidar");
+      check_keys(*lidar, lp, "a lidar", {"rays", "fov", "range"});
+      const std::uint64_t n = natural(require(*lidar, lp, "rays", "a lidar"), at(lp, "rays"));
+      if (n < 1 || n > max_rays) fail(at(lp, "rays"), "a lidar has from 1 to " + std::to_string(max_rays) + " rays (got " + std::to_string(n) + ")");
+      const double fov = positive(require(*lidar, lp, "fov", "a lidar"), at(lp, "fov"), "fov (degrees)");
+      if (fov > 360.0) fail(at(lp, "fov"), "a lidar's fov is at most 360 degrees (got " + num(fov) + ")");
+      sensor.range = positive(require(*lidar, lp, "range", "a lidar"), at(lp, "range"), "range (units)");
+      // Centred on the bearing; a full circle has n equal steps, a narrower fan its two edges as rays.
+      const double step = n == 1 ? 0.0 : (fov >= 360.0 ? fov / static_cast<double>(n) : fov / static_cast<double>(n - 1));
+      const double first = n == 1 ? bearing : (fov >= 360.0 ? bearing : bearing - fov / 2.0);
+      for (std::uint64_t r = 0; r < n; ++r) sensor.bearings.push_back(first + static_cast<double>(r) * step);
+    } else {
+      sensor.range = positive(require(s, p, "range", "a range sensor"), at(p, "range"), "range (units)");
+      if (ring) {
+        const std::uint64_t n = natural(*ring, at(p, "ring"));
+        if (n < 1 || n > max_rays) fail(at(p, "ring"), "a ring has from 1 to " + std::to_string(max_rays) + " rays (got " + std::to_string(n) + ")");
+        // n equal steps, the first at the bearing (0: straight ahead), clockwise.
+        for (std::uint64_t r = 0; r < n; ++r) sensor.bearings.push_back(bearing + 360.0 * static_cast<double>(r) / static_cast<double>(n));
+      } else {
+        sensor.bearings.push_back(bearing);
+      }
+    }
+    out.push_back(std::move(sensor));
+  }
+  return out;
+}
+
+void Reader::check_script(const json& params, const std::string& path,
+                          const std::vector<turtle::RangeSensor>& senses) const {
   // The script controller would only find these at run time, as a fault that stops the turtle; a
   // typo in a scripted test world should stop the load instead.
   check_keys(params, path, "the script controller's params", {"commands"});
@@ -161,6 +228,17 @@ void Reader::check_script(const json& params, const std::string& path) const {
     if (name == "pendown" && c.size() == 2 && c[1].is_string()) {
       if (c[1] != "wall" && c[1] != "line")
         fail(at(p, 1), "a pen mode is \"line\" (draws the path) or \"wall\" (lays walls), got " + c[1].dump());
+      continue;
+    }
+    if (command->op == turtle::ScriptCommand::Op::sense) {
+      if (c.size() != 2 || !c[1].is_string()) fail(p, "'sense' needs a sensor's name, e.g. [\"sense\", \"front\"], got " + c.dump());
+      const std::string sensor = c[1].get<std::string>();
+      std::vector<std::string> known_senses;
+      for (const auto& s : senses) known_senses.push_back(s.name);
+      if (std::find(known_senses.begin(), known_senses.end(), sensor) == known_senses.end())
+        fail(at(p, 1), "this turtle has no range sensor \"" + sensor + "\"" +
+                           (known_senses.empty() ? std::string("; declare it under the turtle's \"senses\"")
+                                                 : "; its senses: " + sim::join_names(known_senses)));
       continue;
     }
     if (name == "pendown" || name == "penup") {

@@ -31,6 +31,7 @@
 //   step_clock.hpp             the start and the end of one of the memo's steps
 //   world_changes.hpp          spawn, remove, teleport: changes to a running world
 //   region.hpp                 the balls in a rectangle, from the cell lists
+//   rays.hpp                   ray casts (range sensors): the grid walked along a ray
 //
 // Order of work, exact mode (event-driven):
 //   1. Every ball holds one pending prediction: its earliest collision among the objects in its
@@ -172,6 +173,7 @@ class Engine final : public EngineBase {
   void teleport_ball(std::size_t i, Vec2 pos, Vec2 vel) override;
   void teleport_turtle(std::size_t i, Vec2 pos, double heading) override;
   void balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const override;  // region.hpp
+  RayHit cast_ray(const Ray& ray) const override;  // rays.hpp
   bool turtle_alive(std::size_t k) const override {
     return k < turtles_.size() && bodies_.body[bodies_.balls() + k].cell != kNone;
   }
@@ -629,6 +631,7 @@ void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
 #include "exact_clock.hpp"
 #include "world_changes.hpp"
 #include "region.hpp"
+#include "rays.hpp"
 #include "step_clock.hpp"
 
 namespace turtlegas::sim::detail {

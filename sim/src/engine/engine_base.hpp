@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "turtlegas/sim/ray_cast.hpp"
 #include "turtlegas/sim/world.hpp"
 
 namespace turtlegas::sim::detail {
@@ -47,6 +48,7 @@ class EngineBase {
   virtual void teleport_turtle(std::size_t i, Vec2 pos, double heading) = 0;
   virtual bool turtle_alive(std::size_t i) const = 0;
   virtual void balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const = 0;
+  virtual RayHit cast_ray(const Ray& ray) const = 0;
   virtual double cell_size() const = 0;
   virtual int cells_x() const = 0;
   virtual int cells_y() const = 0;

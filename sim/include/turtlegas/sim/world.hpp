@@ -12,6 +12,9 @@
 
 namespace turtlegas::sim {
 
+struct Ray;
+struct RayHit;
+
 /// Counters a run accumulates. Collisions are physical contacts; events also count internal
 /// bookkeeping (cell crossings, step boundaries, stale predictions).
 struct Stats {
@@ -232,6 +235,14 @@ class World {
   /// travel may have moved a ball out of its listed cell), O(cells touched + balls found).
   /// Nothing when lo > hi in either axis.
   void balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const;
+
+  /// The first wall, wall end, ball or turtle the ray meets now, within its range, as its layers
+  /// see them (ray_cast.hpp): walls and turtles at their pose now, moving walls included. From the
+  /// grid, walked cell by cell along the ray (a periodic arena's seams crossed); it stops at the
+  /// first hit proven nearest, so a ray costs about the cells it crosses. Ties go to the lower
+  /// (target, index). Throws std::invalid_argument for a zero or non-finite direction, a
+  /// non-finite origin, a negative or NaN range, or an infinite range in a periodic arena.
+  RayHit cast_ray(const Ray& ray) const;
 
   std::size_t turtle_count() const;
   TurtleState turtle(std::size_t i) const;

@@ -19,6 +19,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "turtlegas/sim/vec2.hpp"
 #include "turtlegas/turtle/turtle.hpp"
@@ -33,16 +34,17 @@ inline constexpr std::string_view remote_controller_name = "remote";
 
 /// One command for a remote turtle: what its C++ twin would call on its Turtle.
 struct RemoteCommand {
-  enum class Kind { forward, back, left, right, wait, yield, pen_up, pen_down };
+  enum class Kind { forward, back, left, right, wait, yield, pen_up, pen_down, sense };
   Kind kind = Kind::yield;
   double amount = 0.0;          ///< forward/back: world units; left/right: degrees; wait: seconds
   PenMode pen = PenMode::line;  ///< pen_down's mode
+  std::string sensor;           ///< sense: the range sensor to read (Turtle::scan); takes no time
   /// The sender's number for the command, echoed in its result; not part of the run (an input
   /// log does not record it).
   std::uint64_t tag = 0;
 };
 
-/// "forward", "back", "left", "right", "wait", "yield", "pen_up", "pen_down".
+/// "forward", "back", "left", "right", "wait", "yield", "pen_up", "pen_down", "sense".
 std::string_view to_string(RemoteCommand::Kind kind);
 std::optional<RemoteCommand::Kind> remote_command_kind(std::string_view name);
 /// Whether the command takes an amount (forward, back, left, right, wait).
@@ -64,6 +66,7 @@ struct RemoteReport {
   double t = 0.0;          ///< seconds, the boundary's time
   RemoteCommand command;   ///< result: the command it answers (with its tag)
   Result result;           ///< result
+  std::vector<Reading> readings;  ///< result of a sense: every ray of the sensor, as Turtle::scan
   Touch touch;             ///< touch (its sensor_names live as long as the WorldServer)
   Message message;         ///< message
   std::string fault;       ///< fault

@@ -12,19 +12,22 @@ namespace turtlegas::turtle {
 
 /// One script command: its name in a world file and what its number measures.
 struct ScriptCommand {
-  enum class Op { forward, back, left, right, wait, pendown, penup };
-  /// What the command's amount is: none for pendown and penup (pendown may name a pen mode).
-  enum class Amount { none, units, degrees, seconds };
+  enum class Op { forward, back, left, right, wait, pendown, penup, sense };
+  /// What the command's amount is: none for pendown and penup (pendown may name a pen mode), the
+  /// name of a range sensor for sense.
+  enum class Amount { none, units, degrees, seconds, sensor };
   std::string_view name;
   Op op;
   Amount amount;
   /// Whether the command takes simulated time only (wait): a draw builder, which runs at load
   /// time, has no such command.
   bool timed_only() const { return amount == Amount::seconds; }
+  /// Whether the command reads the world (sense): a draw builder, which runs at load time, has none.
+  bool senses() const { return amount == Amount::sensor; }
 };
 
 /// Every script command, in the order messages list them.
-inline constexpr std::array<ScriptCommand, 7> script_commands = {{
+inline constexpr std::array<ScriptCommand, 8> script_commands = {{
     {"forward", ScriptCommand::Op::forward, ScriptCommand::Amount::units},
     {"back", ScriptCommand::Op::back, ScriptCommand::Amount::units},
     {"left", ScriptCommand::Op::left, ScriptCommand::Amount::degrees},
@@ -32,6 +35,7 @@ inline constexpr std::array<ScriptCommand, 7> script_commands = {{
     {"wait", ScriptCommand::Op::wait, ScriptCommand::Amount::seconds},
     {"pendown", ScriptCommand::Op::pendown, ScriptCommand::Amount::none},
     {"penup", ScriptCommand::Op::penup, ScriptCommand::Amount::none},
+    {"sense", ScriptCommand::Op::sense, ScriptCommand::Amount::sensor},
 }};
 
 /// The names of every script command, in table order ("known: ..." lists).
@@ -54,6 +58,7 @@ constexpr std::string_view unit_name(ScriptCommand::Amount a) {
     case ScriptCommand::Amount::units: return "units";
     case ScriptCommand::Amount::degrees: return "degrees";
     case ScriptCommand::Amount::seconds: return "seconds";
+    case ScriptCommand::Amount::sensor: return "sensor";
     case ScriptCommand::Amount::none: break;
   }
   return {};

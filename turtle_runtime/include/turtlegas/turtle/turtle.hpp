@@ -116,6 +116,17 @@ struct Touch {
   bool any() const { return sensors != 0; }
 };
 
+/// One ray of a range sensor, read now (Turtle::range, Turtle::scan).
+struct Reading {
+  /// World units from the turtle's centre to the first thing the ray meets; infinity when nothing
+  /// is within the sensor's range.
+  double distance = std::numeric_limits<double>::infinity();
+  double bearing = 0.0;  ///< the ray's, degrees clockwise from the heading (as the program sees it)
+  std::string what;      ///< id of the wall, ball or turtle hit; empty when nothing is
+  std::string kind;      ///< "wall", "wall-end", "ball" or "turtle"; empty when nothing is hit
+  bool hit() const { return !kind.empty(); }
+};
+
 /// What a command did.
 class Result {
  public:
@@ -200,6 +211,14 @@ class Turtle {
   /// changes at control-step boundaries, together with the message that announces it.
   bool it() const;
 
+  /// Range sensors (the world file's `"senses"`), read now, at the control boundary the program
+  /// runs at: no simulated time passes. Each call logs a `sense` event with every ray's reading.
+  /// An unknown sensor name throws std::invalid_argument naming the turtle's sensors.
+  /// The sensor's first ray (a single ray's only one).
+  Reading range(const std::string& sensor);
+  /// Every ray of the sensor, in its order, into `out` (cleared first; its capacity is reused).
+  void scan(const std::string& sensor, std::vector<Reading>& out);
+
   /// Odometry: distance driven in all (units) and heading (degrees, Logo convention).
   double odometer() const;
   double heading() const;
@@ -233,7 +252,8 @@ class Turtle {
   /// default, is a vertical line), to run a program as its own mirror image (the `mirror`
   /// controller). The handle it returns exchanges left and right, and reflects across the line
   /// the heading (heading() is 2 axis - the real heading), every touch (bearing b seen as 360 - b,
-  /// sensors those of the reflected bearing: Result::touch(), on_touch, touching()) and, when
+  /// sensors those of the reflected bearing: Result::touch(), on_touch, touching(); a range
+  /// sensor's ray at bearing b reads what lies at 360 - b) and, when
   /// `through` names a point of the line, position() (without it a mirrored position() is
   /// nullopt). Distances, times, messages, the pen and uniform() are the turtle's own. Mirrored
   /// again across the same line, it is the turtle itself; across another line it throws

@@ -59,6 +59,18 @@ std::vector<SensorArc> default_sensors();
 /// n equal arcs, the first centred on the heading, named s0..s{n-1}.
 std::vector<SensorArc> equal_sensors(int n);
 
+/// A range sensor (the world file's `"senses"`): rays from the turtle's centre, each reading the
+/// distance to the first wall, wall end, ball or turtle it meets within `range`, as the turtle's
+/// collision layers see them (Turtle::range, Turtle::scan; docs/controllers.md, "Range sensors").
+struct RangeSensor {
+  std::string name;
+  std::vector<double> bearings;  ///< one per ray: degrees clockwise from the heading
+  double range = 100.0;          ///< world units from the turtle's centre
+  /// Noise, drawn from the turtle's own seeded stream (Turtle::uniform's), so noisy runs repeat:
+  double noise = 0.0;    ///< standard deviation of a Gaussian added to each hit's distance, units
+  double dropout = 0.0;  ///< probability that a hit reads as nothing
+};
+
 /// How a turtle's program is set up (the world file's turtle entry, beyond its body).
 struct TurtleProgram {
   std::string controller = "script";
@@ -70,6 +82,7 @@ struct TurtleProgram {
   /// private collision category, so that it passes through its own walls (see WorldServer).
   bool builder = false;
   bool gps = false;  ///< whether the program may read its global position
+  std::vector<RangeSensor> senses;  ///< range sensors, by name (none by default)
 };
 
 /// The scene the world server runs: `def` with every builder turtle (programs[k].builder) moved
