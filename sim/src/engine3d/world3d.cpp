@@ -79,7 +79,7 @@ std::string check_world3(const World3Def& def) {
     const double an = norm(area);
     double scale = 0.0;
     for (std::size_t k = 0; k < c.size(); ++k) scale = std::max(scale, norm(c[(k + 1) % c.size()] - c[k]));
-    if (!(an > 1e-12 * scale * scale)) return at + "corners are collinear (no plane)";
+    if (!(an > 1e-12 * scale * scale)) return at + "corners are collinear, or not in order around the polygon (no plane)";
     const Vec3 n = (1.0 / an) * area;
     for (std::size_t k = 0; k < c.size(); ++k) {
       if (std::abs(dot(c[k] - c[0], n)) > 1e-9 * scale) return at + "corners are not in one plane";
