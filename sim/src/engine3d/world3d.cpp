@@ -46,6 +46,8 @@ struct Record {
   bool alive = true;
   std::uint32_t partner = 0;      // sphere or wall
   std::uint32_t partner_count = 0;  // or the feature index
+  double cand_t = kNever;  // the pending contact's time (absolute)
+  double exit_t = kNever;  // the cell exit's time (absolute)
 };
 
 constexpr std::uint32_t kNone = EventQueue::kAbsent;
@@ -205,7 +207,10 @@ struct World3::Impl {
   }
 
   // Features of wall k against body b (at now), up to best; updates b's pending event.
-  void predict_wall(Record& b, std::uint32_t k, double& best) {
+  // Walls are searched up to the cell exit too: after it, the next cell's list has them.
+  void predict_wall(Record& b, std::uint32_t k, double& cand, double exit) {
+    double best = std::min(cand, exit);
+    const double before = best;
     const Polygon3& p = walls[k];
     const double tol = 1e-12 * p.scale;
     const Vec3 d = b.x - p.corners[0];
@@ -251,56 +256,77 @@ struct World3::Impl {
         b.kind = Pending::corner; b.partner = k; b.partner_count = static_cast<std::uint32_t>(e);
       }
     }
+    if (best < before) cand = best;
   }
 
+  // The spheres of one cell against b (at now): the earliest approach below cand.
+  void scan_cell(std::uint32_t i, Record& b, int cx, int cy, int cz, double& cand) {
+    Vec3 shift;
+    int k[3] = {cx, cy, cz};
+    for (int a = 0; a < 3; ++a) {
+      if (k[a] >= 0 && k[a] < n[a]) continue;
+      if (boundary != Boundary3::periodic) return;
+      shift[a] = k[a] < 0 ? -size[a] : size[a];
+      k[a] = (k[a] + n[a]) % n[a];
+    }
+    for (std::uint32_t j = head[cell_index(k[0], k[1], k[2])]; j != kNone; j = rec[j].next) {
+      if (j == i) continue;
+      const Record& o = rec[j];
+      const double dt = now - o.t;
+      const Vec3 xo = fly(o.x, o.v, o.a, dt) + shift, vo = o.v + dt * o.a;
+      const double t = toi_sphere_sphere(xo - b.x, vo - b.v, o.a - b.a, b.r + o.r, cand);
+      if (t < cand) {
+        cand = t;
+        b.kind = Pending::pair; b.partner = j; b.partner_count = o.count;
+      }
+    }
+  }
+
+  void schedule(std::uint32_t i, Record& b, double cand, double exit) {
+    b.cand_t = b.kind == Pending::none ? kNever : now + cand;
+    b.exit_t = now + exit;
+    queue.set(i, std::min(b.cand_t, b.exit_t));
+  }
+
+  // A full prediction: the 27 cells around, the walls of the cell, the cell exit. Pairs are
+  // searched without a horizon (a pair's time holds whatever cells the two are in), so that a
+  // crossing needs to look only at the strip of cells that comes into view.
   void predict(std::uint32_t i) {
     Record& b = rec[i];
     bring(b, now);
-    double best = cell_exit(b, b.axis, b.dir);
-    b.kind = std::isfinite(best) ? Pending::cell : Pending::none;
+    const double exit = cell_exit(b, b.axis, b.dir);
+    double cand = kNever;
+    b.kind = Pending::none;
     int k[3];
     coords(b.cell, k);
-    for (int oz = -1; oz <= 1; ++oz) {
-      int cz = k[2] + oz;
-      double sz = 0.0;
-      if (cz < 0 || cz >= n[2]) {
-        if (boundary != Boundary3::periodic) continue;
-        sz = cz < 0 ? -size.z : size.z;
-        cz = (cz + n[2]) % n[2];
+    for (int oz = -1; oz <= 1; ++oz)
+      for (int oy = -1; oy <= 1; ++oy)
+        for (int ox = -1; ox <= 1; ++ox) scan_cell(i, b, k[0] + ox, k[1] + oy, k[2] + oz, cand);
+    for (std::uint32_t wk : cell_walls[b.cell]) predict_wall(b, wk, cand, exit);
+    schedule(i, b, cand, exit);
+  }
+
+  // After a crossing along `axis` by `dir`: the kept contact candidate (still a true time of
+  // its pair if the partner's count has not moved; a stale one is found when popped), the nine
+  // cells of the new strip, the new cell's walls, the new exit.
+  void predict_strip(std::uint32_t i, int axis, int dir) {
+    Record& b = rec[i];
+    const double exit = cell_exit(b, b.axis, b.dir);
+    double cand = b.kind == Pending::none ? kNever : b.cand_t - now;
+    int k[3];
+    coords(b.cell, k);
+    k[axis] += dir;
+    const int u = (axis + 1) % 3, w2 = (axis + 2) % 3;
+    for (int ou = -1; ou <= 1; ++ou)
+      for (int ow = -1; ow <= 1; ++ow) {
+        int c[3];
+        c[axis] = k[axis];
+        c[u] = k[u] + ou;
+        c[w2] = k[w2] + ow;
+        scan_cell(i, b, c[0], c[1], c[2], cand);
       }
-      for (int oy = -1; oy <= 1; ++oy) {
-        int cy = k[1] + oy;
-        double sy = 0.0;
-        if (cy < 0 || cy >= n[1]) {
-          if (boundary != Boundary3::periodic) continue;
-          sy = cy < 0 ? -size.y : size.y;
-          cy = (cy + n[1]) % n[1];
-        }
-        for (int ox = -1; ox <= 1; ++ox) {
-          int cx = k[0] + ox;
-          double sx = 0.0;
-          if (cx < 0 || cx >= n[0]) {
-            if (boundary != Boundary3::periodic) continue;
-            sx = cx < 0 ? -size.x : size.x;
-            cx = (cx + n[0]) % n[0];
-          }
-          const Vec3 shift{sx, sy, sz};
-          for (std::uint32_t j = head[cell_index(cx, cy, cz)]; j != kNone; j = rec[j].next) {
-            if (j == i) continue;
-            const Record& o = rec[j];
-            const double dt = now - o.t;
-            const Vec3 xo = fly(o.x, o.v, o.a, dt) + shift, vo = o.v + dt * o.a;
-            const double t = toi_sphere_sphere(xo - b.x, vo - b.v, o.a - b.a, b.r + o.r, best);
-            if (t < best) {
-              best = t;
-              b.kind = Pending::pair; b.partner = j; b.partner_count = o.count;
-            }
-          }
-        }
-      }
-    }
-    for (std::uint32_t wk : cell_walls[b.cell]) predict_wall(b, wk, best);
-    queue.set(i, b.kind == Pending::none ? kNever : now + best);
+    for (std::uint32_t wk : cell_walls[b.cell]) predict_wall(b, wk, cand, exit);
+    schedule(i, b, cand, exit);
   }
 
   // The other body's position seen from a, by the minimum image (at contact the pair is closer
@@ -326,6 +352,10 @@ struct World3::Impl {
   void serve(std::uint32_t i) {
     Record& b = rec[i];
     ++events;
+    if (b.exit_t < b.cand_t) {
+      cross(i);
+      return;
+    }
     switch (b.kind) {
       case Pending::none: queue.set(i, kNever); return;
       case Pending::pair: {
@@ -382,30 +412,32 @@ struct World3::Impl {
         predict(i);
         return;
       }
-      case Pending::cell: {
-        bring(b, now);
-        int k[3];
-        coords(b.cell, k);
-        const int a = b.axis;
-        k[a] += b.dir;
-        if (k[a] < 0 || k[a] >= n[a]) {
-          if (boundary != Boundary3::periodic) {
-            unlink(i);
-            b.alive = false;
-            ++b.count;
-            queue.remove(i);
-            note(Event3Kind::exit, i, 0, 0);
-            return;
-          }
-          k[a] = (k[a] + n[a]) % n[a];
-          b.x[a] -= b.dir * size[a];
-        }
+      case Pending::cell: break;
+    }
+  }
+
+  void cross(std::uint32_t i) {
+    Record& b = rec[i];
+    bring(b, now);
+    int k[3];
+    coords(b.cell, k);
+    const int a = b.axis, dir = b.dir;
+    k[a] += dir;
+    if (k[a] < 0 || k[a] >= n[a]) {
+      if (boundary != Boundary3::periodic) {
         unlink(i);
-        link(i, cell_index(k[0], k[1], k[2]));
-        predict(i);
+        b.alive = false;
+        ++b.count;
+        queue.remove(i);
+        note(Event3Kind::exit, i, 0, 0);
         return;
       }
+      k[a] = (k[a] + n[a]) % n[a];
+      b.x[a] -= dir * size[a];
     }
+    unlink(i);
+    link(i, cell_index(k[0], k[1], k[2]));
+    predict_strip(i, a, dir);
   }
 
   void advance_to(double t) {
