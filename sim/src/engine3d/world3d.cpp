@@ -197,6 +197,15 @@ struct World3::Impl {
     double best = kNever;
     for (int a = 0; a < 3; ++a) {
       const double lo = k[a] * w[a], hi = (k[a] + 1 == n[a]) ? size[a] : lo + w[a];
+      if (b.a[a] == 0.0) {
+        // A straight flight leaves by the face it moves towards (a position past it by
+        // round-off leaves at once, as first_approach_quadratic would have it).
+        const double va = b.v[a];
+        if (va == 0.0) continue;
+        const double t = va > 0.0 ? std::max(0.0, (hi - b.x[a]) / va) : std::max(0.0, (lo - b.x[a]) / va);
+        if (t < best) { best = t; axis = static_cast<std::uint8_t>(a); dir = va > 0.0 ? 1 : -1; }
+        continue;
+      }
       // The same cancellation-free forms as the 2-D clock's crossings (toi.cpp).
       const double t_hi = first_approach_quadratic(hi - b.x[a], -b.v[a], -0.5 * b.a[a]);
       const double t_lo = first_approach_quadratic(b.x[a] - lo, b.v[a], 0.5 * b.a[a]);
