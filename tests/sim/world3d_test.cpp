@@ -113,13 +113,14 @@ TEST_CASE("toi_sphere_sphere under a relative acceleration finds the second appr
 
 namespace {
 
-World3Def random_scene(std::uint64_t seed, int n, bool gravity) {
+World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool electric = false) {
   std::mt19937_64 gen(seed);
   auto u = [&](double lo, double hi) { return lo + (hi - lo) * static_cast<double>(gen() >> 11) * 0x1.0p-53; };
   World3Def def;
   def.size = {12, 12, 12};
   def.boundary = Boundary3::none;
   if (gravity) def.gravity = {0.3, -0.5, -2.0};
+  if (electric) def.electric = {0.8, 1.5, -1.0};
   // A closed box of our own walls (so the reference sees them too), and two slanted polygons.
   const double L = 12;
   def.walls.push_back({{{0, 0, 0}, {0, L, 0}, {0, L, L}, {0, 0, L}}});
@@ -136,7 +137,7 @@ World3Def random_scene(std::uint64_t seed, int n, bool gravity) {
     bool ok = true;
     for (const auto& s : def.spheres) ok = ok && norm(s.pos - x) > s.radius + r + 0.05;
     for (const auto& wd : def.walls) ok = ok && turtlegas::test3::nearest_on_polygon(wd.corners, x).dist > r + 0.05;
-    if (ok) def.spheres.push_back({x, {u(-2, 2), u(-2, 2), u(-2, 2)}, r, u(0.5, 2.0), 0.0});
+    if (ok) def.spheres.push_back({x, {u(-2, 2), u(-2, 2), u(-2, 2)}, r, u(0.5, 2.0), electric ? u(-1.5, 1.5) : 0.0});
   }
   return def;
 }
@@ -146,9 +147,11 @@ World3Def random_scene(std::uint64_t seed, int n, bool gravity) {
 TEST_CASE("the engine agrees event for event with the brute-force reference (faces, edges, corners)") {
   int kinds[4] = {0, 0, 0, 0};
   for (std::uint64_t seed : {1u, 2u, 3u, 4u, 5u, 6u, 7u, 8u}) {
-    for (bool gravity : {false, true}) {
-      INFO("seed " << seed << (gravity ? " with gravity" : ""));
-      const World3Def def = random_scene(seed, 8, gravity);
+    for (int field = 0; field < 3; ++field) {
+      // Free flights; gravity (the same acceleration for all: pairs stay quadratic, walls'
+      // edges and corners quartic); an electric field on random charges (pairs quartic too).
+      INFO("seed " << seed << " field " << field);
+      const World3Def def = random_scene(seed, 8, field == 1, field == 2);
       World3 w(def);
       std::vector<Event3> fast, slow;
       w.advance_to(15.0, &fast);
