@@ -10,12 +10,14 @@
 #include <spdlog/spdlog.h>
 
 #include "cli_common.hpp"
+#include "run3d.hpp"
 #include "scene_scales.hpp"
 
 namespace turtlegas::apps {
 namespace {
 
 int check_one(const std::string& file, const turtle::Registry& registry) {
+  if (const auto w3 = load_world3_if_3d(file)) return check3d(file, *w3);
   const world::Scene scene = load(file, registry);
   const sim::WorldDef& def = scene.def;
   // One engine at a time: a scene near the memory budget must not need two of it at once (an

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "run_command.hpp"
+#include "run3d.hpp"
 
 #include <unistd.h>
 
@@ -244,6 +245,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     check_outputs(others, {{opt.resume, "--resume"}});
   }
   check_outputs(outputs, inputs);
+  if (const auto w3 = load_world3_if_3d(opt.world)) return run3d(opt, *w3);
   if (opt.checkpoint == "-") throw BadInput("--checkpoint needs a file name, not standard output");
   if (!opt.record.empty()) {
     if (opt.record == "-") throw BadInput("--record needs a file name, not standard output (replay seeks in it)");

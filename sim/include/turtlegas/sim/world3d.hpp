@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: MIT
+// The 3-D gas (docs/architecture.md, "The 3-D room"; docs/physics.md, "3-D"): spheres, convex
+// polygon walls with their faces, edges and corners, uniform gravity and electric fields, exact
+// and event-driven. The order of work of one event is written at the top of world3d.cpp.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "turtlegas/sim/vec3.hpp"
+
+namespace turtlegas::sim {
+
+/// The arena's boundary on every axis: open (a sphere that leaves is removed, `exit`), six
+/// walls on the faces of the box, or periodic.
+enum class Boundary3 : std::uint8_t { none, walls, periodic };
+
+struct Sphere3Def {
+  Vec3 pos;             ///< world units
+  Vec3 vel;             ///< world units per second
+  double radius = 1.0;  ///< world units, > 0
+  double mass = 1.0;    ///< > 0
+  double charge = 0.0;  ///< scales the electric field's acceleration by charge / mass
+};
+
+/// A convex planar polygon, corners in order (3 or more, not collinear).
+struct Wall3Def {
+  std::vector<Vec3> corners;
+};
+
+struct World3Def {
+  Vec3 size{100.0, 100.0, 100.0};  ///< the arena, from the origin to size (width, height, depth)
+  Boundary3 boundary = Boundary3::none;
+  Vec3 gravity;   ///< units / s^2, on every sphere
+  Vec3 electric;  ///< acceleration charge / mass * electric on each sphere
+  double cell = 0.0;  ///< the grid's smallest cell side; 0: the largest diameter (times 1 + 2^-20)
+  std::vector<Sphere3Def> spheres;
+  std::vector<Wall3Def> walls;  ///< with boundary walls, six more follow these (x0 x1 y0 y1 z0 z1)
+};
+
+enum class Event3Kind : std::uint8_t {
+  ball_ball,         ///< a, b sphere indices
+  ball_wall,         ///< a sphere, b wall index: the face
+  ball_wall_edge,    ///< a sphere, b wall index, c the edge (from corner c to corner c + 1)
+  ball_wall_corner,  ///< a sphere, b wall index, c the corner
+  exit,              ///< a left an open arena
+};
+
+struct Event3 {
+  double t = 0.0;
+  Event3Kind kind = Event3Kind::ball_ball;
+  std::uint32_t a = 0, b = 0, c = 0;
+};
+
+/// Checks a definition; returns an empty string when it can be simulated, else what is wrong
+/// and how to fix it.
+std::string check_world3(const World3Def& def);
+
+class World3 {
+ public:
+  /// Builds the world at time 0; throws std::invalid_argument with check_world3's message.
+  explicit World3(const World3Def& def);
+  ~World3();
+  World3(World3&&) noexcept;
+  World3& operator=(World3&&) noexcept;
+
+  /// Serves every event up to time t (seconds, >= time()); appends them to log if given.
+  void advance_to(double t, std::vector<Event3>* log = nullptr);
+  double time() const;
+
+  std::size_t sphere_count() const;  ///< including removed ones
+  bool alive(std::size_t i) const;
+  Vec3 position(std::size_t i) const;  ///< at time()
+  Vec3 velocity(std::size_t i) const;  ///< at time()
+  std::size_t wall_count() const;      ///< the def's walls, then the arena's six
+
+  double kinetic_energy() const;
+  /// Kinetic plus potential (-m a . x per sphere, a its uniform acceleration).
+  double energy() const;
+  Vec3 momentum() const;
+  std::uint64_t collisions() const;  ///< sphere-sphere and sphere-wall contacts
+  std::uint64_t events() const;      ///< every event served, cell crossings and stale ones included
+  /// The largest |distance - contact distance| / radius at the contacts served so far.
+  double max_contact_error() const;
+  /// The largest overlap now, over every pair and wall, relative to the smaller radius (O(N^2)
+  /// over pairs for up to 4096 spheres, through the grid above).
+  double max_overlap_now() const;
+  /// Sum over served sphere-sphere collisions of m1 m2 / (m1 + m2) * (Δv . d): the collision
+  /// virial's numerator, for the pressure of a periodic gas (docs/physics.md).
+  double virial_sum() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace turtlegas::sim

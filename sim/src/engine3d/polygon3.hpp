@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: MIT
+// A convex planar wall in 3-D: its plane, edges and corners, and the contact kinds it has
+// (docs/physics.md, "3-D"): the face (the memo's plane formula), an edge (a sphere against a
+// segment: the cylinder around its line, valid where the foot lies on the segment) and a corner
+// (the memo's wall-end formula, unchanged in 3-D).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "turtlegas/sim/toi3.hpp"
+#include "turtlegas/sim/vec3.hpp"
+
+namespace turtlegas::sim::detail {
+
+struct Polygon3 {
+  std::vector<Vec3> corners;
+  std::vector<Vec3> along;   ///< unit edge directions, corner k to k + 1
+  std::vector<double> length;
+  std::vector<Vec3> inward;  ///< in-plane unit normals of the edges, towards the inside
+  Vec3 normal;               ///< unit
+  Vec3 lo, hi;               ///< bounding box
+  double scale = 1.0;        ///< the largest edge, for tolerances
+
+  explicit Polygon3(const std::vector<Vec3>& c) : corners(c) {
+    const std::size_t n = c.size();
+    Vec3 area;  // Newell's normal: robust for any convex polygon
+    for (std::size_t k = 0; k < n; ++k) area += cross(c[k], c[(k + 1) % n]);
+    normal = (1.0 / norm(area)) * area;
+    lo = hi = c[0];
+    scale = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Vec3 e = c[(k + 1) % n] - c[k];
+      const double l = norm(e);
+      along.push_back((1.0 / l) * e);
+      length.push_back(l);
+      inward.push_back(cross(normal, along.back()));
+      scale = std::max(scale, l);
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], c[k][a]);
+        hi[a] = std::max(hi[a], c[k][a]);
+      }
+    }
+  }
+  /// Whether the projection of q on the plane lies inside (or on) the polygon, within tol.
+  bool covers(Vec3 q, double tol) const {
+    for (std::size_t k = 0; k < corners.size(); ++k)
+      if (dot(q - corners[k], inward[k]) < -tol) return false;
+    return true;
+  }
+};
+
+}  // namespace turtlegas::sim::detail

@@ -1,0 +1,542 @@
+// SPDX-License-Identifier: MIT
+// The 3-D gas's loop (docs/architecture.md, "The 3-D room"). The order of work of one event:
+//   1. pop the body i with the earliest pending event (key, then id: ties are deterministic);
+//   2. a sphere partner whose course-change count moved since the prediction: stale, predict i
+//      afresh from now;
+//   3. a collision: move both to the contact time, reflect the relative velocity about the line
+//      of centres (the memo's vector form), raise both counts, predict both afresh;
+//   4. a wall feature: reflect about the face normal, or from the edge's nearest point, or from
+//      the corner; raise the count; predict afresh;
+//   5. a cell crossing: the body enters the next cell (wrapped in a periodic arena, removed with
+//      `exit` from an open one) and is predicted afresh; its count does not move (same flight).
+// A prediction looks at the 27 cells around the body's cell (with their periodic shifts) and at
+// the walls listed in its own cell, up to the earliest candidate found so far.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "engine3d/polygon3.hpp"
+#include "event_queue.hpp"
+#include "turtlegas/sim/roots.hpp"
+#include "turtlegas/sim/toi3.hpp"
+#include "turtlegas/sim/world3d.hpp"
+
+namespace turtlegas::sim {
+namespace {
+
+using detail::EventQueue;
+using detail::Polygon3;
+
+enum class Pending : std::uint8_t { none, cell, pair, face, edge, corner };
+
+struct Record {
+  EventQueue::Node node;
+  Vec3 x, v, a;            // at local time t
+  double t = 0.0;
+  double r = 1.0, m = 1.0;
+  std::uint32_t count = 0;  // course changes
+  std::uint32_t cell = 0;
+  std::uint32_t next = EventQueue::kAbsent, prev = EventQueue::kAbsent;  // cell list
+  // The pending event.
+  Pending kind = Pending::none;
+  std::uint8_t axis = 0;
+  std::int8_t dir = 0;
+  bool alive = true;
+  std::uint32_t partner = 0;      // sphere or wall
+  std::uint32_t partner_count = 0;  // or the feature index
+  double cand_t = kNever;  // the pending contact's time (absolute)
+  double exit_t = kNever;  // the cell exit's time (absolute)
+};
+
+constexpr std::uint32_t kNone = EventQueue::kAbsent;
+
+}  // namespace
+
+std::string check_world3(const World3Def& def) {
+  for (int a = 0; a < 3; ++a)
+    if (!(def.size[a] > 0.0) || !std::isfinite(def.size[a])) return "the arena's width, height and depth must be finite and > 0";
+  if (!is_finite(def.gravity) || !is_finite(def.electric)) return "gravity and electric must be finite";
+  for (std::size_t i = 0; i < def.spheres.size(); ++i) {
+    const Sphere3Def& s = def.spheres[i];
+    const std::string at = "sphere " + std::to_string(i) + ": ";
+    if (!(s.radius > 0.0) || !std::isfinite(s.radius)) return at + "radius must be finite and > 0";
+    if (!(s.mass > 0.0) || !std::isfinite(s.mass)) return at + "mass must be finite and > 0";
+    if (!is_finite(s.pos) || !is_finite(s.vel) || !std::isfinite(s.charge)) return at + "pos, vel and charge must be finite";
+    for (int a = 0; a < 3; ++a)
+      if (s.pos[a] < 0.0 || s.pos[a] >= def.size[a]) return at + "pos must lie in the arena [0, size)";
+  }
+  for (std::size_t w = 0; w < def.walls.size(); ++w) {
+    const auto& c = def.walls[w].corners;
+    const std::string at = "wall " + std::to_string(w) + ": ";
+    if (c.size() < 3) return at + "needs 3 or more corners";
+    for (const Vec3& p : c) {
+      if (!is_finite(p)) return at + "corners must be finite";
+      for (int a = 0; a < 3; ++a)
+        if (p[a] < 0.0 || p[a] > def.size[a]) return at + "corners must lie in the arena";
+    }
+    Vec3 area;
+    for (std::size_t k = 0; k < c.size(); ++k) area += cross(c[k], c[(k + 1) % c.size()]);
+    const double an = norm(area);
+    double scale = 0.0;
+    for (std::size_t k = 0; k < c.size(); ++k) scale = std::max(scale, norm(c[(k + 1) % c.size()] - c[k]));
+    if (!(an > 1e-12 * scale * scale)) return at + "corners are collinear, or not in order around the polygon (no plane)";
+    const Vec3 n = (1.0 / an) * area;
+    for (std::size_t k = 0; k < c.size(); ++k) {
+      if (std::abs(dot(c[k] - c[0], n)) > 1e-9 * scale) return at + "corners are not in one plane";
+      const Vec3 e1 = c[(k + 1) % c.size()] - c[k], e2 = c[(k + 2) % c.size()] - c[(k + 1) % c.size()];
+      if (!(norm(e1) > 0.0)) return at + "two consecutive corners are the same point";
+      if (dot(cross(e1, e2), n) < -1e-12 * scale * scale) return at + "the polygon is not convex (list its corners in order around it)";
+    }
+  }
+  return {};
+}
+
+struct World3::Impl {
+  Boundary3 boundary;
+  Vec3 size;
+  int n[3] = {1, 1, 1};
+  Vec3 w;  // cell sides
+  std::vector<Record> rec;
+  std::vector<std::uint32_t> head;  // per cell
+  std::vector<std::vector<std::uint32_t>> cell_walls;
+  std::vector<Polygon3> walls;
+  EventQueue queue;
+  double now = 0.0;
+  std::uint64_t collisions = 0, events = 0;
+  double contact_error = 0.0;
+  double virial = 0.0;
+  std::vector<Event3>* log = nullptr;
+
+  std::uint32_t cell_index(int cx, int cy, int cz) const {
+    return static_cast<std::uint32_t>((cz * n[1] + cy) * n[0] + cx);
+  }
+  void coords(std::uint32_t c, int* k) const {
+    k[0] = static_cast<int>(c % n[0]);
+    k[1] = static_cast<int>((c / n[0]) % n[1]);
+    k[2] = static_cast<int>(c / (static_cast<std::uint32_t>(n[0]) * n[1]));
+  }
+  void link(std::uint32_t i, std::uint32_t c) {
+    Record& b = rec[i];
+    b.cell = c;
+    b.prev = kNone;
+    b.next = head[c];
+    if (head[c] != kNone) rec[head[c]].prev = i;
+    head[c] = i;
+  }
+  void unlink(std::uint32_t i) {
+    Record& b = rec[i];
+    if (b.prev != kNone) rec[b.prev].next = b.next; else head[b.cell] = b.next;
+    if (b.next != kNone) rec[b.next].prev = b.prev;
+  }
+  void bring(Record& b, double t) {
+    const double dt = t - b.t;
+    if (dt == 0.0) return;
+    b.x = fly(b.x, b.v, b.a, dt);
+    b.v += dt * b.a;
+    b.t = t;
+  }
+
+  explicit Impl(const World3Def& def) : boundary(def.boundary), size(def.size) {
+    double r_max = 0.0;
+    for (const auto& s : def.spheres) r_max = std::max(r_max, s.radius);
+    const double cell = def.cell > 0.0 ? def.cell : 2.0 * r_max * (1.0 + 0x1p-20);
+    for (int a = 0; a < 3; ++a) {
+      n[a] = std::max(1, static_cast<int>(std::min(1024.0, std::floor(size[a] / std::max(cell, 1e-300)))));
+      if (boundary == Boundary3::periodic && n[a] < 3)
+        throw std::invalid_argument("a periodic arena needs at least 3 cells of the largest diameter on every axis");
+      w[a] = size[a] / n[a];
+    }
+    for (const auto& wd : def.walls) walls.emplace_back(wd.corners);
+    if (boundary == Boundary3::walls) {
+      const double X = size.x, Y = size.y, Z = size.z;
+      walls.emplace_back(std::vector<Vec3>{{0, 0, 0}, {0, Y, 0}, {0, Y, Z}, {0, 0, Z}});
+      walls.emplace_back(std::vector<Vec3>{{X, 0, 0}, {X, 0, Z}, {X, Y, Z}, {X, Y, 0}});
+      walls.emplace_back(std::vector<Vec3>{{0, 0, 0}, {0, 0, Z}, {X, 0, Z}, {X, 0, 0}});
+      walls.emplace_back(std::vector<Vec3>{{0, Y, 0}, {X, Y, 0}, {X, Y, Z}, {0, Y, Z}});
+      walls.emplace_back(std::vector<Vec3>{{0, 0, 0}, {X, 0, 0}, {X, Y, 0}, {0, Y, 0}});
+      walls.emplace_back(std::vector<Vec3>{{0, 0, Z}, {0, Y, Z}, {X, Y, Z}, {X, 0, Z}});
+    }
+    const std::size_t cells = static_cast<std::size_t>(n[0]) * n[1] * n[2];
+    head.assign(cells, kNone);
+    cell_walls.assign(cells, {});
+    // A wall is listed in every cell within r_max of its bounding box: a sphere whose centre
+    // is in the cell can touch it only then.
+    for (std::uint32_t k = 0; k < walls.size(); ++k) {
+      int lo[3], hi[3];
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::clamp(static_cast<int>(std::floor((walls[k].lo[a] - r_max) / w[a])), 0, n[a] - 1);
+        hi[a] = std::clamp(static_cast<int>(std::floor((walls[k].hi[a] + r_max) / w[a])), 0, n[a] - 1);
+      }
+      for (int z = lo[2]; z <= hi[2]; ++z)
+        for (int y = lo[1]; y <= hi[1]; ++y)
+          for (int x = lo[0]; x <= hi[0]; ++x) cell_walls[cell_index(x, y, z)].push_back(k);
+    }
+    rec.resize(def.spheres.size());
+    for (std::uint32_t i = 0; i < rec.size(); ++i) {
+      const Sphere3Def& s = def.spheres[i];
+      Record& b = rec[i];
+      b.x = s.pos;
+      b.v = s.vel;
+      b.a = def.gravity + (s.charge / s.mass) * def.electric;
+      b.r = s.radius;
+      b.m = s.mass;
+      int k[3];
+      for (int a = 0; a < 3; ++a) k[a] = std::clamp(static_cast<int>(std::floor(s.pos[a] / w[a])), 0, n[a] - 1);
+      link(i, cell_index(k[0], k[1], k[2]));
+    }
+    queue.reset(&rec[0].node, sizeof(Record), rec.size());
+    for (std::uint32_t i = 0; i < rec.size(); ++i) predict(i);
+  }
+
+  // The earliest cell exit of body b (at now) over the three axes.
+  double cell_exit(const Record& b, std::uint8_t& axis, std::int8_t& dir) const {
+    int k[3];
+    coords(b.cell, k);
+    double best = kNever;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = k[a] * w[a], hi = (k[a] + 1 == n[a]) ? size[a] : lo + w[a];
+      if (b.a[a] == 0.0) {
+        // A straight flight leaves by the face it moves towards (a position past it by
+        // round-off leaves at once, as first_approach_quadratic would have it).
+        const double va = b.v[a];
+        if (va == 0.0) continue;
+        const double t = va > 0.0 ? std::max(0.0, (hi - b.x[a]) / va) : std::max(0.0, (lo - b.x[a]) / va);
+        if (t < best) { best = t; axis = static_cast<std::uint8_t>(a); dir = va > 0.0 ? 1 : -1; }
+        continue;
+      }
+      // The same cancellation-free forms as the 2-D clock's crossings (toi.cpp).
+      const double t_hi = first_approach_quadratic(hi - b.x[a], -b.v[a], -0.5 * b.a[a]);
+      const double t_lo = first_approach_quadratic(b.x[a] - lo, b.v[a], 0.5 * b.a[a]);
+      if (t_hi < best) { best = t_hi; axis = static_cast<std::uint8_t>(a); dir = 1; }
+      if (t_lo < best) { best = t_lo; axis = static_cast<std::uint8_t>(a); dir = -1; }
+    }
+    return best;
+  }
+
+  // Features of wall k against body b (at now), up to best; updates b's pending event.
+  // Walls are searched up to the cell exit too: after it, the next cell's list has them.
+  void predict_wall(Record& b, std::uint32_t k, double& cand, double exit) {
+    double best = std::min(cand, exit);
+    const double before = best;
+    const Polygon3& p = walls[k];
+    const double tol = 1e-12 * p.scale;
+    const Vec3 d = b.x - p.corners[0];
+    double c[5], times[4];
+    // The face: the memo's plane formula, both sides (s = r falling, s = -r rising).
+    {
+      const double s0 = dot(d, p.normal), s1 = dot(b.v, p.normal), s2 = 0.5 * dot(b.a, p.normal);
+      for (int side = -1; side <= 1; side += 2) {
+        c[0] = side * s0 - b.r; c[1] = side * s1; c[2] = side * s2;
+        const int m = approach_times(c, 2, best, 1e-9 * b.r, times);
+        for (int q = 0; q < m; ++q) {
+          if (!(times[q] < best)) break;
+          if (p.covers(fly(b.x, b.v, b.a, times[q]), tol)) {
+            best = times[q];
+            b.kind = Pending::face; b.partner = k; b.partner_count = 0;
+            break;
+          }
+        }
+      }
+    }
+    const std::size_t nc = p.corners.size();
+    for (std::size_t e = 0; e < nc; ++e) {
+      // The edge: the cylinder of radius r around its line, where the foot is on the segment.
+      const Vec3 u = p.along[e];
+      const Vec3 de = b.x - p.corners[e];
+      const Vec3 dp = de - dot(de, u) * u, vp = b.v - dot(b.v, u) * u, ap = b.a - dot(b.a, u) * u;
+      squared_gap(dp, vp, ap, b.r, c);
+      const int m = approach_times(c, 4, best, 1e-9 * b.r * b.r, times);
+      for (int q = 0; q < m; ++q) {
+        if (!(times[q] < best)) break;
+        const double s = dot(fly(de, b.v, b.a, times[q]), u);
+        if (s >= -tol && s <= p.length[e] + tol) {
+          best = times[q];
+          b.kind = Pending::edge; b.partner = k; b.partner_count = static_cast<std::uint32_t>(e);
+          break;
+        }
+      }
+      // The corner: the memo's wall-end formula.
+      squared_gap(de, b.v, b.a, b.r, c);
+      const int mc = approach_times(c, 4, best, 1e-9 * b.r * b.r, times);
+      if (mc > 0 && times[0] < best) {
+        best = times[0];
+        b.kind = Pending::corner; b.partner = k; b.partner_count = static_cast<std::uint32_t>(e);
+      }
+    }
+    if (best < before) cand = best;
+  }
+
+  // The spheres of one cell against b (at now): the earliest approach below cand.
+  void scan_cell(std::uint32_t i, Record& b, int cx, int cy, int cz, double& cand) {
+    Vec3 shift;
+    int k[3] = {cx, cy, cz};
+    for (int a = 0; a < 3; ++a) {
+      if (k[a] >= 0 && k[a] < n[a]) continue;
+      if (boundary != Boundary3::periodic) return;
+      shift[a] = k[a] < 0 ? -size[a] : size[a];
+      k[a] = (k[a] + n[a]) % n[a];
+    }
+    for (std::uint32_t j = head[cell_index(k[0], k[1], k[2])]; j != kNone; j = rec[j].next) {
+      if (j == i) continue;
+      const Record& o = rec[j];
+      const double dt = now - o.t;
+      const Vec3 xo = fly(o.x, o.v, o.a, dt) + shift, vo = o.v + dt * o.a;
+      const double t = toi_sphere_sphere(xo - b.x, vo - b.v, o.a - b.a, b.r + o.r, cand);
+      if (t < cand) {
+        cand = t;
+        b.kind = Pending::pair; b.partner = j; b.partner_count = o.count;
+      }
+    }
+  }
+
+  void schedule(std::uint32_t i, Record& b, double cand, double exit) {
+    b.cand_t = b.kind == Pending::none ? kNever : now + cand;
+    b.exit_t = now + exit;
+    queue.set(i, std::min(b.cand_t, b.exit_t));
+  }
+
+  // A full prediction: the 27 cells around, the walls of the cell, the cell exit. Pairs are
+  // searched without a horizon (a pair's time holds whatever cells the two are in), so that a
+  // crossing needs to look only at the strip of cells that comes into view.
+  void predict(std::uint32_t i) {
+    Record& b = rec[i];
+    bring(b, now);
+    const double exit = cell_exit(b, b.axis, b.dir);
+    double cand = kNever;
+    b.kind = Pending::none;
+    int k[3];
+    coords(b.cell, k);
+    for (int oz = -1; oz <= 1; ++oz)
+      for (int oy = -1; oy <= 1; ++oy)
+        for (int ox = -1; ox <= 1; ++ox) scan_cell(i, b, k[0] + ox, k[1] + oy, k[2] + oz, cand);
+    for (std::uint32_t wk : cell_walls[b.cell]) predict_wall(b, wk, cand, exit);
+    schedule(i, b, cand, exit);
+  }
+
+  // After a crossing along `axis` by `dir`: the kept contact candidate (still a true time of
+  // its pair if the partner's count has not moved; a stale one is found when popped), the nine
+  // cells of the new strip, the new cell's walls, the new exit.
+  void predict_strip(std::uint32_t i, int axis, int dir) {
+    Record& b = rec[i];
+    const double exit = cell_exit(b, b.axis, b.dir);
+    double cand = b.kind == Pending::none ? kNever : b.cand_t - now;
+    int k[3];
+    coords(b.cell, k);
+    k[axis] += dir;
+    const int u = (axis + 1) % 3, w2 = (axis + 2) % 3;
+    for (int ou = -1; ou <= 1; ++ou)
+      for (int ow = -1; ow <= 1; ++ow) {
+        int c[3];
+        c[axis] = k[axis];
+        c[u] = k[u] + ou;
+        c[w2] = k[w2] + ow;
+        scan_cell(i, b, c[0], c[1], c[2], cand);
+      }
+    for (std::uint32_t wk : cell_walls[b.cell]) predict_wall(b, wk, cand, exit);
+    schedule(i, b, cand, exit);
+  }
+
+  // The other body's position seen from a, by the minimum image (at contact the pair is closer
+  // than half the arena on every axis: cells are at least a diameter and there are 3 or more).
+  Vec3 separation(const Record& a, const Record& o) const {
+    Vec3 d = o.x - a.x;
+    if (boundary == Boundary3::periodic)
+      for (int k = 0; k < 3; ++k) d[k] -= size[k] * std::nearbyint(d[k] / size[k]);
+    return d;
+  }
+
+  void note(Event3Kind kind, std::uint32_t a, std::uint32_t b2, std::uint32_t c) {
+    if (log) log->push_back({now, kind, a, b2, c});
+  }
+
+  void reflect(Record& b, Vec3 normal) {
+    const Vec3 nn = (1.0 / norm(normal)) * normal;
+    b.v -= (2.0 * dot(b.v, nn)) * nn;
+    ++b.count;
+    ++collisions;
+  }
+
+  void serve(std::uint32_t i) {
+    Record& b = rec[i];
+    ++events;
+    if (b.exit_t < b.cand_t) {
+      cross(i);
+      return;
+    }
+    switch (b.kind) {
+      case Pending::none: queue.set(i, kNever); return;
+      case Pending::pair: {
+        Record& o = rec[b.partner];
+        if (!o.alive || o.count != b.partner_count) {
+          predict(i);
+          return;
+        }
+        bring(b, now);
+        bring(o, now);
+        const Vec3 d = separation(b, o);
+        const double dist = norm(d), sigma = b.r + o.r;
+        contact_error = std::max(contact_error, std::abs(dist - sigma) / std::min(b.r, o.r));
+        // The memo's vector form: the relative velocity's part along the line of centres is
+        // reversed, shared by the masses.
+        const Vec3 nn = (1.0 / dist) * d;
+        const double vn = dot(o.v - b.v, nn);
+        const double mu = b.m * o.m / (b.m + o.m);
+        const double jn = 2.0 * mu * vn;  // impulse on b along nn
+        b.v += (jn / b.m) * nn;
+        o.v -= (jn / o.m) * nn;
+        virial += -jn * dist;  // m1 m2 / M (Δv12 . r12) with r12 = -d, Δv12 = jn / m nn
+        ++b.count;
+        ++o.count;
+        ++collisions;
+        note(Event3Kind::ball_ball, i, b.partner, 0);
+        const std::uint32_t j = b.partner;
+        predict(i);
+        predict(j);
+        return;
+      }
+      case Pending::face: case Pending::edge: case Pending::corner: {
+        bring(b, now);
+        const Polygon3& p = walls[b.partner];
+        Vec3 normal;
+        Event3Kind kind;
+        const Vec3 d = b.x - p.corners[b.partner_count];
+        if (b.kind == Pending::face) {
+          normal = p.normal;
+          kind = Event3Kind::ball_wall;
+          contact_error = std::max(contact_error, std::abs(std::abs(dot(b.x - p.corners[0], normal)) - b.r) / b.r);
+        } else if (b.kind == Pending::edge) {
+          const Vec3 u = p.along[b.partner_count];
+          normal = d - dot(d, u) * u;
+          kind = Event3Kind::ball_wall_edge;
+          contact_error = std::max(contact_error, std::abs(norm(normal) - b.r) / b.r);
+        } else {
+          normal = d;
+          kind = Event3Kind::ball_wall_corner;
+          contact_error = std::max(contact_error, std::abs(norm(normal) - b.r) / b.r);
+        }
+        reflect(b, normal);
+        note(kind, i, b.partner, b.partner_count);
+        predict(i);
+        return;
+      }
+      case Pending::cell: break;
+    }
+  }
+
+  void cross(std::uint32_t i) {
+    Record& b = rec[i];
+    bring(b, now);
+    int k[3];
+    coords(b.cell, k);
+    const int a = b.axis, dir = b.dir;
+    k[a] += dir;
+    if (k[a] < 0 || k[a] >= n[a]) {
+      if (boundary != Boundary3::periodic) {
+        unlink(i);
+        b.alive = false;
+        ++b.count;
+        queue.remove(i);
+        note(Event3Kind::exit, i, 0, 0);
+        return;
+      }
+      k[a] = (k[a] + n[a]) % n[a];
+      b.x[a] -= dir * size[a];
+    }
+    unlink(i);
+    link(i, cell_index(k[0], k[1], k[2]));
+    predict_strip(i, a, dir);
+  }
+
+  void advance_to(double t) {
+    while (!queue.empty() && queue.top_key() <= t) {
+      const std::uint32_t i = queue.top_id();
+      now = queue.top_key();
+      serve(i);
+    }
+    now = t;
+  }
+};
+
+World3::World3(const World3Def& def) {
+  const std::string problem = check_world3(def);
+  if (!problem.empty()) throw std::invalid_argument(problem);
+  impl_ = std::make_unique<Impl>(def);
+}
+World3::~World3() = default;
+World3::World3(World3&&) noexcept = default;
+World3& World3::operator=(World3&&) noexcept = default;
+
+void World3::advance_to(double t, std::vector<Event3>* log) {
+  impl_->log = log;
+  impl_->advance_to(std::max(t, impl_->now));
+  impl_->log = nullptr;
+}
+double World3::time() const { return impl_->now; }
+std::size_t World3::sphere_count() const { return impl_->rec.size(); }
+bool World3::alive(std::size_t i) const { return impl_->rec[i].alive; }
+Vec3 World3::position(std::size_t i) const {
+  const Record& b = impl_->rec[i];
+  return fly(b.x, b.v, b.a, impl_->now - b.t);
+}
+Vec3 World3::velocity(std::size_t i) const {
+  const Record& b = impl_->rec[i];
+  return b.v + (impl_->now - b.t) * b.a;
+}
+std::size_t World3::wall_count() const { return impl_->walls.size(); }
+double World3::kinetic_energy() const {
+  double e = 0.0;
+  for (std::size_t i = 0; i < impl_->rec.size(); ++i)
+    if (impl_->rec[i].alive) e += 0.5 * impl_->rec[i].m * norm2(velocity(i));
+  return e;
+}
+double World3::energy() const {
+  double e = kinetic_energy();
+  for (std::size_t i = 0; i < impl_->rec.size(); ++i)
+    if (impl_->rec[i].alive) e -= impl_->rec[i].m * dot(impl_->rec[i].a, position(i));
+  return e;
+}
+Vec3 World3::momentum() const {
+  Vec3 p;
+  for (std::size_t i = 0; i < impl_->rec.size(); ++i)
+    if (impl_->rec[i].alive) p += impl_->rec[i].m * velocity(i);
+  return p;
+}
+std::uint64_t World3::collisions() const { return impl_->collisions; }
+std::uint64_t World3::events() const { return impl_->events; }
+double World3::max_contact_error() const { return impl_->contact_error; }
+double World3::virial_sum() const { return impl_->virial; }
+
+double World3::max_overlap_now() const {
+  const Impl& m = *impl_;
+  double worst = 0.0;
+  const std::size_t n = m.rec.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!m.rec[i].alive) continue;
+    const Vec3 xi = position(i);
+    for (std::size_t j = i + 1; j < n && n <= 4096; ++j) {
+      if (!m.rec[j].alive) continue;
+      Vec3 d = position(j) - xi;
+      if (m.boundary == Boundary3::periodic)
+        for (int k = 0; k < 3; ++k) d[k] -= m.size[k] * std::nearbyint(d[k] / m.size[k]);
+      const double gap = m.rec[i].r + m.rec[j].r - norm(d);
+      worst = std::max(worst, gap / std::min(m.rec[i].r, m.rec[j].r));
+    }
+    for (const Polygon3& p : m.walls) {
+      // The distance to the polygon: the plane where the foot is inside, else the edges.
+      const Vec3 d = xi - p.corners[0];
+      double dist = kNever;
+      if (p.covers(xi, 0.0)) dist = std::abs(dot(d, p.normal));
+      for (std::size_t e = 0; e < p.corners.size(); ++e) {
+        const Vec3 de = xi - p.corners[e];
+        const double s = std::clamp(dot(de, p.along[e]), 0.0, p.length[e]);
+        dist = std::min(dist, norm(de - s * p.along[e]));
+      }
+      worst = std::max(worst, (m.rec[i].r - dist) / m.rec[i].r);
+    }
+  }
+  return worst;
+}
+
+}  // namespace turtlegas::sim

@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: MIT
+// A tiny, independent 3-D reference for tests only: no roots at all. Every body flies exactly
+// (x + v t + a t^2 / 2); time advances by conservative advancement, each step no longer than the
+// time any gap could close at its bounded rate (the distance to a sphere or to a convex polygon
+// is 1-Lipschitz in position), so no contact can be stepped over; a contact is served when a gap
+// is below 1e-12 of a radius and closing. The distance to a polygon is computed from scratch
+// (inside test on the plane, else the nearest point of each edge), and the contact's kind from
+// where the nearest point lies. O(N^2 + N W) per step: small scenes only.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "turtlegas/sim/vec3.hpp"
+#include "turtlegas/sim/world3d.hpp"
+
+namespace turtlegas::test3 {
+
+using sim::Vec3;
+
+struct Nearest {
+  double dist;
+  Vec3 point;
+  sim::Event3Kind kind;
+  std::uint32_t feature;
+};
+
+inline Nearest nearest_on_polygon(const std::vector<Vec3>& c, Vec3 q) {
+  const std::size_t n = c.size();
+  const Vec3 nrm = sim::cross(c[1] - c[0], c[2] - c[0]);
+  const Vec3 un = (1.0 / sim::norm(nrm)) * nrm;
+  bool inside = true;
+  for (std::size_t k = 0; k < n; ++k)
+    if (sim::dot(sim::cross(c[(k + 1) % n] - c[k], q - c[k]), un) < 0.0) inside = false;
+  if (inside) {
+    const double s = sim::dot(q - c[0], un);
+    return {std::abs(s), q - s * un, sim::Event3Kind::ball_wall, 0};
+  }
+  Nearest best{1e300, {}, sim::Event3Kind::ball_wall_edge, 0};
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3 e = c[(k + 1) % n] - c[k];
+    const double s = std::clamp(sim::dot(q - c[k], e) / sim::norm2(e), 0.0, 1.0);
+    const Vec3 p = c[k] + s * e;
+    const double d = sim::norm(q - p);
+    if (d < best.dist) {
+      const bool end0 = s == 0.0, end1 = s == 1.0;
+      best = {d, p, end0 || end1 ? sim::Event3Kind::ball_wall_corner : sim::Event3Kind::ball_wall_edge,
+              static_cast<std::uint32_t>(end1 ? (k + 1) % n : k)};
+    }
+  }
+  return best;
+}
+
+struct Reference3 {
+  struct Ball { Vec3 x, v, a; double r, m; };
+  std::vector<Ball> balls;
+  std::vector<std::vector<Vec3>> walls;
+  double t = 0.0;
+
+  explicit Reference3(const sim::World3Def& def) {
+    for (const auto& s : def.spheres)
+      balls.push_back({s.pos, s.vel, def.gravity + (s.charge / s.mass) * def.electric, s.radius, s.mass});
+    for (const auto& w : def.walls) walls.push_back(w.corners);
+  }
+
+  // The time a gap g can certainly not close in, at relative speed w and acceleration b.
+  static double safe(double g, double w, double b) {
+    return 2.0 * g / (w + std::sqrt(w * w + 2.0 * b * g));
+  }
+
+  void fly_all(double dt) {
+    for (Ball& b : balls) {
+      b.x = b.x + dt * b.v + (0.5 * dt * dt) * b.a;
+      b.v = b.v + dt * b.a;
+    }
+  }
+
+  /// Runs to t_end, appending events (ball_ball a < b; walls as the engine names them).
+  void run(double t_end, std::vector<sim::Event3>& out, std::size_t max_events) {
+    for (long steps = 0; steps < 50'000'000 && t < t_end && out.size() < max_events; ++steps) {
+      double step = t_end - t;
+      bool served = false;
+      for (std::size_t i = 0; i < balls.size() && !served; ++i) {
+        for (std::size_t j = i + 1; j < balls.size() && !served; ++j) {
+          const Vec3 d = balls[j].x - balls[i].x, w = balls[j].v - balls[i].v;
+          const double g = sim::norm(d) - balls[i].r - balls[j].r;
+          const double closing = -sim::dot(d, w) / sim::norm(d);
+          const double b = sim::norm(balls[j].a - balls[i].a);
+          if (g < 1e-12 * balls[i].r && closing > 0.0) {
+            const Vec3 nn = (1.0 / sim::norm(d)) * d;
+            const double mu = balls[i].m * balls[j].m / (balls[i].m + balls[j].m);
+            const double jn = 2.0 * mu * sim::dot(w, nn);
+            balls[i].v = balls[i].v + (jn / balls[i].m) * nn;
+            balls[j].v = balls[j].v - (jn / balls[j].m) * nn;
+            out.push_back({t, sim::Event3Kind::ball_ball, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), 0});
+            served = true;
+          } else if (closing > 0.0 || b > 0.0) {
+            step = std::min(step, g < 1e-9 * balls[i].r && closing <= 0.0 ? -closing / b : safe(g, sim::norm(w), b));
+          }
+        }
+        for (std::size_t k = 0; k < walls.size() && !served; ++k) {
+          const Nearest nw = nearest_on_polygon(walls[k], balls[i].x);
+          const Vec3 d = balls[i].x - nw.point;
+          const double g = nw.dist - balls[i].r;
+          const double closing = -sim::dot(d, balls[i].v) / nw.dist;
+          const double b = sim::norm(balls[i].a);
+          if (g < 1e-12 * balls[i].r && closing > 0.0) {
+            const Vec3 nn = (1.0 / nw.dist) * d;
+            balls[i].v = balls[i].v - (2.0 * sim::dot(balls[i].v, nn)) * nn;
+            out.push_back({t, nw.kind, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k), nw.feature});
+            served = true;
+          } else if (closing > 0.0 || b > 0.0) {
+            step = std::min(step, g < 1e-9 * balls[i].r && closing <= 0.0 ? -closing / b : safe(g, sim::norm(balls[i].v), b));
+          }
+        }
+      }
+      if (served) continue;
+      step = std::max(step, 1e-300);
+      fly_all(std::min(step, t_end - t));
+      t = std::min(t + step, t_end);
+    }
+  }
+};
+
+}  // namespace turtlegas::test3
