@@ -74,7 +74,7 @@ nlohmann::json observed_summary(World& w, const sim::WorldDef& def, double from,
   const double until = from + windows * window;
   formats::Observer obs(w, def, o, until);
   obs.advance_to(until);
-  REQUIRE(obs.windows() == windows);
+  REQUIRE(obs.windows() == static_cast<std::size_t>(windows));
   return obs.result().at("summary");
 }
 double error_of(const nlohmann::json& j) { return j.at("error").get<double>(); }

@@ -38,7 +38,7 @@ struct RemoteCommand {
   Kind kind = Kind::yield;
   double amount = 0.0;          ///< forward/back: world units; left/right: degrees; wait: seconds
   PenMode pen = PenMode::line;  ///< pen_down's mode
-  std::string sensor;           ///< sense: the range sensor to read (Turtle::scan); takes no time
+  std::string sensor{};         ///< sense: the range sensor to read (Turtle::scan); takes no time
   /// The sender's number for the command, echoed in its result; not part of the run (an input
   /// log does not record it).
   std::uint64_t tag = 0;
