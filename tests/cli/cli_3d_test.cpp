@@ -53,6 +53,11 @@ TEST_CASE("check and run of worlds/gas3d_box.json") {
   CHECK(st["collisions"].get<double>() > 100);
   CHECK(std::abs(st["energy_end"].get<double>() - st["energy_start"].get<double>()) < 1e-11 * st["energy_start"].get<double>());
   CHECK(st["max_overlap"].get<double>() < 1e-9);
+  // The start overlaps nothing either: the gas is placed clear of the walls (before: a sphere
+  // started 0.86 of a radius into the shelf, and the loader let it).
+  r = run(dir, {"run", "worlds/gas3d_box.json", "--until", "0", "--stats-json", (dir.path / "st0.json").string()});
+  REQUIRE(r.code == 0);
+  CHECK(nlohmann::json::parse(read(dir.path / "st0.json"))["max_overlap"].get<double>() < 1e-9);
 }
 
 TEST_CASE("3-D world file errors name the JSON path and the fix, exit 2") {
@@ -68,6 +73,12 @@ TEST_CASE("3-D world file errors name the JSON path and the fix, exit 2") {
        "not convex"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "turtles": []})", "turtles stay in the plane"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "effects": {"magnetic": 1}})", "/effects/magnetic"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "balls": [{"id": "a", "pos": [5, 5, 5], "radius": 1}, {"id": "b", "pos": [6.5, 5, 5], "radius": 1}]})",
+       "sphere 0 and sphere 1 overlap"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]]}], "balls": [{"id": "a", "pos": [5, 5, 5.5], "radius": 1}]})",
+       "sphere 0 overlaps wall 0"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10, "boundary": "walls"}, "balls": [{"id": "a", "pos": [0.5, 5, 5], "radius": 1}]})",
+       "overlaps the arena's walls"},
   };
   for (const Case& c : cases) {
     const auto world = dir.write("bad.json", c.text);

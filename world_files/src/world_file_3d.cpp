@@ -152,6 +152,8 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
           bool ok = true;
           for (std::size_t j = 0; j < def.spheres.size() && ok; ++j)
             ok = sim::norm(def.spheres[j].pos - x) > def.spheres[j].radius + r;
+          for (std::size_t w = 0; w < def.walls.size() && ok; ++w)  // nor into a wall
+            ok = sim::distance_to_polygon(x, def.walls[w].corners) > r;
           if (!ok) continue;
           const double cz = u(-1, 1), phi = u(0, 6.283185307179586), sz = std::sqrt(1 - cz * cz);
           def.spheres.push_back({x, {speed * sz * std::cos(phi), speed * sz * std::sin(phi), speed * cz}, r, mass, 0.0});

@@ -12,10 +12,12 @@
 // A prediction looks at the 27 cells around the body's cell (with their periodic shifts) and at
 // the walls listed in its own cell, up to the earliest candidate found so far.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 
 #include "engine3d/polygon3.hpp"
 #include "event_queue.hpp"
@@ -54,6 +56,79 @@ constexpr std::uint32_t kNone = EventQueue::kAbsent;
 
 }  // namespace
 
+double distance_to_polygon(const Vec3& x, const std::vector<Vec3>& corners) {
+  const std::size_t n = corners.size();
+  Vec3 area;
+  for (std::size_t k = 0; k < n; ++k) area += cross(corners[k], corners[(k + 1) % n]);
+  const Vec3 normal = (1.0 / norm(area)) * area;
+  const double height = dot(x - corners[0], normal);
+  const Vec3 foot = x - height * normal;
+  bool inside = true;
+  double edge = kNever;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3 a = corners[k], e = corners[(k + 1) % n] - a;
+    if (dot(cross(e, foot - a), normal) < 0.0) inside = false;
+    const double s = std::clamp(dot(x - a, e) / dot(e, e), 0.0, 1.0);
+    edge = std::min(edge, norm(x - (a + s * e)));
+  }
+  return inside ? std::abs(height) : edge;
+}
+
+namespace {
+
+/// The first pair of spheres that overlap (beyond round-off), in words; empty when none do. A hash
+/// grid of cells one largest diameter wide: O(N) for a gas, not O(N^2).
+std::string first_sphere_overlap(const World3Def& def) {
+  double rmax = 0.0;
+  for (const Sphere3Def& s : def.spheres) rmax = std::max(rmax, s.radius);
+  if (def.spheres.size() < 2) return {};
+  const double side = 2.0 * rmax;
+  std::array<std::int64_t, 3> cells{};
+  for (int a = 0; a < 3; ++a) cells[a] = std::max<std::int64_t>(1, static_cast<std::int64_t>(def.size[a] / side));
+  const bool periodic = def.boundary == Boundary3::periodic;
+  auto cell_of = [&](const Vec3& p) {
+    std::array<std::int64_t, 3> c{};
+    for (int a = 0; a < 3; ++a)
+      c[a] = std::clamp<std::int64_t>(static_cast<std::int64_t>(p[a] / def.size[a] * static_cast<double>(cells[a])), 0,
+                                      cells[a] - 1);
+    return c;
+  };
+  auto key = [&](std::array<std::int64_t, 3> c) { return (c[0] * cells[1] + c[1]) * cells[2] + c[2]; };
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> grid;
+  for (std::size_t i = 0; i < def.spheres.size(); ++i) grid[key(cell_of(def.spheres[i].pos))].push_back(i);
+  for (std::size_t i = 0; i < def.spheres.size(); ++i) {
+    const std::array<std::int64_t, 3> c = cell_of(def.spheres[i].pos);
+    for (std::int64_t dx = -1; dx <= 1; ++dx)
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        for (std::int64_t dz = -1; dz <= 1; ++dz) {
+          std::array<std::int64_t, 3> o{c[0] + dx, c[1] + dy, c[2] + dz};
+          bool outside = false;
+          for (int a = 0; a < 3; ++a) {
+            if (o[a] >= 0 && o[a] < cells[a]) continue;
+            if (periodic) o[a] = (o[a] + cells[a]) % cells[a];
+            else outside = true;
+          }
+          if (outside) continue;
+          const auto it = grid.find(key(o));
+          if (it == grid.end()) continue;
+          for (std::size_t j : it->second) {
+            if (j <= i) continue;
+            Vec3 d = def.spheres[j].pos - def.spheres[i].pos;
+            if (periodic)
+              for (int a = 0; a < 3; ++a) d[a] -= def.size[a] * std::nearbyint(d[a] / def.size[a]);
+            const double reach = def.spheres[i].radius + def.spheres[j].radius;
+            if (norm(d) < reach * (1.0 - 1e-12))
+              return "sphere " + std::to_string(i) + " and sphere " + std::to_string(j) + " overlap (centres " +
+                     std::to_string(norm(d)) + " apart, radii sum " + std::to_string(reach) +
+                     "): move one, or make them smaller";
+          }
+        }
+  }
+  return {};
+}
+
+}  // namespace
+
 std::string check_world3(const World3Def& def) {
   for (int a = 0; a < 3; ++a)
     if (!(def.size[a] > 0.0) || !std::isfinite(def.size[a])) return "the arena's width, height and depth must be finite and > 0";
@@ -66,6 +141,10 @@ std::string check_world3(const World3Def& def) {
     if (!is_finite(s.pos) || !is_finite(s.vel) || !std::isfinite(s.charge)) return at + "pos, vel and charge must be finite";
     for (int a = 0; a < 3; ++a)
       if (s.pos[a] < 0.0 || s.pos[a] >= def.size[a]) return at + "pos must lie in the arena [0, size)";
+    if (def.boundary == Boundary3::walls)
+      for (int a = 0; a < 3; ++a)
+        if (s.pos[a] < s.radius * (1.0 - 1e-12) || s.pos[a] > def.size[a] - s.radius * (1.0 - 1e-12))
+          return at + "overlaps the arena's walls (its centre must be at least its radius inside each face)";
   }
   for (std::size_t w = 0; w < def.walls.size(); ++w) {
     const auto& c = def.walls[w].corners;
@@ -90,7 +169,15 @@ std::string check_world3(const World3Def& def) {
       if (dot(cross(e1, e2), n) < -1e-12 * scale * scale) return at + "the polygon is not convex (list its corners in order around it)";
     }
   }
-  return {};
+  for (std::size_t w = 0; w < def.walls.size(); ++w)
+    for (std::size_t i = 0; i < def.spheres.size(); ++i) {
+      const Sphere3Def& s = def.spheres[i];
+      const double d = distance_to_polygon(s.pos, def.walls[w].corners);
+      if (d < s.radius * (1.0 - 1e-12))
+        return "sphere " + std::to_string(i) + " overlaps wall " + std::to_string(w) + " (its centre is " +
+               std::to_string(d) + " from it, radius " + std::to_string(s.radius) + "): move one of them";
+    }
+  return first_sphere_overlap(def);
 }
 
 struct World3::Impl {

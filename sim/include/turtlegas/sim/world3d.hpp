@@ -55,8 +55,13 @@ struct Event3 {
 };
 
 /// Checks a definition; returns an empty string when it can be simulated, else what is wrong
-/// and how to fix it.
+/// and how to fix it. Spheres may touch but not overlap one another, a wall, or (with boundary
+/// walls) the arena's faces: an event-driven engine never sees a contact that has already begun.
 std::string check_world3(const World3Def& def);
+
+/// The distance from x to the convex polygon `corners` (in order around it): to its plane where
+/// the foot of x falls inside it, else to its nearest edge.
+double distance_to_polygon(const Vec3& x, const std::vector<Vec3>& corners);
 
 class World3 {
  public:
