@@ -49,6 +49,17 @@ struct Polygon3 {
       if (dot(q - corners[k], inward[k]) < -tol) return false;
     return true;
   }
+  /// The distance from q to the polygon: to its plane where q's foot falls inside, else to the
+  /// nearest edge.
+  double distance(Vec3 q) const {
+    double dist = covers(q, 0.0) ? std::abs(dot(q - corners[0], normal)) : kNever;
+    for (std::size_t e = 0; e < corners.size(); ++e) {
+      const Vec3 de = q - corners[e];
+      const double s = std::clamp(dot(de, along[e]), 0.0, length[e]);
+      dist = std::min(dist, norm(de - s * along[e]));
+    }
+    return dist;
+  }
 };
 
 }  // namespace turtlegas::sim::detail

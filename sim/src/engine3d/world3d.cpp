@@ -57,21 +57,7 @@ constexpr std::uint32_t kNone = EventQueue::kAbsent;
 }  // namespace
 
 double distance_to_polygon(const Vec3& x, const std::vector<Vec3>& corners) {
-  const std::size_t n = corners.size();
-  Vec3 area;
-  for (std::size_t k = 0; k < n; ++k) area += cross(corners[k], corners[(k + 1) % n]);
-  const Vec3 normal = (1.0 / norm(area)) * area;
-  const double height = dot(x - corners[0], normal);
-  const Vec3 foot = x - height * normal;
-  bool inside = true;
-  double edge = kNever;
-  for (std::size_t k = 0; k < n; ++k) {
-    const Vec3 a = corners[k], e = corners[(k + 1) % n] - a;
-    if (dot(cross(e, foot - a), normal) < 0.0) inside = false;
-    const double s = std::clamp(dot(x - a, e) / dot(e, e), 0.0, 1.0);
-    edge = std::min(edge, norm(x - (a + s * e)));
-  }
-  return inside ? std::abs(height) : edge;
+  return Polygon3(corners).distance(x);
 }
 
 namespace {
@@ -610,18 +596,7 @@ double World3::max_overlap_now() const {
       const double gap = m.rec[i].r + m.rec[j].r - norm(d);
       worst = std::max(worst, gap / std::min(m.rec[i].r, m.rec[j].r));
     }
-    for (const Polygon3& p : m.walls) {
-      // The distance to the polygon: the plane where the foot is inside, else the edges.
-      const Vec3 d = xi - p.corners[0];
-      double dist = kNever;
-      if (p.covers(xi, 0.0)) dist = std::abs(dot(d, p.normal));
-      for (std::size_t e = 0; e < p.corners.size(); ++e) {
-        const Vec3 de = xi - p.corners[e];
-        const double s = std::clamp(dot(de, p.along[e]), 0.0, p.length[e]);
-        dist = std::min(dist, norm(de - s * p.along[e]));
-      }
-      worst = std::max(worst, (m.rec[i].r - dist) / m.rec[i].r);
-    }
+    for (const Polygon3& p : m.walls) worst = std::max(worst, (m.rec[i].r - p.distance(xi)) / m.rec[i].r);
   }
   return worst;
 }
