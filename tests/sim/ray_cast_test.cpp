@@ -6,7 +6,11 @@
 // rays along cell lines, through seams, with layers, invisible walls and turtles, moving walls.
 #include <catch2/catch.hpp>
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <future>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -142,6 +146,29 @@ TEST_CASE("ray_segment and ray_point: crossings, ends, and rays along the wall's
   CHECK(sim::ray_point(Vec2{10, -20} - Vec2{10, -5}, {0, 1}) == 15.0);
   CHECK(sim::ray_point(Vec2{10, -20} - Vec2{10, -5}, {0, -1}) == sim::kNever);
   CHECK(sim::ray_point(Vec2{10 + 1e-12, -20} - Vec2{10, -5}, {0, 1}) == sim::kNever);
+}
+
+TEST_CASE("cast_ray: a ray of range 1e308 out of an open arena ends, even at 180 degrees (sin = 1.2e-16)", "[rays]") {
+  WorldDef def = box(400, 400);
+  def.arena.boundary = sim::Boundary::none;
+  def.balls.push_back(ball("b", {300, 300}, {0, 0}, 5));
+  const sim::World w(def, sim::Mode::exact);
+  // Before, the walk stepped x until the ray's y crossing 1e17 units on: it never returned. Bounded
+  // here by a thread: a hang fails the test instead of stalling the suite.
+  auto cast = std::async(std::launch::async, [&] {
+    std::vector<RayHit> hits;
+    for (const double deg : {0.0, 90.0, 180.0, 270.0, 45.0})
+      hits.push_back(w.cast_ray(Ray{{200, 200}, {std::cos(deg * M_PI / 180), std::sin(deg * M_PI / 180)}, 1e308}));
+    return hits;
+  });
+  if (cast.wait_for(std::chrono::seconds(20)) != std::future_status::ready) {
+    std::fprintf(stderr, "cast_ray did not return in 20 s\n");
+    std::_Exit(1);
+  }
+  const std::vector<RayHit> hits = cast.get();
+  for (std::size_t k = 0; k < 4; ++k) CHECK_FALSE(hits[k].hit());
+  REQUIRE(hits[4].hit());  // 45 degrees: the ball at (300, 300)
+  CHECK(hits[4].distance == Approx(100 * std::sqrt(2.0) - 5).epsilon(1e-12));
 }
 
 TEST_CASE("cast_ray: closed forms in a world, layers, invisibility, self, 1e6 from the origin", "[rays]") {

@@ -313,6 +313,17 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
   if (const json* v = find(doc, "balls")) read_balls(*v, def.balls);
   explicit_balls_ = def.balls.size();
   if (const json* v = find(doc, "turtles")) read_turtles(*v, def.turtles, scene.programs);
+  if (def.arena.boundary == sim::Boundary::periodic) {
+    // A ray in a periodic arena wraps on until its range: one that meets nothing walks every cell
+    // it crosses (a range of 1e308 never ended). 1000 periods is far past any sensor's use.
+    const double most = 1000.0 * std::max(def.arena.width, def.arena.height);
+    for (std::size_t k = 0; k < scene.programs.size(); ++k)
+      for (std::size_t j = 0; j < scene.programs[k].senses.size(); ++j)
+        if (scene.programs[k].senses[j].range > most)
+          fail("/turtles/" + std::to_string(k) + "/senses/" + std::to_string(j),
+               "range " + num(scene.programs[k].senses[j].range) + " in a periodic arena: at most 1000 times its longer "
+               "side (" + num(most) + "), as a ray wraps round it until its range");
+  }
   {
     std::size_t builders = 0;
     for (std::size_t k = 0; k < scene.programs.size(); ++k) {

@@ -166,6 +166,13 @@ RayHit Engine<F, kBallBall, kStep, kExtras>::cast_ray(const Ray& ray) const {
   };
   double tx = next_x(), ty = next_y();
   for (;;) {
+    if (!periodic) {
+      // A frozen axis is not stepped again: its block reads the same ring cells, all searched. (A
+      // ray along x with sin(180 deg) = 1.2e-16 across it stepped x until that y crossing, 1e17
+      // units on: a sensor of range 1e308 hung its program.)
+      if (frozen(kx, sx, nx)) tx = kNever;
+      if (frozen(ky, sy, ny)) ty = kNever;
+    }
     const double leave = std::min(tx, ty);
     if (best.distance <= leave || leave > range) return best;
     if (!periodic && frozen(kx, sx, nx) && frozen(ky, sy, ny)) return best;
