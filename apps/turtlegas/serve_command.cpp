@@ -250,7 +250,7 @@ PreparedServe prepare_serve(const ServeCommandOptions& opt, const turtle::Regist
     r.end = rec.end;
     r.dt = rec.header.dt;
     r.complete = rec.complete;
-    for (const formats::Keyframe& k : rec.keyframes) r.keyframes.push_back(k.t);
+    r.keyframes = rec.keyframes;
     if (rec.header.command == "serve")  // its inputs, up to where the recording is whole
       r.inputs = formats::recording_inputs(opt.replay, rec.complete ? rec.bytes : rec.keyframes.back().offset,
                                            scene.def.name, rec.header.dt);

@@ -134,15 +134,37 @@ void WorldHost::plan_snapshots() {
 }
 
 void WorldHost::replay_run_until(double t) {
-  const std::vector<double>& keys = options_.replay->keyframes;
-  for (auto k = std::upper_bound(keys.begin(), keys.end(), server_->time());
-       k != keys.end() && *k <= t && snapshots_.size() < max_snapshots_; ++k) {
-    if (snapshots_.contains(*k)) continue;
-    // Cut at the keyframe (a run does not depend on where it is cut) and copy the world there.
-    server_->run_until(*k);
-    snapshots_.emplace(*k, server_->snapshot());
+  const std::vector<formats::Keyframe>& keys = options_.replay->keyframes;
+  check_reached_keyframes();
+  auto later = [](double time, const formats::Keyframe& k) { return time < k.t; };
+  for (auto k = std::upper_bound(keys.begin(), keys.end(), server_->time(), later); k != keys.end() && k->t <= t; ++k) {
+    const bool compare = !replay_diverged_ && static_cast<std::size_t>(k - keys.begin()) >= keys_checked_;
+    const bool snapshot = snapshots_.size() < max_snapshots_ && !snapshots_.contains(k->t);
+    if (!compare && !snapshot) continue;
+    // Cut at the keyframe (a run does not depend on where it is cut), compare, copy the world there.
+    server_->run_until(k->t);
+    check_reached_keyframes();
+    if (snapshot) snapshots_.emplace(k->t, server_->snapshot());
   }
   server_->run_until(t);
+  check_reached_keyframes();
+}
+
+void WorldHost::check_reached_keyframes() {
+  const std::vector<formats::Keyframe>& keys = options_.replay->keyframes;
+  while (keys_checked_ < keys.size() && keys[keys_checked_].t <= server_->time()) {
+    const formats::Keyframe& k = keys[keys_checked_++];
+    if (replay_diverged_ || k.t != server_->time()) continue;
+    const std::optional<std::string> d =
+        formats::keyframe_difference(formats::read_keyframe(options_.replay->path, k), server_->world(),
+                                     formats::RunNames{ball_ids_, scene_.def, server_->world()});
+    if (!d) continue;
+    replay_diverged_ = true;
+    spdlog::warn("{}: at t = {} s this replay differs from the recording's keyframe ({}): the recorded world, a "
+                 "program, or this build differs from the one that recorded it, and the viewer shows this run, "
+                 "not the recorded one",
+                 options_.replay->path, fmt(k.t), *d);
+  }
 }
 
 bool WorldHost::restore_snapshot(double t) {
@@ -219,13 +241,13 @@ void WorldHost::check_replay() {
     throw std::invalid_argument(r.path + ": the header's dt (" + fmt(r.dt) +
                                 " s) is not a time step from 0 to 1e6 s; the recording is damaged");
   double before = 0.0;
-  for (const double k : r.keyframes)
-    if (!(std::isfinite(k) && k >= before)) throw std::invalid_argument(r.path + ": keyframe times out of order or not finite; the recording is damaged");
-    else before = k;
-  if (!(r.end >= 0.0) || !std::isfinite(r.end) || (!r.keyframes.empty() && r.end > r.keyframes.back())) {
+  for (const formats::Keyframe& k : r.keyframes)
+    if (!(std::isfinite(k.t) && k.t >= before)) throw std::invalid_argument(r.path + ": keyframe times out of order or not finite; the recording is damaged");
+    else before = k.t;
+  if (!(r.end >= 0.0) || !std::isfinite(r.end) || (!r.keyframes.empty() && r.end > r.keyframes.back().t)) {
     // A recording ends on its last keyframe (formats/recording.cpp writes one at its end): an index
     // claiming more would make a seek run for ever.
-    const double last = r.keyframes.empty() ? 0.0 : r.keyframes.back();
+    const double last = r.keyframes.empty() ? 0.0 : r.keyframes.back().t;
     spdlog::warn("{}: its index says it ends at t={} s, but its last keyframe is at t={} s; it is replayed to {} s",
                  r.path, fmt(r.end), fmt(last), fmt(last));
     r.end = last;

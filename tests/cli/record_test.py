@@ -286,6 +286,25 @@ def check_render():
     assert b".svg or .png" in p.stderr
 
 
+def check_replay_warns(rec, at):
+    """Seeks a replay of `rec` forward and back; its stderr names the first difference once."""
+    server = harness.Server(rec, "--paused", command="replay")
+    try:
+        w = World.connect(port=server.line_port, timeout=60)
+        for t in (2.5, 0.5, 2.5):
+            r = w.request({"type": "seek", "t": t}, timeout=120)
+            assert r["status"]["t"] == t, r
+        w.close()
+    finally:
+        server.stop()
+    err = server.err()
+    assert "this replay differs from the recording's keyframe" in err, err
+    assert " here, " in err and " in the recording" in err, err
+    if at:
+        assert at in err, err
+    assert err.count("differs from the recording") == 1, err
+
+
 def check_altered(rec):
     """A render re-simulates the recording's header world: it checks the run against each keyframe it
     passes and names the first difference (before: an altered header world drew another run without a
@@ -293,6 +312,14 @@ def check_altered(rec):
     png = path("altered.png")
     p = run("render", rec, "--at", 2.5, "--out", png)
     assert b"differs from the recording" not in p.stderr, p.stderr
+    server = harness.Server(rec, "--paused", command="replay")
+    try:
+        w = World.connect(port=server.line_port, timeout=60)
+        w.request({"type": "seek", "t": 2.5}, timeout=120)
+        w.close()
+    finally:
+        server.stop()
+    assert "differs from the recording" not in server.err(), server.err()
     data = read(rec)
     header, rest = data.split(b"\n", 1)
     # The same length, so that the index's byte offsets still hold: only the physics changes.
@@ -308,6 +335,9 @@ def check_altered(rec):
         if at:
             assert at in err, err
         assert err.count("differs from the recording") == 1, err  # once
+        # `replay` checks the keyframes it passes as render does (before: it showed another run
+        # without a word).
+        check_replay_warns(altered, at)
     # A header re-written with spaces after the colons is still a recording (before: read as a world
     # file and refused, exit 2).
     spaced = path("spaced.tgrec")

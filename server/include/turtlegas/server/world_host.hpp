@@ -48,7 +48,7 @@ struct ReplaySource {
   double end = 0.0;           ///< the last time the recording vouches for
   double dt = 0.0;            ///< the recorded run's (after its --dt), for the rebuilt worlds
   bool complete = true;       ///< false: it was cut, and `end` is its last keyframe's time
-  std::vector<double> keyframes;  ///< their times
+  std::vector<formats::Keyframe> keyframes;  ///< its index (times and byte offsets; states are read when reached)
   std::string inputs;  ///< a served run's recording: its inputs as an input log (formats::ReplayInput); else empty
 };
 
@@ -283,6 +283,11 @@ class WorldHost {
   /// A replay: run_until(t), stopping on the way at the recording's keyframe times to snapshot
   /// the world (WorldServer::snapshot) while the budget lasts.
   void replay_run_until(double t);
+  /// A replay: the recording's keyframes the run has reached and not yet compared, compared with
+  /// the run (formats::keyframe_difference); the first difference is warned about once, naming it,
+  /// as `render` does: an altered header world, a changed program or another build's arithmetic
+  /// would otherwise be shown as if it were the recorded run.
+  void check_reached_keyframes();
   /// A replay: the world put back to the latest snapshot at or before t when t is behind the
   /// world or that snapshot is ahead of it; whether it was.
   bool restore_snapshot(double t);
@@ -293,6 +298,8 @@ class WorldHost {
   std::vector<turtle::View> client_views_;  ///< a replay's clients' views
   std::map<double, std::shared_ptr<const turtle::WorldServer::Snapshot>> snapshots_;  ///< a replay's, by time
   std::size_t max_snapshots_ = 0;
+  std::size_t keys_checked_ = 0;   ///< a replay: its keyframes before this one are compared (or passed)
+  bool replay_diverged_ = false;   ///< a replay: a keyframe differed from the run (warned about)
 
   HostOptions options_;
   const turtle::Registry& registry_;
