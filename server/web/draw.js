@@ -6,10 +6,15 @@ import {apply, layerBits, pixelMatrix, transformOf, wallPose} from './geometry.j
 import {BUCKETS, S} from './protocol.js';
 
 export const COLOURS = {
-  background: '#f8f8f4', wall: '#222222', turtle: '#1d7f74', it: '#d62828', remote: '#6a4c93',
-  heading: '#ffffff', outline: '#0b3d38', trail: 'rgba(40, 90, 200, 0.85)', flash: 'rgba(255, 160, 0, 0.9)',
+  background: '#f8f8f4', wall: '#222222', it: '#d62828', remote: '#6a4c93',
+  heading: '#ffffff', outline: '#222222', flash: 'rgba(255, 160, 0, 0.9)',
 };
 const FLASH_MS = 400;
+// Turtle i's colour, as `render` and `run --svg` draw it (formats/look.hpp: Tableau 10, repeating
+// after ten turtles): a turtle looks the same in the viewer, a replay, a picture and a video.
+export const TURTLE_COLOURS = ['#4e79a7', '#f28e2b', '#e15759', '#76b7b2', '#59a14f', '#edc948', '#b07aa1', '#ff9da7',
+                               '#9c755f', '#bab0ac'];
+export const turtleColour = (i) => TURTLE_COLOURS[i % TURTLE_COLOURS.length];
 
 function bucketColour(k) {
   // A blue-green-yellow-red ramp.
@@ -73,12 +78,12 @@ export function drawPanel(p, now) {
     ctx.globalAlpha = 1;
   }
   if (layers & 2) drawBalls(ctx, px, x0, x1, y0, y1);
-  if (layers & 8) {  // trails
-    ctx.strokeStyle = COLOURS.trail;
+  if (layers & 8) {  // trails, each in its turtle's colour
     ctx.lineWidth = 1.5 * px;
     ctx.lineJoin = 'round';
-    for (const t of S.turtles) {
+    for (const [i, t] of S.turtles.entries()) {
       if (!t.trail.length) continue;
+      ctx.strokeStyle = turtleColour(i);
       ctx.beginPath();
       let gap = true;  // null in a trail: a break between strokes (pen lifted, or a teleport)
       for (const p of t.trail) {
@@ -91,15 +96,16 @@ export function drawPanel(p, now) {
     }
   }
   if (layers & 4) {  // turtles
-    for (const t of S.turtles) {
+    for (const [i, t] of S.turtles.entries()) {
       if (t.gone) continue;  // crushed, out of the arena or removed: no longer in the world
       if (t.x + t.radius < x0 || t.x - t.radius > x1 || t.y + t.radius < y0 || t.y - t.radius > y1) continue;
-      ctx.fillStyle = (layers & 32) && t.it ? COLOURS.it : t.remote ? COLOURS.remote : COLOURS.turtle;
+      ctx.fillStyle = turtleColour(i);
       ctx.beginPath();
       ctx.arc(t.x, t.y, t.radius, 0, 2 * Math.PI);
       ctx.fill();
-      ctx.strokeStyle = COLOURS.outline;
-      ctx.lineWidth = 1 * px;
+      // The outline: dark; a remote turtle's (driven by a client) thick and purple.
+      ctx.strokeStyle = t.remote ? COLOURS.remote : COLOURS.outline;
+      ctx.lineWidth = t.remote ? Math.max(2.5 * px, t.radius / 5) : 1 * px;
       ctx.stroke();
       const h = t.heading * Math.PI / 180;
       ctx.strokeStyle = COLOURS.heading;

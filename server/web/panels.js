@@ -7,7 +7,7 @@ import {invert} from './geometry.js';
 import {S, send} from './protocol.js';
 
 export const panels = new Map();  // id -> panel
-let localShown = null;     // whether the local whole-arena panel is wanted (null: when no view)
+let localShown = null;     // whether the local whole-arena panel is wanted (null: when no view shows the room)
 
 function localView() {
   return {id: 'arena', local: true, center: [S.arena.width / 2, S.arena.height / 2],
@@ -21,7 +21,9 @@ export function setViews(views) {
 
 export function syncPanels() {
   const wanted = new Map();
-  const showLocal = localShown === null ? S.views.length === 0 : localShown;
+  // Shown by default when no view shows the room: no view at all, or only views that follow a
+  // turtle (a recording whose one view is a follow camera would otherwise never show the room).
+  const showLocal = localShown === null ? S.views.every((v) => v.follow) : localShown;
   if (showLocal) wanted.set('arena', localView());
   for (const v of S.views) wanted.set(v.id, v);
   for (const [id, p] of panels) if (!wanted.has(id)) removePanel(p);
@@ -29,7 +31,34 @@ export function syncPanels() {
     const p = panels.get(id);
     if (p) p.view = v; else panels.set(id, makePanel(v));
   }
+  layoutPanels();
   S.dirty = true;
+}
+
+/// The docked panels share the window: the grid (columns × rows) that draws the views largest,
+/// each view fitted to its cell at its own aspect (at least 360 × 320 px a cell; more rows scroll).
+/// One panel fills the page; four views of a room make two rows of two, not four thin columns.
+export function layoutPanels() {
+  const box = document.getElementById('panels');
+  const docked = [...panels.values()].filter((p) => !p.popup);
+  const gap = 8, chrome = 52;  // a panel's title bar and status line, px
+  const width = box.clientWidth - 2 * gap, height = box.clientHeight - 2 * gap;
+  let best = {cols: 1, rows: Math.max(1, docked.length), area: -1, rowHeight: 320};
+  for (let cols = 1; cols <= Math.max(1, docked.length); cols++) {
+    const rows = Math.max(1, Math.ceil(docked.length / cols));
+    const cw = (width - (cols - 1) * gap) / cols;
+    if (cols > 1 && cw < 360) break;
+    const rowHeight = Math.max(320, Math.floor((height - (rows - 1) * gap) / rows));
+    const ch = rowHeight - chrome;
+    let area = 0;
+    for (const p of docked) {
+      const a = p.view.size[0] / p.view.size[1];
+      area += a > cw / ch ? cw * cw / a : ch * ch * a;
+    }
+    if (area > best.area * 1.001) best = {cols, rows, area, rowHeight};
+  }
+  box.style.gridTemplateColumns = `repeat(${best.cols}, minmax(0, 1fr))`;
+  box.style.gridAutoRows = `${best.rowHeight}px`;
 }
 
 function makePanel(view) {
@@ -72,12 +101,14 @@ function popOut(p) {
   p.el.querySelector('.pop').textContent = 'dock';
   p.el.querySelector('.pop').onclick = () => w.close();
   w.addEventListener('pagehide', () => setTimeout(() => dock(p), 0));
+  layoutPanels();
 }
 
 export function dock(p) {
   if (!panels.has(p.id)) return;
   document.getElementById('panels').appendChild(document.adoptNode(p.el));
   p.popup = null;
+  layoutPanels();
   p.el.querySelector('.pop').textContent = 'pop out';
   p.el.querySelector('.pop').onclick = () => popOut(p);
   S.dirty = true;

@@ -18,6 +18,7 @@ export const S = {
   balls: {n: 0, ids: [], radius: new Float32Array(0), pos: new Float32Array(0), vel: null, dead: new Set()},
   bucketOf: new Uint8Array(0), buckets: [], speedScale: 1,
   turtles: [], t: 0, step: 0, paused: false, speed: 1, simEvents: null,
+  replay: null,  // a replay's {end, reverse, complete} (the status's "replay"); null: a live world
   lastSeq: 0, dropped: 0, framesIn: 0, bytesIn: 0, dirty: true, ended: null,
 };
 export const stats = {frames: [], draws: [], events: []};  // [wall ms, value] samples of the last seconds
@@ -86,6 +87,7 @@ function onStatus(st) {
   S.speed = st.speed;
   S.ended = st.ended;
   S.t = st.t;
+  S.replay = st.replay || null;
   const sel = document.getElementById('speed');
   if (String(st.speed) !== sel.value && [...sel.options].some((o) => o.value === String(st.speed))) sel.value = String(st.speed);
   S.dirty = true;
@@ -258,5 +260,6 @@ function updateBuckets() {
   for (let i = 0; i < n; i++) { const b = S.bucketOf[i]; S.buckets[b][fill[b]++] = i; }
   S.bucketCounts = fill;
   document.getElementById('legend-hi').textContent = S.speedScale.toPrecision(3);
+  document.getElementById('legend').hidden = n === 0;  // no balls: no speed scale to explain
 }
 

@@ -8,7 +8,7 @@
 //   viewer.js    (this) the status line, the one animation loop, the controls, the start
 import {BUCKET_COLOURS, drawPanel} from './draw.js';
 import {pixelMatrix, transformOf} from './geometry.js';
-import {dock, panels, setViews, showArena} from './panels.js';
+import {dock, layoutPanels, panels, setViews, showArena} from './panels.js';
 import {BUCKETS, S, connect, hooks, params, send, stats, subscribe} from './protocol.js';
 
 const bench = params.get('bench') === '1';  // draw every animation frame (bench/viewer_bench.py)
@@ -31,7 +31,8 @@ function flashStatus(text) { statusMessage = text; statusUntil = performance.now
 function updateStatus(now) {
   const fps = rate(stats.frames, now, true), drawn = rate(stats.draws, now, true), eps = rate(stats.events, now, false);
   const speed = S.speed === 'max' ? 'max' : '×' + S.speed;
-  let s = `t=${S.t.toFixed(2)} s  speed ${speed}${S.paused ? '  PAUSED' : ''}  events/s ${eps.toFixed(0)}  ` +
+  const mode = S.replay ? (S.paused ? '' : S.replay.reverse ? '  REVERSE' : '') : '';
+  let s = `t=${S.t.toFixed(2)} s  speed ${speed}${S.paused ? '  PAUSED' : ''}${mode}  events/s ${eps.toFixed(0)}  ` +
           `frames/s ${fps.toFixed(1)} (drawn ${drawn.toFixed(1)})  dropped ${S.dropped}`;
   if (S.ended) s += '  ended: ' + S.ended;
   if (now < statusUntil) s += '  ! ' + statusMessage;
@@ -47,7 +48,7 @@ function updateStatus(now) {
 
 // ---- the one animation loop ----------------------------------------------------------------
 let lastStatus = 0, lastDraw = 0;
-const resized = () => { S.dirty = true; };
+const resized = () => { layoutPanels(); S.dirty = true; };
 window.addEventListener('resize', resized);
 if (window.ResizeObserver) new ResizeObserver(resized).observe(document.getElementById('panels'));
 
@@ -67,15 +68,63 @@ function frame(now) {
     lastStatus = now;
     updateStatus(now);
   }
+  updateReplay();
   requestAnimationFrame(frame);
 }
 
 if (params.get('json') === '1') document.getElementById('binary').checked = false;
 
+// ---- a replay: the REPLAY mark, reverse and the timeline ------------------------------------
+// Shown when the status carries "replay" (`turtlegas replay R.tgrec`). Dragging the timeline
+// seeks: one seek in flight at a time, the latest position sent when it is answered, so a fast
+// drag never queues seeks behind each other; the knob follows the clock again once let go.
+let dragging = false, seekBusy = false, seekWanted = null;
+
+function seekTo(t) {
+  seekWanted = t;
+  if (seekBusy) return;
+  seekBusy = true;
+  const target = seekWanted;
+  seekWanted = null;
+  send({type: 'seek', t: target}, () => {
+    seekBusy = false;
+    if (seekWanted !== null) seekTo(seekWanted);
+  });
+}
+
+let replayShown = false;
+function updateReplay() {
+  const r = S.replay;
+  if (!!r !== replayShown) {
+    replayShown = !!r;
+    document.getElementById('replay-bar').hidden = !r;
+    document.body.classList.toggle('replay', !!r);
+    document.title = (r ? 'REPLAY - ' : '') + ((S.world && S.world.name) || 'turtlegas') + ' - turtlegas viewer';
+    layoutPanels();
+  }
+  if (!r) return;
+  const tl = document.getElementById('timeline');
+  if (tl.max !== String(r.end)) tl.max = String(r.end);
+  if (!dragging && !seekBusy && Number(tl.value) !== S.t) tl.value = String(S.t);
+  const text = `${S.t.toFixed(2)} / ${r.end.toFixed(2)} s${r.complete ? '' : ' (cut)'}`;
+  const label = document.getElementById('replay-time');
+  if (label.textContent !== text) label.textContent = text;
+  document.getElementById('reverse').classList.toggle('on', !!r.reverse && !S.paused);
+}
+
+function wireReplay() {
+  const tl = document.getElementById('timeline');
+  tl.addEventListener('pointerdown', () => { dragging = true; });
+  tl.addEventListener('input', () => { dragging = true; seekTo(Number(tl.value)); });
+  tl.addEventListener('change', () => { dragging = false; seekTo(Number(tl.value)); });
+  window.addEventListener('pointerup', () => { dragging = false; });
+  document.getElementById('reverse').onclick = () => send({type: 'reverse'});
+}
+
 // ---- controls ------------------------------------------------------------------------------
 function wire() {
   document.getElementById('pause').onclick = () => send({type: 'pause'});
-  document.getElementById('resume').onclick = () => send({type: 'resume'});
+  document.getElementById('resume').onclick = () => send({type: 'resume'});  // a replay: forward
   document.getElementById('step').onclick = () => send({type: 'step', steps: 1});
   document.getElementById('speed').onchange = (e) => {
     const v = e.target.value;
@@ -86,6 +135,7 @@ function wire() {
     if (e.target.tagName === 'INPUT' || e.target.tagName === 'SELECT') return;
     if (e.key === ' ') { send({type: S.paused ? 'resume' : 'pause'}); e.preventDefault(); }
     if (e.key === 's') send({type: 'step', steps: 1});
+    if (e.key === 'r' && S.replay) send({type: 'reverse'});
   });
   const legend = document.getElementById('legend-bar').getContext('2d');
   for (let k = 0; k < BUCKETS; k++) {
@@ -99,11 +149,12 @@ window.turtlegasViewer = {
   state: S, panels, transformOf: (view) => transformOf(view, S.turtles), pixelMatrix, send,
   stats: () => ({framesIn: S.framesIn, dropped: S.dropped, t: S.t, paused: S.paused,
                  draws: Object.fromEntries([...panels].map(([id, p]) => [id, p.draws.length]))}),
-  showArena,
+  showArena, seekTo,
 };
 
 hooks.views = setViews;
 hooks.error = flashStatus;
 wire();
+wireReplay();
 connect();
 requestAnimationFrame(frame);
