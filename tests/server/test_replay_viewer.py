@@ -15,18 +15,18 @@ its clock:
 Skips (exit 77, with the reason) only when no Chromium is installed."""
 
 import json
+import math
 import os
-import struct
 import subprocess
 import sys
 import tempfile
 import time
 import urllib.request
-import zlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from harness import BIN, Server, check, world  # noqa: E402
 import cdp  # noqa: E402
+from png import png_pixels  # noqa: E402
 
 WORLD = world("replay_follow.json")
 UNTIL = 8.0
@@ -37,40 +37,6 @@ WIDTH, HEIGHT = 1280, 800
 
 def near(rgb, want, tol=40):
     return all(abs(a - b) <= tol for a, b in zip(rgb, want))
-
-
-def png_pixels(data):
-    """Width, height and RGB rows of an 8-bit RGB or RGBA PNG (Chromium's screenshots)."""
-    assert data[:8] == b"\x89PNG\r\n\x1a\n"
-    pos, idat = 8, b""
-    while pos < len(data):
-        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
-        body = data[pos + 8:pos + 8 + n]
-        if kind == b"IHDR":
-            w, h, depth, ctype = struct.unpack(">IIBB", body[:10])
-            assert depth == 8 and ctype in (2, 6), (depth, ctype)
-            bpp = 3 if ctype == 2 else 4
-        elif kind == b"IDAT":
-            idat += body
-        pos += 12 + n
-    raw = zlib.decompress(idat)
-    stride = w * bpp
-    rows, prev = [], bytearray(stride)
-    for y in range(h):
-        f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        for i in range(stride):
-            a = line[i - bpp] if i >= bpp else 0
-            b, c = prev[i], prev[i - bpp] if i >= bpp else 0
-            if f == 1: line[i] = (line[i] + a) & 255
-            elif f == 2: line[i] = (line[i] + b) & 255
-            elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
-            elif f == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        rows.append(line)
-        prev = line
-    return w, h, lambda x, y: tuple(rows[y][x * bpp:x * bpp + 3])
 
 
 def api_state(server):
@@ -101,7 +67,6 @@ class Page:
           return pts.map(([x, y]) => { const X = M.a * x + M.c * y + M.e, Y = M.b * x + M.d * y + M.f;
             return Array.from(g.getImageData(Math.floor(X), Math.floor(Y), 1, 1).data.slice(0, 3)); });
         })(%s)"""
-        import math
         pts, ids = [], []
         for t in server_state["turtles"]:
             h = math.radians(t["heading"])
@@ -155,7 +120,8 @@ def test():
         b.screenshot(shot)
 
         # The REPLAY mark: its badge's pixels are its red.
-        w, h, px = png_pixels(open(shot, "rb").read())
+        w, h, rows = png_pixels(open(shot, "rb").read())
+        px = lambda x, y: rows[y][x]  # noqa: E731
         m = page.rect("#replay-mark")
         check(m and m[2] > 20 and m[3] > 8, "the REPLAY mark is laid out: %r" % m)
         red = sum(near(px(int(m[0] + m[2] * fx), int(m[1] + m[3] * fy)), MARK, 30)
