@@ -44,13 +44,17 @@ json WorldHost::world_json() const {
   for (std::size_t i = 0; i < server_->turtle_count(); ++i) {
     json sensors = json::array();
     for (const turtle::SensorArc& a : scene_.programs[i].sensors) sensors.push_back(a.name);
+    json senses = json::array();  // range sensors: the viewer draws their rays (docs/viewer.md)
+    for (const turtle::RangeSensor& r : scene_.programs[i].senses)
+      senses.push_back({{"name", r.name}, {"bearings", r.bearings}, {"range", r.range}});
     turtles.push_back({{"id", def.turtles[i].id},
                        {"index", i},
                        {"controller", server_->controller(i)},
                        {"remote", server_->is_remote(i)},
                        {"claimed", slots_[i].owner != 0},
                        {"radius", server_->world().turtle_radius(i)},
-                       {"sensors", sensors}});
+                       {"sensors", sensors},
+                       {"senses", senses}});
   }
   return {{"name", def.name},
           {"arena", {{"width", def.arena.width}, {"height", def.arena.height}, {"boundary", std::string(sim::to_string(def.arena.boundary))}}},

@@ -7,7 +7,7 @@ import {BUCKETS, S} from './protocol.js';
 
 export const COLOURS = {
   background: '#f8f8f4', wall: '#222222', it: '#d62828', remote: '#6a4c93',
-  heading: '#ffffff', outline: '#222222', flash: 'rgba(255, 160, 0, 0.9)',
+  heading: '#ffffff', outline: '#222222', flash: 'rgba(255, 160, 0, 0.9)', ray: '#d6336c', miss: 'rgba(214, 51, 108, 0.3)',
 };
 const FLASH_MS = 400;
 // Turtle i's colour, as `render` and `run --svg` draw it (formats/look.hpp: Tableau 10, repeating
@@ -95,6 +95,7 @@ export function drawPanel(p, now) {
       ctx.stroke();
     }
   }
+  if ((layers & 16) && (layers & 4)) drawRays(ctx, px, tf.followed);
   if (layers & 4) {  // turtles
     for (const [i, t] of S.turtles.entries()) {
       if (t.gone) continue;  // crushed, out of the arena or removed: no longer in the world
@@ -153,6 +154,38 @@ export function drawPanel(p, now) {
     }
   }
   ctx.setTransform(1, 0, 0, 1, 0, 0);
+}
+
+/// Range sensors' last readings (`sense` events): each ray from the turtle's centre to what it hit
+/// (a dot there), or faint and dashed to its range when it hit nothing. Drawn while the turtle is
+/// at the pose the reading came with, so a ray is never shown from where it was not cast; in a
+/// view that follows a turtle, that turtle's rays only.
+function drawRays(ctx, px, followed) {
+  for (const t of S.turtles) {
+    if (t.gone || !t.readings.size || (followed && followed !== t)) continue;
+    for (const r of t.readings.values()) {
+      if (r.x !== t.x || r.y !== t.y || r.heading !== t.heading) continue;
+      r.bearings.forEach((b, k) => {
+        const a = (r.heading + b) * Math.PI / 180, d = r.range[k];
+        const ux = Math.sin(a), uy = Math.cos(a), len = d === null || d === undefined ? r.max : d;
+        const hit = !(d === null || d === undefined);
+        ctx.strokeStyle = hit ? COLOURS.ray : COLOURS.miss;
+        ctx.lineWidth = 2 * px;
+        ctx.setLineDash(hit ? [] : [4 * px, 4 * px]);
+        ctx.beginPath();
+        ctx.moveTo(r.x, r.y);
+        ctx.lineTo(r.x + len * ux, r.y + len * uy);
+        ctx.stroke();
+        if (hit) {
+          ctx.fillStyle = COLOURS.ray;
+          ctx.beginPath();
+          ctx.arc(r.x + len * ux, r.y + len * uy, 3.5 * px, 0, 2 * Math.PI);
+          ctx.fill();
+        }
+      });
+    }
+  }
+  ctx.setLineDash([]);
 }
 
 function drawBalls(ctx, px, x0, x1, y0, y1) {

@@ -71,7 +71,7 @@ export function connect() {
 export function subscribe() {
   const binary = document.getElementById('binary').checked;
   send({type: 'subscribe', rate: Number(params.get('rate') || 30), format: binary ? 'binary' : 'json',
-        events: ['touch', 'tag', 'view', 'wall-drawn', 'wall-added'], velocities: true});
+        events: ['touch', 'tag', 'view', 'wall-drawn', 'wall-added', 'sense'], velocities: true});
 }
 
 function onWelcome(m) {
@@ -109,13 +109,17 @@ function onSnapshot(m) {
   S.balls.pos = Float32Array.from(b.pos);
   S.balls.vel = b.vel ? Float32Array.from(b.vel) : null;
   S.balls.dead = new Set(b.dead);
-  const names = new Map();
-  for (const t of (S.world && S.world.turtles) || []) names.set(t.id, t.sensors);
+  const names = new Map(), senses = new Map();
+  for (const t of (S.world && S.world.turtles) || []) {
+    names.set(t.id, t.sensors);
+    senses.set(t.id, new Map((t.senses || []).map((r) => [r.name, r])));
+  }
   S.turtles = m.turtles.map((t) => ({
     id: t.id, radius: t.radius, x: t.pos[0], y: t.pos[1], heading: t.heading, pen: t.pen, it: t.it,
     remote: t.remote, claimed: t.claimed, finished: t.finished, gone: !!t.gone,
     cat: t.layers ? t.layers[0] >>> 0 : 1, mask: t.layers ? t.layers[1] >>> 0 : 0xffffffff,
     arcs: t.arcs || [], sensorNames: names.get(t.id) || [], flash: new Map(),
+    senses: senses.get(t.id) || new Map(), readings: new Map(),
     trail: t.trail.slice(),
   }));
   hooks.views(m.views || []);
@@ -167,6 +171,7 @@ function applyParts(trails, wallsFrom, walls) {
 function applyEvents(events) {
   const now = performance.now();
   for (const e of events) {
+    if (e.kind === 'sense') { applyReading(e); continue; }
     if (e.kind !== 'touch') continue;
     const t = S.turtles.find((x) => x.id === e.a);
     if (!t) continue;
@@ -175,6 +180,16 @@ function applyEvents(events) {
       if (k >= 0) t.flash.set(k, now);
     }
   }
+}
+
+/// A range sensor's reading (a `sense` event): kept, per sensor, with the turtle's pose in the frame
+/// that brought it (its rays are drawn from there, while the turtle stays at that pose).
+function applyReading(e) {
+  const t = S.turtles.find((x) => x.id === e.a);
+  const sensor = t && t.senses.get(e.sensor);
+  if (!sensor) return;
+  t.readings.set(e.sensor, {range: e.range, hit: e.hit, bearings: sensor.bearings, max: sensor.range,
+                            x: t.x, y: t.y, heading: t.heading, t: e.t});
 }
 
 function onJsonFrame(m) {
