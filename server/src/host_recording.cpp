@@ -89,7 +89,7 @@ void WorldHost::finish_recording(const std::string& stopped, bool keyframe) {
 }
 
 void WorldHost::record_view(const char* op, const nlohmann::json& view) {
-  if (recorder_) recorder_->input(formats::input_view_line(server_->step(), op, view));
+  if (recorder_) recorder_->input(input_line(formats::input_view_line(server_->step(), op, view)));
 }
 
 std::shared_ptr<turtle::InputSource> WorldHost::world_input() {
