@@ -23,6 +23,7 @@
 #include <spdlog/spdlog.h>
 
 #include "checkpoint.hpp"
+#include "plugins.hpp"
 #include "cli_common.hpp"
 #include "output_file.hpp"
 #include "scene_scales.hpp"
@@ -455,6 +456,9 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     h.dt = def.dt;
     h.until = opt.until;
     h.keyframes = {opt.keyframe_seconds, opt.keyframe_events};
+    std::vector<std::string> controllers;
+    for (const turtle::TurtleProgram& p : scene.programs) controllers.push_back(p.controller);
+    h.plugins = plugins_used(controllers);
     recorder.emplace(record_file->stream(), h);
   }
   // Ids by index. With the world server, its scene: bodies spawned by an input log are in it

@@ -71,6 +71,7 @@ struct HostOptions {
   std::optional<ReplaySource> replay;  ///< set: a replay (ReplaySource)
   std::string record_path;             ///< `serve --record`: the recording (docs/recording.md); empty: none
   formats::KeyframePolicy keyframes;   ///< its keyframes
+  nlohmann::ordered_json plugins;      ///< its header's plugins (formats::RecordingHeader::plugins)
 };
 
 class WorldHost {
