@@ -360,7 +360,7 @@ int render_command(const RenderOptions& opt, const turtle::Registry& registry) {
       char rate[32];
       std::snprintf(rate, sizeof rate, "%.10g", opt.fps);
       std::vector<std::string> args = {ffmpeg, "-loglevel", "error", "-y", "-framerate", rate, "-i", (dir / "frame-%05d.png").string(),
-                                        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", tmp.string()};
+                                        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white", "-pix_fmt", "yuv420p", tmp.string()};
       std::vector<char*> argv;
       argv.reserve(args.size() + 1);  // and the closing null
       for (std::string& a : args) argv.push_back(a.data());
