@@ -83,8 +83,8 @@ int dispatch(const CommandLine& line, turtle::Registry& registry) {
       case Command::replay: inputs = {line.replay_opt.replay}; break;
       case Command::render: inputs = {line.render_opt.input}; break;
       case Command::run: inputs = {line.run_line.options().world}; break;
-      case Command::controllers:
-      case Command::sweep: break;
+      case Command::sweep: load_sweep_plugins(line.sweep_opt.spec, registry); break;
+      case Command::controllers: break;
     }
     for (const std::string& input : inputs) load_input_plugins(input, registry);
     switch (line.command()) {

@@ -257,4 +257,15 @@ void load_input_plugins(const std::string& input, turtle::Registry& registry) {
   load_plugins(files, registry, "/plugins of " + input);
 }
 
+void load_sweep_plugins(const std::string& spec, turtle::Registry& registry) {
+  std::ifstream in(spec, std::ios::binary);
+  if (!in) return;  // the sweep says why
+  std::ostringstream buf;
+  buf << in.rdbuf();
+  const nlohmann::json doc = nlohmann::json::parse(buf.str(), nullptr, false);
+  if (!doc.is_object() || !doc.contains("world") || !doc["world"].is_string()) return;
+  const fs::path world = doc["world"].get<std::string>();
+  load_input_plugins((world.is_absolute() ? world : fs::path(spec).parent_path() / world).string(), registry);
+}
+
 }  // namespace turtlegas::apps

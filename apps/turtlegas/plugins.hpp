@@ -40,5 +40,7 @@ nlohmann::ordered_json plugins_used(const std::vector<std::string>& controllers)
 /// recording's: which plugin, which controllers, and how to give it). Anything else about the
 /// input is left to the command that reads it.
 void load_input_plugins(const std::string& input, turtle::Registry& registry);
+/// load_input_plugins for the world a sweep spec names ("world", relative to the spec).
+void load_sweep_plugins(const std::string& spec, turtle::Registry& registry);
 
 }  // namespace turtlegas::apps

@@ -252,6 +252,13 @@ TEST_CASE("plugins: a world file's \"plugins\" key, relative to the world file (
   // The same file by --plugin as well is loaded once (no clash with itself).
   CHECK(run(dir.path, {"run", world.string(), "--until", "1", "--plugin", (dir.path / "lib" / "libfeeler.so").string()}).code == 0);
 
+  // A sweep of that world (its children too) loads them as well.
+  dir.write("worlds/sweep.json", R"({"format": "turtlegas-sweep/1", "world": "feeler.json", "until": 2, "seeds": [1, 2]})");
+  const Result sweep = run(dir.path, {"sweep", (dir.path / "worlds" / "sweep.json").string(), "--jobs", "2", "--out",
+                                      (dir.path / "results.jsonl").string()});
+  INFO(sweep.err);
+  CHECK(sweep.code == 0);
+
   w["plugins"] = {"../lib/libnothere.so"};
   const fs::path missing = dir.write("worlds/missing.json", w.dump());
   const Result bad = run(dir.path, {"check", missing.string()});
