@@ -55,6 +55,8 @@ set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
-# Not needed to run worlds, only to build controller plugins against the SDK.
-set(CPACK_DEBIAN_PACKAGE_SUGGESTS "cmake, g++, nlohmann-json3-dev, pkg-config")
+# The SDK's headers include <nlohmann/json.hpp> (registry.hpp): a package that ships them depends
+# on it (merged with the shared libraries' Depends). The tools to build a plugin are suggested.
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "nlohmann-json3-dev")
+set(CPACK_DEBIAN_PACKAGE_SUGGESTS "cmake, g++, pkg-config")
 include(CPack)

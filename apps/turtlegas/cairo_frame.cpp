@@ -8,6 +8,8 @@
 #include <ostream>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <cairo.h>
 
@@ -47,9 +49,12 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
   const bool walls = layers & turtle::kLayerWalls, balls = layers & turtle::kLayerBalls,
              turtles = layers & turtle::kLayerTurtles, trails = layers & turtle::kLayerTrails,
              roles = layers & turtle::kLayerRoles;
-  const look::Layout l = look::layout_for(win.w, win.h, width_px);
+  const bool legend = !snap.balls.empty() && balls;
+  const look::Layout l = look::layout_for(win.w, win.h, width_px, legend);
   const double margin = look::margin;
-  const int width = static_cast<int>(std::ceil(l.width)), height = static_cast<int>(std::ceil(l.height));
+  // Even sides: an mp4 (yuv420p) needs them, and ffmpeg's padding of an odd side was a black row.
+  auto even = [](double v) { const int n = static_cast<int>(std::ceil(v)); return n + (n % 2); };
+  const int width = even(l.width), height = even(l.height);
   std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface(
       cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height), cairo_surface_destroy);
   std::unique_ptr<cairo_t, decltype(&cairo_destroy)> ctx(cairo_create(surface.get()), cairo_destroy);
@@ -99,7 +104,11 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
     const bool there = sim::wall_visible(wall, snap.time);
     cairo_move_to(cr, pose.from.x, pose.from.y);
     cairo_line_to(cr, pose.to.x, pose.to.y);
-    if (there) {
+    if (there && look::passable_by_some(wall, snap.turtles)) {  // some turtle passes through it
+      set_rgb(cr, look::wall_passable_colour);
+      const double dash[2] = {6, 3};
+      cairo_set_dash(cr, dash, 2, 0);
+    } else if (there) {
       set_grey(cr, 0x22);
     } else {
       set_grey(cr, 0xbb);
@@ -158,23 +167,31 @@ void write_png(std::ostream& out, const formats::Snapshot& snap, const Window& w
       stroke_px(cr, 2);
     }
   }
-  // Ids beside each turtle's upper right, upright.
-  cairo_set_font_size(cr, 11 / l.scale);
-  for (const auto& t : snap.turtles) {
-    if (!turtles) break;
-    cairo_save(cr);
-    cairo_translate(cr, t.pos.x, t.pos.y);
-    cairo_rotate(cr, -win.angle);
-    cairo_move_to(cr, t.radius + 2 / l.scale, t.radius);
-    cairo_scale(cr, 1, -1);
-    set_grey(cr, 0);
-    cairo_show_text(cr, t.id.c_str());
-    cairo_restore(cr);
+  // Where each turtle is in the picture's pixels (labels are drawn there, outside the clip).
+  std::vector<std::pair<double, double>> at(snap.turtles.size());
+  for (std::size_t i = 0; i < snap.turtles.size(); ++i) {
+    at[i] = {snap.turtles[i].pos.x, snap.turtles[i].pos.y};
+    cairo_user_to_device(cr, &at[i].first, &at[i].second);
   }
   cairo_restore(cr);
 
+  // Ids beside each turtle's upper right, upright; to its left or below where they would leave
+  // the picture (look::label_spot). Turtles outside the window get none.
+  cairo_set_font_size(cr, 11);
+  set_grey(cr, 0);
+  for (std::size_t i = 0; i < snap.turtles.size() && turtles; ++i) {
+    const auto& t = snap.turtles[i];
+    const auto [px, py] = at[i];
+    if (px < margin || px > margin + win.w * l.scale || py < l.top || py > l.top + win.h * l.scale) continue;
+    cairo_text_extents_t te;
+    cairo_text_extents(cr, t.id.c_str(), &te);
+    const look::LabelSpot spot = look::label_spot(px, py, t.radius * l.scale, te.x_advance, 11.0, width, height);
+    cairo_move_to(cr, spot.x, spot.y);
+    cairo_show_text(cr, t.id.c_str());
+  }
+
   // The legend: a colour bar from 0 (bottom) to v_max (top), when there are balls.
-  if (!snap.balls.empty() && balls) {
+  if (legend) {
     const double lx = l.legend_x, ly = l.legend_y, lh = look::legend_h;
     cairo_pattern_t* g = cairo_pattern_create_linear(0, ly + lh, 0, ly);
     for (std::size_t k = 0; k < look::palette.size(); ++k) {

@@ -73,6 +73,20 @@ int dispatch(const CommandLine& line, turtle::Registry& registry) {
     // by both is loaded once.
     load_plugins(plugin_path_entries(std::getenv("TURTLEGAS_PLUGIN_PATH")), registry, "TURTLEGAS_PLUGIN_PATH");
     load_plugins(line.plugins, registry);
+    // Then the plugins the input names: a world file's "plugins", a recording's.
+    std::vector<std::string> inputs;
+    switch (line.command()) {
+      case Command::check: inputs = line.check_worlds; break;
+      case Command::test: inputs = line.test_opt.worlds; break;
+      case Command::tag: inputs = {line.tag_opt.world}; break;
+      case Command::serve: inputs = {line.serve_opt.world}; break;
+      case Command::replay: inputs = {line.replay_opt.replay}; break;
+      case Command::render: inputs = {line.render_opt.input}; break;
+      case Command::run: inputs = {line.run_line.options().world}; break;
+      case Command::sweep: load_sweep_plugins(line.sweep_opt.spec, registry); break;
+      case Command::controllers: break;
+    }
+    for (const std::string& input : inputs) load_input_plugins(input, registry);
     switch (line.command()) {
       case Command::controllers: return controllers_command(registry);
       case Command::check: return check_command(line.check_worlds, registry);

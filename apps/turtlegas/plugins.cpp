@@ -14,12 +14,15 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 #include <utility>
 
 #include "cli_common.hpp"
+#include "turtlegas/formats/recording.hpp"
 #include "turtlegas/turtle/remote.hpp"
 
 namespace turtlegas::apps {
@@ -121,6 +124,13 @@ std::vector<std::string> plugin_path_entries(const char* value) {
   return out;
 }
 
+namespace {
+std::map<std::string, std::string>& plugin_files() {  // controller name -> the plugin file (absolute)
+  static std::map<std::string, std::string> files;
+  return files;
+}
+}  // namespace
+
 void load_plugins(const std::vector<std::string>& paths, turtle::Registry& registry, const std::string& given_by) {
   using Register = void (*)(turtle::Registry&);
   static std::map<std::string, std::string> registered_by;  // controller name -> the plugin that added it
@@ -167,11 +177,95 @@ void load_plugins(const std::vector<std::string>& paths, turtle::Registry& regis
                        "; a plugin may not replace a controller: rename it");
       }
       registered_by[name] = shown;
+      std::error_code ec;
+      const fs::path absolute = fs::absolute(file, ec);
+      plugin_files()[name] = (ec ? fs::path(file) : absolute.lexically_normal()).string();
       const turtle::ControllerInfo& info = *own.info(name);
       if (info.params_declared) registry.add(name, *own.find(name), info);
       else registry.add(name, *own.find(name), info.summary);
     }
   }
+}
+
+std::optional<std::string> plugin_of(const std::string& controller) {
+  const auto it = plugin_files().find(controller);
+  if (it == plugin_files().end()) return std::nullopt;
+  return it->second;
+}
+
+nlohmann::ordered_json plugins_used(const std::vector<std::string>& controllers) {
+  std::map<std::string, std::set<std::string>> by_file;
+  for (const std::string& c : controllers)
+    if (auto f = plugin_of(c)) by_file[*f].insert(c);
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (const auto& [file, names] : by_file)
+    out.push_back({{"file", file}, {"controllers", std::vector<std::string>(names.begin(), names.end())}});
+  return out;
+}
+
+void load_input_plugins(const std::string& input, turtle::Registry& registry) {
+  std::ifstream in(input, std::ios::binary);
+  if (!in) return;  // the command says why
+  std::string first;
+  std::getline(in, first);
+  const nlohmann::json head = nlohmann::json::parse(first, nullptr, false);
+  if (head.is_object() && head.value("format", std::string()) == formats::recording_format) {
+    const auto p = head.find("plugins");
+    if (p == head.end() || !p->is_array()) return;
+    for (const nlohmann::json& e : *p) {
+      if (!e.is_object() || !e.contains("file") || !e["file"].is_string() || !e.contains("controllers") ||
+          !e["controllers"].is_array())
+        continue;  // read_recording says what is wrong with the header
+      std::vector<std::string> missing;
+      for (const nlohmann::json& c : e["controllers"])
+        if (c.is_string() && registry.find(c.get<std::string>()) == nullptr) missing.push_back(c.get<std::string>());
+      if (missing.empty()) continue;  // given by --plugin or TURTLEGAS_PLUGIN_PATH, from wherever
+      const std::string file = e["file"].get<std::string>();
+      std::string names;
+      for (const std::string& m : missing) names += (names.empty() ? "'" : ", '") + m + "'";
+      std::error_code ec;
+      if (!fs::exists(file, ec))
+        throw BadInput(input + ": the recording's programs need the plugin " + file + " (controllers " + names +
+                       "), which is not there; give it with --plugin FILE or TURTLEGAS_PLUGIN_PATH");
+      load_plugins({file}, registry, "named by the recording " + input);
+    }
+    return;
+  }
+  // A world file: its "plugins" key, if it has one (a world without the word is not parsed here).
+  in.clear();
+  in.seekg(0);
+  std::ostringstream buf;
+  buf << in.rdbuf();
+  const std::string text = buf.str();
+  if (text.find("\"plugins\"") == std::string::npos) return;
+  const nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
+  if (!doc.is_object()) return;  // the world file's reader names the problem
+  const auto p = doc.find("plugins");
+  if (p == doc.end()) return;
+  if (!p->is_array())
+    throw BadInput(input + ": /plugins: a list of plugin files, relative to the world file, e.g. [\"build/libfeeler.so\"]");
+  std::vector<std::string> files;
+  const fs::path dir = fs::path(input).parent_path();
+  for (std::size_t k = 0; k < p->size(); ++k) {
+    const nlohmann::json& f = (*p)[k];
+    if (!f.is_string() || f.get<std::string>().empty())
+      throw BadInput(input + ": /plugins/" + std::to_string(k) + ": a plugin file's path (a string), relative to the world file");
+    const fs::path given = f.get<std::string>();
+    files.push_back((given.is_absolute() ? given : dir / given).string());
+    if (files.back().find('/') == std::string::npos) files.back() = "./" + files.back();
+  }
+  load_plugins(files, registry, "/plugins of " + input);
+}
+
+void load_sweep_plugins(const std::string& spec, turtle::Registry& registry) {
+  std::ifstream in(spec, std::ios::binary);
+  if (!in) return;  // the sweep says why
+  std::ostringstream buf;
+  buf << in.rdbuf();
+  const nlohmann::json doc = nlohmann::json::parse(buf.str(), nullptr, false);
+  if (!doc.is_object() || !doc.contains("world") || !doc["world"].is_string()) return;
+  const fs::path world = doc["world"].get<std::string>();
+  load_input_plugins((world.is_absolute() ? world : fs::path(spec).parent_path() / world).string(), registry);
 }
 
 }  // namespace turtlegas::apps

@@ -3,8 +3,11 @@
 // that add controllers to the registry.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "turtlegas/turtle/registry.hpp"
 
@@ -23,5 +26,21 @@ void load_plugins(const std::vector<std::string>& paths, turtle::Registry& regis
 /// The plugins a TURTLEGAS_PLUGIN_PATH value names: colon-separated entries, each a plugin file or
 /// a directory whose `*.so` files are all loaded (in name order). Empty entries are skipped.
 std::vector<std::string> plugin_path_entries(const char* value);
+
+/// The plugin file (its absolute path) that registered `controller`; none for a built-in.
+std::optional<std::string> plugin_of(const std::string& controller);
+
+/// For a recording's header (formats::RecordingHeader::plugins): the plugins whose controllers
+/// `controllers` names, [{"file": ABSOLUTE_PATH, "controllers": [NAME, ...]}, ...].
+nlohmann::ordered_json plugins_used(const std::vector<std::string>& controllers);
+
+/// The plugins `input` names, loaded: a world file's "plugins" (paths relative to the world file;
+/// docs/worlds.md), or a recording's (formats::RecordingHeader::plugins) whose controllers are not
+/// registered already. BadInput naming the input for a plugin that is missing or bad (a
+/// recording's: which plugin, which controllers, and how to give it). Anything else about the
+/// input is left to the command that reads it.
+void load_input_plugins(const std::string& input, turtle::Registry& registry);
+/// load_input_plugins for the world a sweep spec names ("world", relative to the spec).
+void load_sweep_plugins(const std::string& spec, turtle::Registry& registry);
 
 }  // namespace turtlegas::apps

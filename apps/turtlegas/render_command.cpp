@@ -29,6 +29,7 @@
 #include "turtlegas/formats/svg_snapshot.hpp"
 #include "turtlegas/sim/angles.hpp"
 #include "turtlegas/turtle/game.hpp"
+#include "turtlegas/turtle/program_log.hpp"
 #include "turtlegas/turtle/view.hpp"
 #include "turtlegas/world/file_error.hpp"
 #include "turtlegas/world/world_file.hpp"
@@ -251,6 +252,8 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opt) {
   r->add_option("--to", opt.to, "The last frame's time (default: the recording's end; needed for a world file)")
       ->check(real_in(0, big, "seconds"));
   r->add_option("--width", opt.width, "Pixels across the arena's longer side")->capture_default_str()->check(real_in(16, 8192, "pixels"));
+  r->add_flag("--program-logs", opt.program_logs,
+              "Print the turtle programs' log lines as the world is run again to draw it (off: the run printed them)");
   r->add_option("--view", opt.view, "Draw what this view of the world shows (its \"views\")");
   opt.limits.add_to(*r, "the rendering", "the frames drawn so far kept");
   return r;
@@ -258,6 +261,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& opt) {
 
 int render_command(const RenderOptions& opt, const turtle::Registry& registry) {
   const auto start = Clock::now();
+  turtle::set_program_logs(opt.program_logs);
   const bool one = opt.at.has_value();
   const bool many = !opt.frames.empty() || !opt.video.empty();
   if (one == many)
@@ -356,7 +360,7 @@ int render_command(const RenderOptions& opt, const turtle::Registry& registry) {
       char rate[32];
       std::snprintf(rate, sizeof rate, "%.10g", opt.fps);
       std::vector<std::string> args = {ffmpeg, "-loglevel", "error", "-y", "-framerate", rate, "-i", (dir / "frame-%05d.png").string(),
-                                        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", tmp.string()};
+                                        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white", "-pix_fmt", "yuv420p", tmp.string()};
       std::vector<char*> argv;
       argv.reserve(args.size() + 1);  // and the closing null
       for (std::string& a : args) argv.push_back(a.data());

@@ -26,6 +26,7 @@ struct RenderOptions {
   double width = 800.0;            ///< pixels across the arena's longer side
   std::string view;                ///< a view id (the world's "views")
   LimitOptions limits;             ///< --max-wall-seconds, --max-events
+  bool program_logs = false;       ///< print the programs' Turtle::log lines again (the recorded run printed them)
 };
 
 CLI::App* add_render_command(CLI::App& app, RenderOptions& opt);

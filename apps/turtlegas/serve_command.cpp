@@ -14,6 +14,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cli_common.hpp"
+#include "plugins.hpp"
 #include "output_file.hpp"
 #include "turtlegas/formats/recording.hpp"
 #include "turtlegas/world/file_error.hpp"
@@ -258,6 +259,9 @@ PreparedServe prepare_serve(const ServeCommandOptions& opt, const turtle::Regist
     h.until.reset();
   } else {
     scene = load(opt.world, registry);
+    std::vector<std::string> controllers;
+    for (const turtle::TurtleProgram& p : scene.programs) controllers.push_back(p.controller);
+    h.plugins = plugins_used(controllers);
     std::ifstream in(opt.world, std::ios::binary);
     std::ostringstream text;
     text << in.rdbuf();

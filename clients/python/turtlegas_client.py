@@ -511,8 +511,29 @@ class World:
     def run_until(self, t):
         return self.request({"type": "run_until", "t": t})
 
+    # World changes (docs/protocol.md, "World changes"): answered at the boundary they are made at.
+    # In lockstep a boundary that waits for one of this connection's turtles makes them there and
+    # then, so calling them between a turtle's commands cannot hold the world up.
     def add_wall(self, wall_id, start, end):
         return self.request({"type": "add_wall", "wall": {"id": wall_id, "from": list(start), "to": list(end)}})
+
+    def spawn(self, ball=None, turtle=None):
+        """Adds a body: one world-file entry, e.g. spawn(ball={"id": "b9", "pos": [50, 50], "radius": 4})."""
+        if (ball is None) == (turtle is None):
+            raise ValueError("spawn(ball=...) or spawn(turtle=...), one of them")
+        return self.request({"type": "spawn", "ball": dict(ball)} if ball is not None else {"type": "spawn", "turtle": dict(turtle)})
+
+    def remove(self, body):
+        return self.request({"type": "remove", "body": body})
+
+    def teleport(self, body, pos, heading=None, vel=None):
+        """Moves a ball (vel: its new velocity, else kept) or a turtle (heading in degrees, else kept)."""
+        m = {"type": "teleport", "body": body, "pos": list(pos)}
+        if heading is not None:
+            m["heading"] = heading
+        if vel is not None:
+            m["vel"] = list(vel)
+        return self.request(m)
 
     def save(self, file):
         return self.request({"type": "save", "file": file})

@@ -115,6 +115,19 @@ std::string input_view_line(std::uint64_t step, std::string_view op, const nlohm
   return line(step, "view", v);
 }
 
+std::string input_while_waiting(std::string line, std::string_view turtle, std::size_t taken) {
+  // Every line ends "}\n": the members go in before it.
+  line.resize(line.size() - 2);
+  line += ", \"waiting\": ";
+  append_json_string(line, turtle);
+  if (taken > 0) {
+    line += ", \"taken\": ";
+    line += std::to_string(taken);
+  }
+  line += "}\n";
+  return line;
+}
+
 std::string input_remove_line(std::uint64_t step, std::string_view id) {
   return line(step, "remove", json_string(id));
 }
@@ -176,6 +189,12 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
       Change c;
       c.kind = kind;
       c.step = step;
+      if (j.contains("waiting")) {
+        c.waiting = index_of(j.at("waiting").get<std::string>(), line, "waiting");
+        const auto taken = j.find("taken");
+        if (taken != j.end() && !taken->is_number_unsigned()) fail("/taken: a count of commands >= 0");
+        if (taken != j.end()) c.taken = taken->get<std::size_t>();
+      }
       return c;
     };
     try {
@@ -262,28 +281,46 @@ void ReplayInput::apply_view(turtle::WorldServer& server, const nlohmann::json& 
   }
 }
 
+void ReplayInput::apply(turtle::WorldServer& server, Change& c) const {
+  switch (c.kind) {
+    case Change::Kind::takeover: server.make_remote(c.turtle); break;
+    case Change::Kind::add_wall: server.add_wall(c.wall); break;
+    case Change::Kind::spawn: spawn_(server, c.body); break;
+    case Change::Kind::remove: server.remove_body(c.id); break;
+    case Change::Kind::teleport:
+      if (c.vel) server.teleport_ball(c.id, c.pos, *c.vel);
+      else server.teleport_turtle(c.id, c.pos, *c.heading);
+      break;
+    case Change::Kind::view: apply_view(server, c.body, c.step); break;
+  }
+}
+
 void ReplayInput::at_boundary(turtle::WorldServer& server, std::uint64_t step) {
+  server_ = &server;
+  step_ = step;
+  taken_.assign(commands_.size(), 0);
+  // The boundary's own changes, up to the first one made while the world waited for a command
+  // (next() makes that one, in its turtle's turn).
   while (!changes_.empty() && changes_.front().step <= step) {
+    if (changes_.front().step < step)
+      throw std::runtime_error(file_ + ": the change recorded at step " + std::to_string(changes_.front().step) +
+                               " was not reached at that step; is this the log of this world?");
+    if (changes_.front().waiting) break;
     Change c = std::move(changes_.front());
     changes_.pop_front();
-    if (c.step < step)
-      throw std::runtime_error(file_ + ": the change recorded at step " + std::to_string(c.step) +
-                               " was not reached at that step; is this the log of this world?");
-    switch (c.kind) {
-      case Change::Kind::takeover: server.make_remote(c.turtle); break;
-      case Change::Kind::add_wall: server.add_wall(c.wall); break;
-      case Change::Kind::spawn: spawn_(server, c.body); break;
-      case Change::Kind::remove: server.remove_body(c.id); break;
-      case Change::Kind::teleport:
-        if (c.vel) server.teleport_ball(c.id, c.pos, *c.vel);
-        else server.teleport_turtle(c.id, c.pos, *c.heading);
-        break;
-      case Change::Kind::view: apply_view(server, c.body, c.step); break;
-    }
+    apply(server, c);
   }
 }
 
 std::optional<turtle::RemoteCommand> ReplayInput::next(std::uint64_t step, std::size_t turtle) {
+  if (taken_.size() <= turtle) taken_.resize(turtle + 1, 0);
+  // The changes made while the world waited for this turtle, at this point of the boundary.
+  while (server_ && step == step_ && !changes_.empty() && changes_.front().step == step && changes_.front().waiting == turtle &&
+         changes_.front().taken == taken_[turtle]) {
+    Change c = std::move(changes_.front());
+    changes_.pop_front();
+    apply(*server_, c);
+  }
   if (turtle >= commands_.size()) return std::nullopt;
   std::deque<Command>& q = commands_[turtle];
   if (q.empty() || q.front().step > step) return std::nullopt;
@@ -292,6 +329,7 @@ std::optional<turtle::RemoteCommand> ReplayInput::next(std::uint64_t step, std::
                              std::to_string(q.front().step) + " where the log gives it a command; is this the log of this world?");
   const turtle::RemoteCommand c = q.front().command;
   q.pop_front();
+  ++taken_[turtle];
   return c;
 }
 

@@ -35,15 +35,25 @@ SpeedScale scale_of_speeds(std::vector<double> speeds) {
   return s;
 }
 
-Layout layout_for(double w, double h, double width_px) {
+Layout layout_for(double w, double h, double width_px, bool legend) {
   Layout l;
   l.scale = width_px / std::max(w, h);
   l.top = title_h + margin;
-  l.width = w * l.scale + 2 * margin + legend_w;
+  l.width = w * l.scale + 2 * margin + (legend ? legend_w : 0.0);
   l.height = std::max(h * l.scale, min_world_h) + title_h + 2 * margin;
   l.legend_x = margin + w * l.scale + legend_dx;
   l.legend_y = l.top + legend_dy;
   return l;
+}
+
+LabelSpot label_spot(double cx, double cy, double r, double text_w, double text_h, double width, double height) {
+  constexpr double gap = 2.0;
+  LabelSpot s{cx + r + gap, cy - r};
+  if (s.x + text_w > width - gap) s.x = cx - r - gap - text_w;  // off the right edge: on the left
+  if (s.y - text_h < gap) s.y = cy + r + text_h;                 // off the top: below
+  s.x = std::clamp(s.x, gap, std::max(gap, width - gap - text_w));
+  s.y = std::clamp(s.y, text_h + gap, std::max(text_h + gap, height - gap));
+  return s;
 }
 
 }  // namespace turtlegas::formats::look

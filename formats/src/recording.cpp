@@ -25,7 +25,7 @@ bool starts_with(std::string_view s, std::string_view p) { return s.substr(0, p.
 
 RecordingWriter::RecordingWriter(std::ostream& out, const RecordingHeader& h) : out_(out), policy_(h.keyframes) {
   // Ordered, so that the format comes first (nlohmann::json sorts its keys).
-  const nlohmann::ordered_json header = {
+  nlohmann::ordered_json header = {
       {"format", recording_format},
       {"command", h.command},
       {"world_file", h.world_file},
@@ -35,6 +35,7 @@ RecordingWriter::RecordingWriter(std::ostream& out, const RecordingHeader& h) : 
       {"keyframes", {{"every_seconds", h.keyframes.seconds}, {"every_events", h.keyframes.events}}},
       {"world", h.world},
   };
+  if (h.plugins.is_array() && !h.plugins.empty()) header["plugins"] = h.plugins;
   buf_ = header.dump();
   buf_ += '\n';
   put();
@@ -139,6 +140,10 @@ RecordingHeader parse_header(const std::string& line, const std::string& path) {
     r.command = h.value("command", std::string("run"));
     r.keyframes.seconds = h.at("keyframes").at("every_seconds").get<double>();
     r.keyframes.events = h.at("keyframes").at("every_events").get<std::uint64_t>();
+    if (const auto p = h.find("plugins"); p != h.end()) {
+      for (const auto& e : *p) (void)e.at("file").get<std::string>(), (void)e.at("controllers").get<std::vector<std::string>>();
+      r.plugins = *p;
+    }
   } catch (const json::exception& e) {
     throw std::invalid_argument(where + "the header (line 1) lacks a key or has one of the wrong type (" +
                                 std::string(e.what()) + "); the recording is damaged");

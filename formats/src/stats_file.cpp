@@ -64,6 +64,7 @@ nlohmann::json stats_json(const RunFigures& run, const sim::World& world) {
       {"steps", st.steps},
       {"events", st.events},
       {"wall_seconds", run.wall_seconds},
+      {"check_seconds", run.check_seconds},
       {"collisions_per_second", run.collisions_per_second(st)},
       {"energy_start", run.energy_start},
       {"energy_end", run.energy_end},

@@ -45,7 +45,7 @@ Snapshot snapshot_of(const sim::WorldDef& def) {
     for (auto& w : sim::arena_walls(def.arena)) s.walls.push_back(std::move(w));
   s.balls.reserve(def.balls.size());
   for (const auto& b : def.balls) s.balls.push_back({b.pos, b.vel, b.radius});
-  for (const auto& t : def.turtles) s.turtles.push_back({t.id, t.pos, t.heading, t.radius, {}, false});
+  for (const auto& t : def.turtles) s.turtles.push_back({t.id, t.pos, t.heading, t.radius, {}, false, t.layers});
   return s;
 }
 
@@ -61,7 +61,7 @@ Snapshot snapshot_of(const turtle::WorldServer& server, const sim::WorldDef& def
 
 void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
   const double aw = snap.arena.width, ah = snap.arena.height;
-  const look::Layout layout = look::layout_for(aw, ah, width_px);
+  const look::Layout layout = look::layout_for(aw, ah, width_px, !snap.balls.empty());
   const double scale = layout.scale, margin = look::margin, w = layout.width, h = layout.height, top = layout.top;
 
   // Colours span 0 to the 99th-percentile speed (look.hpp).
@@ -88,8 +88,12 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
   for (const auto& wall : snap.walls) {
     const sim::WallKey pose = sim::wall_pose(wall, snap.time);
     const bool there = sim::wall_visible(wall, snap.time);
-    out << "<line x1=\"" << fmt(pose.from.x) << "\" y1=\"" << fmt(pose.from.y) << "\" x2=\"" << fmt(pose.to.x)
-        << "\" y2=\"" << fmt(pose.to.y) << (there ? "\" stroke=\"#222\"" : "\" stroke=\"#bbb\" stroke-dasharray=\"4 3\"")
+    const bool passable = look::passable_by_some(wall, snap.turtles);
+    out << "<line" << (passable ? " class=\"wall-passable\"" : "") << " x1=\"" << fmt(pose.from.x) << "\" y1=\"" << fmt(pose.from.y)
+        << "\" x2=\"" << fmt(pose.to.x) << "\" y2=\"" << fmt(pose.to.y)
+        << (!there      ? "\" stroke=\"#bbb\" stroke-dasharray=\"4 3\""
+            : passable ? "\" stroke=\"" + look::hex(look::wall_passable_colour) + "\" stroke-dasharray=\"6 3\""
+                       : std::string("\" stroke=\"#222\""))
         << " stroke-width=\"2\" stroke-linecap=\"round\" vector-effect=\"non-scaling-stroke\"/>\n";
   }
   for (const auto& trail : snap.ball_trails) {
@@ -140,9 +144,13 @@ void write_svg(std::ostream& out, const Snapshot& snap, double width_px) {
   out << "</g>\n";
   // Labels in pixel coordinates (outside the flipped group, so the text is upright), beside each
   // turtle's upper right.
+  // A label that would leave the picture goes to the turtle's left (or below it) instead (look.hpp);
+  // its width is estimated at 0.62 em a character, a little over sans-serif's average.
   for (const auto& t : snap.turtles) {
-    const double px = margin + (t.pos.x + t.radius) * scale + 2.0, py = top + (ah - t.pos.y - t.radius) * scale;
-    out << "<text class=\"turtle-id\" x=\"" << fmt(px) << "\" y=\"" << fmt(py) << "\" font-size=\"11\">"
+    const double text_w = 11.0 * 0.62 * static_cast<double>(t.id.size());
+    const look::LabelSpot spot = look::label_spot(margin + t.pos.x * scale, top + (ah - t.pos.y) * scale, t.radius * scale,
+                                                  text_w, 11.0, w, h);
+    out << "<text class=\"turtle-id\" x=\"" << fmt(spot.x) << "\" y=\"" << fmt(spot.y) << "\" font-size=\"11\">"
         << xml_escape(t.id) << "</text>\n";
   }
 

@@ -13,6 +13,7 @@
 #include <spdlog/spdlog.h>
 
 #include "host_text.hpp"
+#include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/state_file.hpp"
 #include "turtlegas/server/protocol.hpp"
 #include "turtlegas/server/world_host.hpp"
@@ -127,7 +128,15 @@ void WorldHost::do_file_requests() {
   }
 }
 
-void WorldHost::write_input(const std::string& line) {
+std::string WorldHost::input_line(std::string line) const {
+  if (!waiting_) return line;
+  const Slot& s = slots_[*waiting_];
+  return formats::input_while_waiting(std::move(line), scene_.def.turtles[*waiting_].id,
+                                      s.taken_step == server_->step() ? s.taken : 0);
+}
+
+void WorldHost::write_input(const std::string& raw) {
+  const std::string line = input_line(raw);
   if (inputs_file_) {
     *inputs_file_ << line;
     inputs_file_->flush();  // on disk as it is taken (the header is, too: host_world.cpp)

@@ -46,6 +46,7 @@ void WorldHost::start_recording() {
   h.dt = scene_.def.dt;
   h.until = options_.until;
   h.keyframes = options_.keyframes;
+  h.plugins = options_.plugins;
   recorder_.emplace(*record_file_, h);
   recorder_->keyframe(server_->world(), formats::RunNames{ball_ids_, scene_.def, server_->world()});
   next_key_ = next_multiple(server_->time(), options_.keyframes.seconds);
@@ -89,7 +90,7 @@ void WorldHost::finish_recording(const std::string& stopped, bool keyframe) {
 }
 
 void WorldHost::record_view(const char* op, const nlohmann::json& view) {
-  if (recorder_) recorder_->input(formats::input_view_line(server_->step(), op, view));
+  if (recorder_) recorder_->input(input_line(formats::input_view_line(server_->step(), op, view)));
 }
 
 std::shared_ptr<turtle::InputSource> WorldHost::world_input() {

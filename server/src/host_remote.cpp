@@ -35,16 +35,27 @@ class WorldHost::Input : public turtle::InputSource {
 
 std::shared_ptr<turtle::InputSource> WorldHost::remote_input() { return std::make_shared<Input>(*this); }
 
-void WorldHost::release_all(ClientState& c, const char* why) {
+void WorldHost::release_all(ClientState& c, const char* why, const char* code, const std::string& message) {
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     Slot& s = slots_[i];
     if (s.owner != c.client->id) continue;
     s.owner = 0;
     if (s.queued) {  // accepted, not yet taken: dropped
+      if (code) {
+        ++c.errors;
+        reply_text(c, error_text(code, message, &s.queued_id, {}, "/turtle"));
+      }
       s.queued.reset();
+      s.queued_id = nullptr;
       s.busy = false;
     }
-    if (s.busy) s.orphan = true;
+    if (s.busy) {
+      s.orphan = true;
+      if (code && !s.inflight_id.is_null()) {  // its sender is told now; the result, when it comes, is dropped
+        ++c.errors;
+        reply_text(c, error_text(code, message, &s.inflight_id, {}, "/turtle"));
+      }
+    }
     spdlog::info("turtle '{}' released ({}, connection {}); it stands still", scene_.def.turtles[i].id, why, c.client->id);
   }
   std::erase_if(takeovers_, [&](const Takeover& t) { return t.client == c.client->id; });
@@ -160,10 +171,24 @@ void WorldHost::apply_takeovers(turtle::WorldServer& server, std::uint64_t step)
 
 std::optional<turtle::RemoteCommand> WorldHost::next_command(std::uint64_t step, std::size_t turtle) {
   drain_inbox();
-  Slot& s = slots_[turtle];
-  if (!s.queued && s.owner != 0 && !options_.realtime && !stopping_) {
+  // (slots_[turtle] is looked up afresh after each change: a spawn grows slots_.)
+  if (!slots_[turtle].queued && slots_[turtle].owner != 0 && !options_.realtime && !stopping_) {
+    // The world waits here for the owner's command. A client may well wait for something else
+    // first: the `ok` of an add_wall or spawn, a claim with takeover, a save. Those are made here
+    // and now, at this boundary (recorded as made while waiting, so that a replay makes them at
+    // the same point), so that no client's request waits for a boundary that waits for that
+    // client. A load cannot be made inside a step: the wait ends (the turtle stands still until
+    // the next boundary) and the load is done when the step is.
+    waiting_ = turtle;
     const double deadline = now() + options_.lockstep_timeout;
-    while (!s.queued && s.owner != 0 && !stopping_) {
+    auto pending_load = [&] {
+      return std::any_of(file_requests_.begin(), file_requests_.end(), [](const FileRequest& f) { return f.load; });
+    };
+    for (;;) {
+      apply_changes(*server_, step);
+      if (!file_requests_.empty() && !pending_load()) do_file_requests();  // saves only
+      Slot& s = slots_[turtle];
+      if (s.queued || s.owner == 0 || stopping_ || pending_load()) break;
       const double t = now();
       if (t >= deadline) {
         // The client that holds the world up loses its claims, not everyone their world: its
@@ -181,7 +206,7 @@ std::optional<turtle::RemoteCommand> WorldHost::next_command(std::uint64_t step,
         }
         ++it->second.errors;
         reply_text(it->second, error_text("lockstep_timeout", why));
-        release_all(it->second, "lockstep timeout");
+        release_all(it->second, "lockstep timeout", "lockstep_timeout", why);
         break;
       }
       send_due_frames(t);
@@ -190,13 +215,18 @@ std::optional<turtle::RemoteCommand> WorldHost::next_command(std::uint64_t step,
       wait_inbox_until(wake);
       drain_inbox();
     }
+    waiting_.reset();
   }
+  Slot& s = slots_[turtle];
   if (!s.queued) return std::nullopt;
   const turtle::RemoteCommand c = *s.queued;
   s.queued.reset();
   s.inflight_id = s.queued_id;
   s.queued_id = nullptr;
   write_input(formats::input_command_line(step, scene_.def.turtles[turtle].id, c));
+  if (s.taken_step != step) s.taken = 0;
+  s.taken_step = step;
+  ++s.taken;
   return c;
 }
 

@@ -21,7 +21,9 @@
 //   6. the world advances one control step (step_world). At each control boundary inside it
 //      (at_boundary, called by the runtime): the inbox is drained again, then claims with takeover,
 //      walls, and spawn/remove/teleport are applied, in that order, and written to the input log;
-//      a lockstep remote turtle's command is waited for there (next_command, host_remote.cpp);
+//      a lockstep remote turtle's command is waited for there (next_command, host_remote.cpp),
+//      and changes and saves that come meanwhile are made there and then (their senders may wait
+//      for them before they send that command);
 //   7. the step's events go to the event log, the recording and the subscribers' frames;
 //   8. a `step` count or a run_until's time reached pauses; --until stops.
 #include "turtlegas/server/world_host.hpp"
@@ -216,6 +218,10 @@ void WorldHost::at_boundary(turtle::WorldServer& server, std::uint64_t step) {
   // request would see a seek's way rather than its end.
   if (options_.replay) return;
   drain_inbox();
+  apply_changes(server, step);
+}
+
+void WorldHost::apply_changes(turtle::WorldServer& server, std::uint64_t step) {
   apply_takeovers(server, step);
   apply_wall_changes(server, step);
   apply_body_changes(server, step);

@@ -232,6 +232,85 @@ TEST_CASE("plugins: TURTLEGAS_PLUGIN_PATH names plugin files and directories, fo
   CHECK(twice.code == 0);
 }
 
+TEST_CASE("plugins: a world file's \"plugins\" key, relative to the world file (issue 32)") {
+  TempDir dir;
+  fs::create_directories(dir.path / "lib");
+  fs::create_directories(dir.path / "worlds");
+  fs::copy_file(FEELER_PLUGIN, dir.path / "lib" / "libfeeler.so");
+  json w = json::parse(read(feeler_world));
+  w["plugins"] = {"../lib/libfeeler.so"};  // from the world file's directory, not the working one
+  const fs::path world = dir.write("worlds/feeler.json", w.dump());
+  const Result check = run(dir.path, {"check", world.string()});
+  INFO(check.err);
+  CHECK(check.code == 0);
+  CHECK(contains(check.out, "controllers: feeler"));
+  const fs::path events = dir.path / "e.jsonl";
+  const Result r = run(dir.path, {"run", world.string(), "--until", "20", "--events", events.string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(contains(read(events), "\"touch\""));
+  // The same file by --plugin as well is loaded once (no clash with itself).
+  CHECK(run(dir.path, {"run", world.string(), "--until", "1", "--plugin", (dir.path / "lib" / "libfeeler.so").string()}).code == 0);
+
+  // A sweep of that world (its children too) loads them as well.
+  dir.write("worlds/sweep.json", R"({"format": "turtlegas-sweep/1", "world": "feeler.json", "until": 2, "seeds": [1, 2]})");
+  const Result sweep = run(dir.path, {"sweep", (dir.path / "worlds" / "sweep.json").string(), "--jobs", "2", "--out",
+                                      (dir.path / "results.jsonl").string()});
+  INFO(sweep.err);
+  CHECK(sweep.code == 0);
+
+  w["plugins"] = {"../lib/libnothere.so"};
+  const fs::path missing = dir.write("worlds/missing.json", w.dump());
+  const Result bad = run(dir.path, {"check", missing.string()});
+  CHECK(bad.code == 2);
+  CHECK(contains(bad.err, "libnothere.so"));
+  CHECK(contains(bad.err, "/plugins of " + missing.string()));
+  w["plugins"] = "../lib/libfeeler.so";
+  const fs::path not_list = dir.write("worlds/not_list.json", w.dump());
+  const Result bad2 = run(dir.path, {"run", not_list.string(), "--until", "1"});
+  CHECK(bad2.code == 2);
+  CHECK(contains(bad2.err, "/plugins"));
+}
+
+TEST_CASE("plugins: a recording names its plugins; render loads them, names one missing, and is quiet (issue 32)") {
+  TempDir dir;
+  fs::create_directories(dir.path / "lib");
+  const fs::path plugin = dir.path / "lib" / "libfeeler.so";
+  fs::copy_file(FEELER_PLUGIN, plugin);
+  const fs::path rec = dir.path / "r.tgrec";
+  const Result r = run(dir.path, {"run", feeler_world, "--until", "120", "--plugin", plugin.string(), "--record", rec.string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(contains(r.err, "turtle 'feeler'"));  // the run prints its program's log lines
+  std::string header;
+  {
+    std::ifstream in(rec);
+    std::getline(in, header);
+  }
+  const json h = json::parse(header);
+  REQUIRE(h.contains("plugins"));
+  CHECK(h.at("plugins") == json::array({{{"file", fs::canonical(plugin).string()}, {"controllers", {"feeler"}}}}));
+
+  // No --plugin: the recording's own is loaded; its log lines are not printed again unless asked.
+  const Result draw = run(dir.path, {"render", rec.string(), "--at", "110", "--out", (dir.path / "a.png").string()});
+  INFO(draw.err);
+  CHECK(draw.code == 0);
+  CHECK_FALSE(contains(draw.err, "turtle 'feeler'"));
+  const Result loud = run(dir.path, {"render", rec.string(), "--at", "110", "--out", (dir.path / "b.png").string(), "--program-logs"});
+  CHECK(loud.code == 0);
+  CHECK(contains(loud.err, "turtle 'feeler'"));
+
+  // Gone: render names the plugin and its controller; given another way, it is found.
+  fs::remove(plugin);
+  const Result gone = run(dir.path, {"render", rec.string(), "--at", "110", "--out", (dir.path / "c.png").string()});
+  CHECK(gone.code == 2);
+  CHECK(contains(gone.err, "the recording's programs need the plugin " + fs::canonical(dir.path).string() + "/lib/libfeeler.so"));
+  CHECK(contains(gone.err, "'feeler'"));
+  const Result replaced = run(dir.path, {"render", rec.string(), "--at", "110", "--out", (dir.path / "d.png").string(), "--plugin", FEELER_PLUGIN});
+  INFO(replaced.err);
+  CHECK(replaced.code == 0);
+}
+
 // `turtlegas test` runs each world in a process of its own (the test plugin's misbehaving
 // programs), a few at a time, and reports in JUnit XML and TAP 13.
 namespace {

@@ -214,6 +214,30 @@ TEST_CASE("cli: a run writes events, state and stats") {
   }
 }
 
+TEST_CASE("cli: --stats' collisions per second leave the overlap self-check out (issue 32)") {
+  // A gas measured at 1000 instants: the samples take a good share of the wall time, which the
+  // speed printed and written must not count.
+  TempDir dir;
+  const fs::path w = dir.write("gas.json", R"({"format": "turtlegas-world/1", "seed": 3,
+    "arena": {"width": 400, "height": 400, "boundary": "walls"},
+    "gas": [{"count": 3000, "radius": 2, "speed": 50, "region": [[5, 5], [395, 395]]}]})");
+  const fs::path stats = dir.path / "stats.json";
+  const Result r = run(dir, {"run", w.string(), "--until", "2", "--stats-json", stats.string(), "--stats",
+                             "--overlap-samples", "1000"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const json st = json::parse(read(stats));
+  REQUIRE(st.contains("check_seconds"));
+  const double wall = st.at("wall_seconds").get<double>(), check = st.at("check_seconds").get<double>();
+  CHECK(check > 0.0);
+  CHECK(check < wall);
+  const double collisions = st.at("collisions").get<double>();
+  REQUIRE(collisions > 0.0);
+  const double expected = collisions / (wall - check);
+  CHECK(std::abs(st.at("collisions_per_second").get<double>() - expected) <= 1e-12 * expected);
+  CHECK(contains(r.out, "self-check"));
+}
+
 TEST_CASE("cli: the same run gives the same event log, byte for byte") {
   TempDir dir;
   const fs::path w = dir.write("box.json", box_world);

@@ -205,7 +205,8 @@ def check_render():
     assert near(px(56, 50), (0x22, 0x22, 0x22), 60), px(56, 50)    # its heading tick, east (90 degrees)
     assert near(px(50, 44), body, 16) and near(px(44, 50), body, 16)
     assert near(px(50, 63), floor), px(50, 63)              # just outside its radius of 10
-    assert (w, h) == (int(200 * s + 24 + 90), int(100 * s + 30 + 24)), (w, h)
+    # No balls, so no speed legend and no 90 px column for it (issue 32); sides even (an mp4's).
+    assert (w, h) == (int(200 * s + 24), int(100 * s + 30 + 24)), (w, h)
     # Later, the turtle has moved: at t = 1 s it drove 20 units east (speed 20).
     run("render", world, "--at", 1, "--out", png)
     _, _, rows = png_pixels(read(png))
@@ -214,7 +215,7 @@ def check_render():
     # --view: a fixed view crops (40 x 40 units around the turtle's start: 20 px a unit) ...
     run("render", world, "--at", 0, "--view", "corner", "--out", png)
     w, h, rows = png_pixels(read(png))
-    assert (w, h) == (800 + 24 + 90, 800 + 30 + 24), (w, h)
+    assert (w, h) == (800 + 24, 800 + 30 + 24), (w, h)
     vx = lambda x, y, size, sc: rows[int(top + (size / 2 - y) * sc)][int(left + (x + size / 2) * sc)]
     assert near(vx(0, 6, 40, 20), body, 16), vx(0, 6, 40, 20)        # the turtle at the view's centre
     assert near(vx(6, 0, 40, 20), (0x22, 0x22, 0x22), 60)          # its tick, east
@@ -236,6 +237,30 @@ def check_render():
     run("render", world, "--frames", frames, "--fps", 10, "--from", 0.5, "--to", 1.5)
     names = sorted(os.listdir(frames))
     assert names == ["frame-%05d.png" % k for k in range(11)], names
+    # A window of an odd pixel height: the frame's sides are made even, the extra row white (an mp4
+    # needs even sides, and ffmpeg's padding of an odd one was a black row).
+    odd = path("odd")
+    run("render", world, "--frames", odd, "--fps", 1, "--from", 0, "--to", 0, "--width", 1001)  # 500.5 + 54 px high
+    w, h, rows = png_pixels(read(os.path.join(odd, "frame-00000.png")))
+    assert w % 2 == 0 and h % 2 == 0, (w, h)
+    assert all(c == (255, 255, 255) for c in rows[-1]) and all(r[-1] == (255, 255, 255) for r in rows), "white edges"
+    # A turtle's id at the right edge stays in the picture, drawn to its left (it was cut off).
+    edge = path("edge.json")
+    with open(world) as f:
+        scene = json.load(f)
+    scene["turtles"][0]["pos"] = [188, 50]
+    scene["turtles"][0]["id"] = "a-long-turtle-name"
+    scene["views"] = []
+    with open(edge, "w") as f:
+        json.dump(scene, f)
+    run("render", edge, "--at", 0, "--out", png)
+    w, h, rows = png_pixels(read(png))
+    # The turtle's disc spans x 712..772 px; its upper edge is at y 202 px, where the label's baseline goes.
+    cx, cy, r = left + 188 * s, top + 50 * s, 10 * s
+    dark = lambda x0, x1: sum(1 for y in range(int(cy - r - 14), int(cy - r + 2)) for x in range(int(x0), int(x1))
+                              if max(rows[y][x]) < 80)
+    assert dark(cx - r - 130, cx - r - 1) > 20, "the label, left of the turtle"
+    assert w >= cx + r, (w, cx)
     # An SVG from the same scene.
     run("render", world, "--at", 0.25, "--out", path("scene.svg"))
     assert b"<svg" in read(path("scene.svg"))

@@ -36,6 +36,11 @@ TEST_CASE("input log: the header and every kind of line, byte for byte") {
   wall.to = {-3, 4};
   CHECK(formats::input_wall_line(5, wall) ==
         "{\"step\": 5, \"add_wall\": {\"id\": \"w9\", \"from\": [1, 2.5], \"to\": [-3, 4]}}\n");
+  // Made while the world waited at a boundary for a turtle's command (issue 32 section 1).
+  CHECK(formats::input_while_waiting(formats::input_wall_line(5, wall), "t1", 0) ==
+        "{\"step\": 5, \"add_wall\": {\"id\": \"w9\", \"from\": [1, 2.5], \"to\": [-3, 4]}, \"waiting\": \"t1\"}\n");
+  CHECK(formats::input_while_waiting(formats::input_remove_line(6, "b1"), "t\"2", 3) ==
+        "{\"step\": 6, \"remove\": \"b1\", \"waiting\": \"t\\\"2\", \"taken\": 3}\n");
 
   const nlohmann::json ball = {{"id", "b1"}, {"pos", {1.5, 2}}};
   CHECK(formats::input_spawn_line(9, "ball", ball) ==

@@ -108,3 +108,56 @@ TEST_CASE("an SVG snapshot draws moving walls where they are at its time, and ab
   CHECK(svg.find("x1=\"10\" y1=\"10\" x2=\"20\" y2=\"20\"") != std::string::npos);
   CHECK(count(svg, "stroke-dasharray") == 1);
 }
+
+TEST_CASE("an SVG snapshot without balls has no legend column; labels stay in the picture (issue 32)") {
+  sim::WorldDef def;
+  def.name = "edge";
+  def.arena.width = 200;
+  def.arena.height = 100;
+  sim::TurtleDef t;
+  t.id = "a-long-turtle-name";
+  t.pos = {190, 92};  // at the right edge, near the top
+  t.radius = 5;
+  def.turtles.push_back(t);
+  std::ostringstream out;
+  tf::write_svg(out, tf::snapshot_of(def), 400.0);
+  const std::string svg = out.str();
+  // 400 px of world and two 12 px margins: the 90 px legend column is for balls only.
+  CHECK(svg.find("width=\"424\"") != std::string::npos);
+  const std::size_t at = svg.find("class=\"turtle-id\" x=\"");
+  REQUIRE(at != std::string::npos);
+  const double x = std::stod(svg.substr(at + 22));
+  const double y = std::stod(svg.substr(svg.find("y=\"", at) + 3));
+  // The label's estimated width (0.62 em a character at 11 px) fits left of the right edge, and
+  // it is below the top edge.
+  CHECK(x + 11 * 0.62 * 18 <= 424);
+  CHECK(x < 12 + 185 * 2);  // left of the turtle
+  CHECK(y >= 11);
+
+  def.balls.push_back({"b", {20, 20}, {5, 0}, 3});
+  std::ostringstream with_balls;
+  tf::write_svg(with_balls, tf::snapshot_of(def), 400.0);
+  CHECK(with_balls.str().find("width=\"514\"") != std::string::npos);  // the legend column is back
+}
+
+TEST_CASE("an SVG snapshot marks walls some turtle passes through (issue 32)") {
+  sim::WorldDef def;
+  def.arena.width = 100;
+  def.arena.height = 100;
+  sim::WallDef solid{"solid", {10, 10}, {10, 90}};
+  sim::WallDef ghost{"ghost", {50, 10}, {50, 90}};
+  ghost.layers.category = 2;  // a category of its own ...
+  sim::TurtleDef t;
+  t.id = "t";
+  t.pos = {30, 50};
+  t.layers.mask = ~std::uint32_t{2};  // ... that the turtle does not collide with
+  def.walls = {solid, ghost};
+  def.turtles.push_back(t);
+  REQUIRE(!ghost.layers.collides_with(t.layers));
+  REQUIRE(solid.layers.collides_with(t.layers));
+  std::ostringstream out;
+  tf::write_svg(out, tf::snapshot_of(def), 100.0);
+  const std::string svg = out.str();
+  CHECK(count(svg, "class=\"wall-passable\"") == 1);
+  CHECK(svg.find("class=\"wall-passable\" x1=\"50\"") != std::string::npos);
+}

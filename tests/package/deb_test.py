@@ -122,6 +122,11 @@ def main():
                 missing.append("{} (from {})".format(lib, ", ".join(sorted(pkgs))))
         if missing:
             fail("Depends ({}) lacks the package of: {}".format(fields["Depends"], "; ".join(missing)))
+        # The SDK's registry.hpp includes <nlohmann/json.hpp>: a dependency, not a suggestion.
+        if "nlohmann-json3-dev" not in depends:
+            fail("Depends ({}) lacks nlohmann-json3-dev, which the SDK's headers include".format(fields["Depends"]))
+        if not list(root.glob("usr/lib/cmake/turtlegas/turtlegasConfig.cmake")):
+            fail("the CMake package is not where docs/controllers.md says (usr/lib/cmake/turtlegas)")
 
         apt = ""
         if shutil.which("apt-get"):

@@ -3,6 +3,7 @@
 // calls do, on the program's own stack.
 #include "agent.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -12,6 +13,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sensors.hpp"
+#include "turtlegas/turtle/program_log.hpp"
 #include "server_impl.hpp"
 #include "turtlegas/sim/angles.hpp"
 #include "turtlegas/sim/format.hpp"
@@ -200,8 +202,16 @@ const std::string& Turtle::id() const { return agent_->id; }
 double Turtle::uniform() {
   safe_point();
   return static_cast<double>(agent_->rng() >> 11) * 0x1.0p-53; }
+namespace {
+std::atomic<bool> g_program_logs{true};
+}  // namespace
+
+void set_program_logs(bool on) { g_program_logs.store(on, std::memory_order_relaxed); }
+bool program_logs() { return g_program_logs.load(std::memory_order_relaxed); }
+
 void Turtle::log(const std::string& message) {
   safe_point();
+  if (!program_logs()) return;
   spdlog::info("turtle '{}' t={:.6g}: {}", agent_->id, time(), message); }
 
 double Turtle::radius() const { return agent_->server->def.turtles[agent_->index].radius; }

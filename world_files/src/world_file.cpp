@@ -295,12 +295,19 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
                             std::string(key) + "\" to keep it in the file)");
   check_keys(doc, "", "the world",
              {"format", "name", "seed", "dt", "arena", "effects", "walls", "balls", "turtles", "gas", "expect", "game",
-              "draw", "views"});
+              "draw", "views", "plugins"});
 
   Scene scene;
   sim::WorldDef& def = scene.def;
   def.name = std::string(default_name);
   if (const json* v = find(doc, "name")) def.name = string(*v, "/name");
+  if (const json* v = find(doc, "plugins")) {
+    // Loaded by the program before the file is read (apps/turtlegas/plugins.hpp); checked here.
+    if (!v->is_array()) fail("/plugins", "a list of controller plugin files, relative to the world file, e.g. [\"build/libfeeler.so\"]");
+    for (std::size_t k = 0; k < v->size(); ++k)
+      if (!(*v)[k].is_string() || (*v)[k].get_ref<const std::string&>().empty())
+        fail("/plugins/" + std::to_string(k), "a plugin file's path (a non-empty string), relative to the world file");
+  }
   if (const json* v = find(doc, "seed")) def.seed = natural(*v, "/seed");
   if (const json* v = find(doc, "dt")) def.dt = positive(*v, "/dt", "dt");
   if (const json* v = find(doc, "arena")) read_arena(*v, def.arena);

@@ -11,6 +11,12 @@
 //   {"step": 70, "remove": "b9"}
 //   {"step": 80, "teleport": {"id": "t9", "pos": [120, 80], "heading": 180}}
 //   {"step": 90, "view": {"op": "open", "view": {"id": "v1", "center": [250, 200], ...}}}
+// A change made while a lockstep world waited at a boundary for a remote turtle's command (the
+// host applies it there rather than make its sender wait for a boundary that needs that sender's
+// command; docs/protocol.md, "Lockstep and real time") says so:
+//   {"step": 52, "add_wall": {...}, "waiting": "t1", "taken": 1}
+// it was made inside boundary 52's programs, while the world waited for t1's command, after t1 had
+// taken `taken` commands at that boundary ("taken" is left out when 0). ReplayInput makes it there.
 // View lines are display data a client sent (view_open/change/close); `serve --inputs-out` leaves
 // them out (they change no physics), a recording of a served run (`serve --record`) keeps them so
 // that its replay shows the client's views; ReplayInput applies them when it finds them.
@@ -50,6 +56,9 @@ std::string input_remove_line(std::uint64_t step, std::string_view id);
 /// A client's view change: op "open" or "change" with the whole view (view_to_json), or "close"
 /// with the view's id only.
 std::string input_view_line(std::uint64_t step, std::string_view op, const nlohmann::json& view);
+/// `line` (a change's line from the functions here) marked as made while the world waited for
+/// `turtle`'s command, after it had taken `taken` commands at that boundary.
+std::string input_while_waiting(std::string line, std::string_view turtle, std::size_t taken);
 /// A ball's teleport (vel) or a turtle's (heading, degrees).
 std::string input_teleport_line(std::uint64_t step, std::string_view id, sim::Vec2 pos, std::optional<sim::Vec2> vel,
                                 std::optional<double> heading);
@@ -67,6 +76,8 @@ class ReplayInput : public turtle::InputSource {
   /// `spawn` applies the log's spawn lines (a log with one and no applier is refused).
   ReplayInput(std::istream& in, const sim::WorldDef& def, std::string file, SpawnApplier spawn = {});
   void at_boundary(turtle::WorldServer& server, std::uint64_t step) override;
+  /// The turtle's recorded command; first the changes recorded as made while the world waited
+  /// for it at this point of the boundary.
   std::optional<turtle::RemoteCommand> next(std::uint64_t step, std::size_t turtle) override;
 
  private:
@@ -80,7 +91,10 @@ class ReplayInput : public turtle::InputSource {
     sim::Vec2 pos;           ///< teleport
     std::optional<sim::Vec2> vel;
     std::optional<double> heading;
+    std::optional<std::size_t> waiting;  ///< made while the world waited for this turtle's command
+    std::size_t taken = 0;               ///< after it had taken this many at the boundary
   };
+  void apply(turtle::WorldServer& server, Change& c) const;
   void apply_view(turtle::WorldServer& server, const nlohmann::json& v, std::uint64_t step) const;
   SpawnApplier spawn_;
   struct Command {
@@ -91,6 +105,9 @@ class ReplayInput : public turtle::InputSource {
   std::vector<std::string> turtle_ids_;
   std::deque<Change> changes_;
   std::vector<std::deque<Command>> commands_;  // per turtle
+  turtle::WorldServer* server_ = nullptr;     // the one at_boundary was last given
+  std::uint64_t step_ = 0;                    // its step
+  std::vector<std::size_t> taken_;            // per turtle: commands taken at that step
 };
 
 }  // namespace turtlegas::formats

@@ -60,7 +60,8 @@ inline constexpr double margin = 12.0, title_h = 30.0, legend_w = 90.0, min_worl
 inline constexpr double legend_dx = 24.0, legend_dy = 16.0, legend_h = 120.0, legend_bar_w = 14.0;
 
 /// The layout of a picture of a window w x h world units wide and high whose longer side is
-/// width_px pixels: the world below the title, the legend column on its right.
+/// width_px pixels: the world below the title, and the legend column on its right when there is a
+/// legend to draw (balls coloured by speed); without one the picture ends a margin past the world.
 struct Layout {
   double scale = 1.0;   ///< pixels per world unit
   double top = 0.0;     ///< the world's top edge, pixels
@@ -68,6 +69,24 @@ struct Layout {
   double height = 0.0;
   double legend_x = 0.0, legend_y = 0.0;  ///< the colour bar's top left
 };
-Layout layout_for(double w, double h, double width_px);
+Layout layout_for(double w, double h, double width_px, bool legend = true);
+
+/// Where a label `text_w` x `text_h` pixels goes beside a disc at pixel (cx, cy) of pixel radius
+/// r: its baseline's left end, at the disc's upper right, or flipped to its left and below it
+/// where it would leave the picture (width x height pixels); never outside it when it fits.
+struct LabelSpot {
+  double x = 0.0, y = 0.0;
+};
+LabelSpot label_spot(double cx, double cy, double r, double text_w, double text_h, double width, double height);
+
+/// Whether some turtle passes through this wall (its collision layers do not meet the wall's; a
+/// builder's own pen walls, say): such walls are drawn dashed in wall_passable_colour.
+template <class Wall, class Turtles>
+bool passable_by_some(const Wall& wall, const Turtles& turtles) {
+  for (const auto& t : turtles)
+    if (!wall.layers.collides_with(t.layers)) return true;
+  return false;
+}
+inline constexpr Rgb wall_passable_colour = {0x4e, 0x79, 0xa7};
 
 }  // namespace turtlegas::formats::look

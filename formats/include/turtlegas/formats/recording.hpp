@@ -51,6 +51,10 @@ struct RecordingHeader {
   std::optional<double> until;   ///< the time the run was asked to reach (none: a served run without --until)
   std::string command;           ///< "run" or "serve"
   KeyframePolicy keyframes;
+  /// The controller plugins the world's programs come from: [{"file": ABSOLUTE_PATH,
+  /// "controllers": [NAME, ...]}, ...] (null or empty: none); render and replay load them, and
+  /// name the one that is missing (docs/recording.md).
+  nlohmann::ordered_json plugins;
 };
 
 /// Writes a recording as the run goes. Every call appends; keyframe() flushes.

@@ -33,6 +33,7 @@ struct Snapshot {
     double radius = 10.0;
     std::vector<sim::Vec2> trail;  ///< pen-down path, world units; empty when nothing was drawn
     bool fault = false;            ///< its program failed (drawn crossed out)
+    sim::Layers layers{};          ///< its collision layers (walls it passes through are drawn dashed)
   };
   std::vector<Turtle> turtles;
 };
@@ -58,7 +59,7 @@ inline Snapshot snapshot_of(const sim::World& world, const sim::WorldDef& def) {
   s.turtles.reserve(world.turtle_count());
   for (std::size_t i = 0; i < world.turtle_count(); ++i) {
     const sim::TurtleState t = world.turtle(i);
-    s.turtles.push_back({def.turtles[i].id, t.pos, t.heading, world.turtle_radius(i), {}, false});
+    s.turtles.push_back({def.turtles[i].id, t.pos, t.heading, world.turtle_radius(i), {}, false, def.turtles[i].layers});
   }
   return s;
 }
@@ -67,7 +68,8 @@ inline Snapshot snapshot_of(const sim::World& world, const sim::WorldDef& def) {
 Snapshot snapshot_of(const turtle::WorldServer& server, const sim::WorldDef& def);
 
 /// Writes an SVG image of the snapshot: +y up, the arena as a rectangle, walls as lines, balls as
-/// circles coloured by speed (with a legend), pen trails as polylines, turtles as discs with a tick
+/// circles coloured by speed (with a legend column when there are balls), walls some turtle passes
+/// through dashed in blue, pen trails as polylines, turtles as discs with a tick
 /// towards their heading and their id beside them, and a title with the name and time. width_px is the
 /// size of the arena's longer side in the image.
 void write_svg(std::ostream& out, const Snapshot& snapshot, double width_px = 800.0);

@@ -71,6 +71,7 @@ struct HostOptions {
   std::optional<ReplaySource> replay;  ///< set: a replay (ReplaySource)
   std::string record_path;             ///< `serve --record`: the recording (docs/recording.md); empty: none
   formats::KeyframePolicy keyframes;   ///< its keyframes
+  nlohmann::ordered_json plugins;      ///< its header's plugins (formats::RecordingHeader::plugins)
 };
 
 class WorldHost {
@@ -129,6 +130,8 @@ class WorldHost {
     nlohmann::json inflight_id;
     bool busy = false;      ///< a command was accepted and its result has not come
     bool orphan = false;    ///< the command in flight was sent by a connection that let go
+    std::uint64_t taken_step = 0;  ///< the boundary of `taken`
+    std::size_t taken = 0;         ///< commands taken at that boundary
   };
   struct WallChange {
     std::uint64_t client;
@@ -216,9 +219,19 @@ class WorldHost {
   void on_release(ClientState& c, const nlohmann::json& m, const std::string& type);
   void on_command(ClientState& c, const nlohmann::json& m, const std::string& type);
   void apply_takeovers(turtle::WorldServer& server, std::uint64_t step);
+  /// In lockstep, waits (at most --lockstep-timeout) for the owner's command; meanwhile world
+  /// changes and saves are made at this boundary (their senders may be waiting for them before
+  /// they send the command), recorded as made while waiting (formats::input_while_waiting).
   std::optional<turtle::RemoteCommand> next_command(std::uint64_t step, std::size_t turtle);
   void on_report(const turtle::RemoteReport& r);
-  void release_all(ClientState& c, const char* why);
+  /// Lets go of every turtle `c` claimed. A command of theirs in flight gets the error `code`
+  /// with `why` when `code` is given (its sender would otherwise wait for a result that is not
+  /// coming to it), else its result is dropped.
+  void release_all(ClientState& c, const char* why, const char* code = nullptr, const std::string& message = {});
+  /// Takeovers, walls and spawn/remove/teleport queued, made at this boundary, in that order.
+  void apply_changes(turtle::WorldServer& server, std::uint64_t step);
+  /// An input-log line, marked when it is made while the world waits for a command (waiting_).
+  std::string input_line(std::string line) const;
 
   // World changes (host_world_changes.cpp): checked on arrival, applied at the boundary.
   void on_add_wall(ClientState& c, const nlohmann::json& m, const std::string& type);
@@ -331,6 +344,7 @@ class WorldHost {
   bool stopping_ = false;
   std::string stop_reason_;
   bool in_step_ = false;
+  std::optional<std::size_t> waiting_;  ///< the turtle a lockstep boundary waits for (next_command)
   bool reverse_ = false;  ///< a replay plays backwards
   std::uint64_t frames_built_ = 0;
   mutable std::mutex text_mutex_;  // options_.world_text, read by HTTP sessions

@@ -94,7 +94,10 @@ class InputSource {
   /// The next command of remote turtle `turtle` (an index) at boundary `step`, or nullopt for
   /// none: the turtle stands still until the next boundary. May block (a lockstep host waits for
   /// its client here) and may throw, which ends the run: run_until rethrows, and the WorldServer
-  /// must not be run further.
+  /// must not be run further. It may change the world as at_boundary does (the same server, still
+  /// at boundary `step`): the change lands among the boundary's programs, after those that ran
+  /// before this turtle's turn, and a replay makes it at the same point (formats/input_log.hpp).
+  /// A turtle spawned there first runs at the next boundary.
   virtual std::optional<RemoteCommand> next(std::uint64_t step, std::size_t turtle) = 0;
 };
 
