@@ -190,7 +190,8 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
   run->add_option("--resume", opt.resume, "Continue the run a checkpoint was written for (replays it to there)");
   run->add_option("--observe", opt.observe,
                   "Write the gas observables here (JSON; - for standard output): temperature, pressure, collision "
-                  "rate, mean free path, speed histogram, density profile, per time window with error bars");
+                  "rate, mean free path, speed histogram, density profile, g(r), MSD, VACF and D, per species, per time "
+                  "window with error bars");
   run->add_option("--observe-from", opt.observe_from, "Simulated time the observation starts at (equilibration before)")
       ->check(real_in(0, big, "seconds"));
   run->add_option("--observe-window", opt.observe_window,
@@ -208,6 +209,13 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
   run->add_option("--observe-speed-bins", opt.observe_speed_bins, "Bins of the speed histogram (0 to 4 rms speeds)")
       ->capture_default_str()
       ->check(integer_in(1, 100000, "bins"));
+  run->add_option("--observe-rdf-bins", opt.observe_rdf_bins, "Bins of the radial distribution function g(r)")
+      ->capture_default_str()
+      ->check(integer_in(1, 100000, "bins"));
+  run->add_option("--observe-rdf-max", opt.observe_rdf_max,
+                  "Largest distance of g(r) (default 5 of the largest diameters; at most half the shorter side when "
+                  "periodic)")
+      ->check(real_in(0, big, "distance", true));
   run->add_option("--overlap-samples", opt.overlap_samples,
                   "With --stats or --stats-json: measure the deepest overlap at this many evenly spaced instants "
                   "besides every contact and the end (0: none; default: every control step, at most 1000, fewer "
@@ -263,6 +271,8 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     observing.axis = opt.observe_axis.empty() ? 'y' : opt.observe_axis[0];
     observing.profile_bins = opt.observe_bins;
     observing.speed_bins = opt.observe_speed_bins;
+    observing.rdf_bins = opt.observe_rdf_bins;
+    observing.rdf_max = opt.observe_rdf_max;
     if (const std::string bad = formats::check_observe(observing, 0.0, opt.until); !bad.empty()) throw BadInput(bad);
     observe_file.emplace(opt.observe, "--observe");
   }

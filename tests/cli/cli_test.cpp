@@ -446,7 +446,7 @@ TEST_CASE("cli: --observe writes the gas observables and --svg-trails the balls'
   REQUIRE(plain.code == 0);
   const Result r = run(dir, {"run", gas, "--until", "3", "--events", P("observed.jsonl"), "--observe", P("obs.json"),
                              "--observe-from", "1", "--observe-window", "0.5", "--observe-samples", "5", "--svg",
-                             P("pic.svg"), "--svg-trails", "1"});
+                             P("pic.svg"), "--svg-trails", "1", "--observe-rdf-bins", "30"});
   REQUIRE(r.code == 0);
   // Stopping at the sample times changes nothing: the same event log, byte for byte.
   CHECK(read(dir.path / "observed.jsonl") == read(dir.path / "plain.jsonl"));
@@ -460,6 +460,11 @@ TEST_CASE("cli: --observe writes the gas observables and --svg-trails the balls'
   CHECK(o.at("density_profile").at("density").size() == 20);
   CHECK(o.at("walls").size() > 4);
   CHECK(!o.at("summary").contains("Z_virial"));  // a walled arena: no virial pressure
+  CHECK(o.at("rdf").at("g").size() == 30);
+  CHECK(o.at("msd").at("lag").size() == 6);  // lags 0..samples
+  CHECK(o.at("vacf").at("vacf")[0].get<double>() > 0.0);
+  CHECK(!o.at("species").empty());
+  CHECK(o.at("summary").contains("D_msd"));
   CHECK(contains(read(dir.path / "pic.svg"), "class=\"ball-trail\""));
   SECTION("bad uses are refused with exit 2") {
     Result b = run(dir, {"run", gas, "--until", "3", "--svg-trails", "1"});
