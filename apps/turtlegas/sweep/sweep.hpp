@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "child_processes.hpp"
+#include "turtlegas/formats/observables.hpp"
 #include "sweep_command.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/turtle/registry.hpp"
@@ -52,6 +53,10 @@ struct Spec {
   std::vector<std::pair<std::string, std::vector<json>>> grid;  ///< pointer -> values, in the spec's order
   std::vector<std::string> summary;                             ///< pointers into a result line
   std::size_t runs = 0;
+  /// The spec's "observe": each run measures the gas (formats/observables.hpp) and its line carries
+  /// "observables": the summary and the species, or (observe.full) the whole measurement.
+  std::optional<formats::ObserveOptions> observe;
+  bool observe_full = false;
 };
 
 /// Reads and checks a spec and its world file (or, given, the bytes the sweep read at its start);
@@ -111,7 +116,8 @@ class Journal {
 std::string summary_table(const Spec& spec, const Results& results);
 /// <spec's stem>.results.jsonl, here.
 std::string default_out(const std::string& spec);
-/// The summary pointers that no result line has (misspelt).
+/// What is wrong with each summary pointer that no result line has as a number: in none (misspelt;
+/// parse_spec names most before any run), or at an object, array or string in all.
 std::vector<std::string> summary_not_found(const Spec& spec, const Results& results);
 /// The end of a sweep: the summary table, and the results file when every run has a result (the
 /// journal then removed). exit_ok; exit_failure when runs are missing; exit_bad_input when a
