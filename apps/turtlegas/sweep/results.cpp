@@ -135,6 +135,7 @@ int finish(const std::string& out, const Spec& spec, Results& results, Journal& 
   if (results.size() == spec.runs) {
     write_results(out, spec, results);
     journal.remove();
+    remove_tasks(out);
     std::printf("%zu runs; results in %s\n", spec.runs, out.c_str());
     return missing.empty() ? exit_ok : exit_bad_input;
   }
