@@ -34,6 +34,7 @@
 #include "turtlegas/formats/input_log.hpp"
 #include "turtlegas/formats/names.hpp"
 #include "turtlegas/formats/observables.hpp"
+#include "turtlegas/formats/xyz_trajectory.hpp"
 #include "turtlegas/formats/recording.hpp"
 #include "turtlegas/formats/state_file.hpp"
 #include "turtlegas/formats/stats_file.hpp"
@@ -195,7 +196,8 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
   run->add_option("--resume", opt.resume, "Continue the run a checkpoint was written for (replays it to there)");
   run->add_option("--observe", opt.observe,
                   "Write the gas observables here (JSON; - for standard output): temperature, pressure, collision "
-                  "rate, mean free path, speed histogram, density profile, per time window with error bars");
+                  "rate, mean free path, speed histogram, density profile, g(r), MSD, VACF and D, per species, per time "
+                  "window with error bars");
   run->add_option("--observe-from", opt.observe_from, "Simulated time the observation starts at (equilibration before)")
       ->check(real_in(0, big, "seconds"));
   run->add_option("--observe-window", opt.observe_window,
@@ -213,6 +215,18 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
   run->add_option("--observe-speed-bins", opt.observe_speed_bins, "Bins of the speed histogram (0 to 4 rms speeds)")
       ->capture_default_str()
       ->check(integer_in(1, 100000, "bins"));
+  run->add_option("--xyz", opt.xyz,
+                  "Write the balls' trajectory here as extended XYZ (OVITO, ASE; VMD reads its first four columns), "
+                  "a frame every --xyz-every");
+  run->add_option("--xyz-every", opt.xyz_every, "Simulated seconds between --xyz frames (the first at the start)")
+      ->check(real_in(0, big, "seconds", true));
+  run->add_option("--observe-rdf-bins", opt.observe_rdf_bins, "Bins of the radial distribution function g(r)")
+      ->capture_default_str()
+      ->check(integer_in(1, 100000, "bins"));
+  run->add_option("--observe-rdf-max", opt.observe_rdf_max,
+                  "Largest distance of g(r) (default 5 of the largest diameters; at most half the shorter side when "
+                  "periodic)")
+      ->check(real_in(0, big, "distance", true));
   run->add_option("--overlap-samples", opt.overlap_samples,
                   "With --stats or --stats-json: measure the deepest overlap at this many evenly spaced instants "
                   "besides every contact and the end (0: none; default: every control step, at most 1000, fewer "
@@ -242,7 +256,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   std::vector<NamedPath> inputs{{opt.world, "the world file"}};
   for (const std::string& p : opt.plugins) inputs.push_back({p, "--plugin"});
   std::vector<NamedPath> outputs{{opt.events, "--events"}, {opt.state_out, "--state-out"},
-                                 {opt.stats_json, "--stats-json"}, {opt.svg, "--svg"}, {opt.observe, "--observe"},
+                                 {opt.stats_json, "--stats-json"}, {opt.svg, "--svg"}, {opt.observe, "--observe"}, {opt.xyz, "--xyz"},
                                  {opt.record, "--record"}, {opt.checkpoint, "--checkpoint"}};  // the checkpoint last: see below
   if (opt.stats) outputs.push_back({"-", "--stats"});
   if (!opt.resume.empty()) {
@@ -259,7 +273,13 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     if (!opt.inputs.empty())
       throw BadInput("--record with --inputs: a recording does not carry the input log yet; drop one of the two");
   }
-  std::optional<OutputFile> events_file, state_file, stats_file, svg_file, observe_file;
+  std::optional<OutputFile> events_file, state_file, stats_file, svg_file, observe_file, xyz_file;
+  if (!opt.xyz.empty()) {
+    if (!(opt.xyz_every > 0.0)) throw BadInput("--xyz needs --xyz-every DT, the simulated seconds between its frames");
+    xyz_file.emplace(opt.xyz, "--xyz");
+  } else if (opt.xyz_every > 0.0) {
+    throw BadInput("--xyz-every sets the frames of --xyz F: give --xyz F as well");
+  }
   formats::ObserveOptions observing;
   if (!opt.observe.empty()) {
     observing.from = opt.observe_from;
@@ -268,6 +288,8 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     observing.axis = opt.observe_axis.empty() ? 'y' : opt.observe_axis[0];
     observing.profile_bins = opt.observe_bins;
     observing.speed_bins = opt.observe_speed_bins;
+    observing.rdf_bins = opt.observe_rdf_bins;
+    observing.rdf_max = opt.observe_rdf_max;
     if (const std::string bad = formats::check_observe(observing, 0.0, opt.until); !bad.empty()) throw BadInput(bad);
     observe_file.emplace(opt.observe, "--observe");
   }
@@ -373,6 +395,13 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
                      ": leave out --svg-trails");
     trails.emplace(def, std::max(0.0, opt.until - opt.svg_trails));
   }
+  if (xyz_file && (!def.turtles.empty() || replay))
+    throw BadInput("--xyz writes the balls of a run by the bare engine; " + opt.world +
+                   (replay ? " is run with --inputs" : " has turtles") + ": leave out --xyz (a recording, --record, "
+                   "keeps turtles)");
+  std::optional<formats::XyzWriter> xyz;
+  double next_frame = 0.0;
+  std::uint64_t frame_k = 0;
   if (observe_file && (!def.turtles.empty() || replay))
     throw BadInput("--observe measures a gas run by the bare engine; " + opt.world +
                    (replay ? " is run with --inputs" : " has turtles") + ": leave out --observe, or the turtles");
@@ -395,11 +424,28 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     else if (trails) world.set_impulse_log(&trail_impulses);
     // A quarter step first: short enough for a million balls.
     first_chunk = std::min((opt.until - world.time()) / 64.0, def.dt / 4.0);
-    advance = [&world, &observer, &trails, &trail_impulses](double t) {
-      auto to = [&](double u) {
+    if (xyz_file) {
+      xyz.emplace(xyz_file->stream(), world, def, ball_ids);
+      // Frames at k DT from the first at or after the start (a resumed run's time).
+      frame_k = static_cast<std::uint64_t>(std::ceil(world.time() / opt.xyz_every - 1e-9));
+      next_frame = static_cast<double>(frame_k) * opt.xyz_every;
+    }
+    advance = [&world, &observer, &trails, &trail_impulses, &xyz, &xyz_file, &next_frame, &frame_k,
+               every = opt.xyz_every](double t) {
+      auto step = [&](double u) {
         if (observer) observer->advance_to(u);  // stops at its sample times on the way
         else world.advance_to(u);
         if (trails) trails->take(trail_impulses), trail_impulses.clear();
+      };
+      auto to = [&](double u) {  // stops at the trajectory's frames on the way
+        // (A frame within round-off of u, 30 x 0.1 for 3, is taken at u.)
+        while (xyz && next_frame <= u + 1e-12 * std::max(1.0, u)) {
+          step(std::clamp(next_frame, world.time(), std::max(u, world.time())));
+          xyz->frame(world);
+          next_frame = static_cast<double>(++frame_k) * every;
+        }
+        if (xyz) xyz_file->flush();
+        step(u);
       };
       if (trails && !trails->started() && trails->from() <= t) {
         to(trails->from());  // the trails start: a stop there
@@ -601,6 +647,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     observe_file->stream() << observer->result().dump(1) << '\n';
     observe_file->commit();
   }
+  if (xyz_file) xyz_file->commit();
   if (svg_file) {
     formats::Snapshot picture = server ? formats::snapshot_of(*server, def) : formats::snapshot_of(world, def);
     if (trails) picture.ball_trails = trails->polylines();

@@ -44,9 +44,12 @@ struct RunOptions {
   /// Gas observables (formats/observables.hpp) written to `observe`, with their options.
   std::string observe;
   double observe_from = 0.0, observe_window = 0.0;
-  int observe_samples = 20, observe_bins = 20, observe_speed_bins = 40;
+  int observe_samples = 20, observe_bins = 20, observe_speed_bins = 40, observe_rdf_bins = 200;
+  double observe_rdf_max = 0.0;
   std::string observe_axis = "y";
   double svg_trails = 0.0;  ///< seconds of each ball's path the SVG draws (0: none)
+  std::string xyz;          ///< the balls' trajectory as extended XYZ (formats/xyz_trajectory.hpp)
+  double xyz_every = 0.0;   ///< simulated seconds between its frames
   /// How many evenly spaced instants --stats measures the deepest overlap at (0: only at
   /// contacts and the end); unset: the default of overlap_samples() in run_command.cpp.
   std::optional<std::uint64_t> overlap_samples;

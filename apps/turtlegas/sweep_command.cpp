@@ -6,6 +6,8 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -38,6 +40,18 @@ CLI::App* add_sweep_command(CLI::App& app, SweepOptions& options) {
   add_stack_kib_option(*cmd, options.stack_kib);
   add_program_budget_option(*cmd, options.program_budget, "its run fails");
   cmd->add_flag("--quiet,-q", options.quiet, "No progress lines");
+  cmd->add_option("--task-index", options.task_index,
+                  "Run only this task of the sweep (0-based; its runs k with k mod --tasks = I), results into "
+                  "<out>.tasks/; default $SLURM_ARRAY_TASK_ID, $PBS_ARRAY_INDEX or $PBS_ARRAYID when set "
+                  "(docs/scaling.md)");
+  cmd->add_option("--tasks", options.tasks, "How many tasks the runs are dealt into (default: one per run)")
+      ->check(integer_in(1, 10000000, "tasks"));
+  cmd->add_flag("--gather", options.gather,
+                "Collect the tasks' results (and the journal's) into the results file; run nothing, and name the "
+                "runs still missing");
+  cmd->add_flag("--resume", options.resume,
+                "Go on with a sweep begun before (its journal, its tasks' results), running only the missing runs; "
+                "refused when there is none (the same command without it resumes too, or starts afresh)");
   cmd->add_option("--run", options.child_run, "(internal) run this one run here, report on descriptor 3")->group("");
   cmd->add_option("--inputs-fd", options.inputs_fd, "(internal) the spec and world the parent read, on this descriptor")
       ->group("");
@@ -70,6 +84,30 @@ int sweep_command(const SweepOptions& options, const turtle::Registry& registry,
   for (const std::string& p : plugins) inputs.push_back({p, "--plugin"});
   check_outputs({{out, "--out"}, {out + ".partial", "--out's journal (" + out + ".partial)"}}, inputs);
 
+  if (options.gather && options.task_index)
+    throw BadInput("sweep --gather collects the tasks' results; --task-index runs one task: give one of the two");
+  // A job array's task: its index from the option, else from the scheduler's variable.
+  std::optional<std::size_t> index = options.task_index;
+  std::string from;
+  if (!index && !options.gather && !options.resume) {
+    for (const char* name : {"SLURM_ARRAY_TASK_ID", "PBS_ARRAY_INDEX", "PBS_ARRAYID"}) {
+      const char* v = std::getenv(name);
+      if (!v || !*v) continue;
+      char* end = nullptr;
+      const unsigned long long i = std::strtoull(v, &end, 10);
+      if (*end != '\0' || v[0] == '-')
+        throw BadInput(std::string("sweep: ") + name + "=" + v + " is not a task index (an integer >= 0); give "
+                       "--task-index I, or unset " + name + " to run the whole sweep here");
+      index = static_cast<std::size_t>(i);
+      from = std::string(" (") + name + ")";
+      break;
+    }
+  }
+  if (index) return sweep::run_task(options, registry, spec, out, *index, from);
+  if (options.gather) return sweep::gather(options, spec, out);
+  if (options.resume && !std::filesystem::exists(out + ".partial") && !std::filesystem::is_directory(sweep::tasks_dir(out)))
+    throw BadInput("sweep --resume: nothing to go on with: no journal " + out + ".partial and no task results in " +
+                   sweep::tasks_dir(out) + " (another --out? leave out --resume to start the sweep)");
   return sweep::run_launched(options, registry, plugins, spec, out);
 }
 

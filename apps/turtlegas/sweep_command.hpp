@@ -26,6 +26,12 @@ struct SweepOptions {
   bool quiet = false;          ///< no progress lines
   std::optional<std::size_t> child_run;  ///< hidden: run this one and report on descriptor 3
   std::optional<int> inputs_fd;          ///< hidden: the spec and world the parent read (sweep/sweep.hpp)
+  /// Run one task of the sweep (sweep/tasks.cpp); default from SLURM_ARRAY_TASK_ID, PBS_ARRAY_INDEX
+  /// or PBS_ARRAYID when set.
+  std::optional<std::size_t> task_index;
+  std::optional<std::size_t> tasks;  ///< how many tasks the runs are dealt into; default one per run
+  bool gather = false;               ///< collect the tasks' results, run nothing
+  bool resume = false;               ///< go on with a sweep begun before; refused when none was
 };
 
 CLI::App* add_sweep_command(CLI::App& app, SweepOptions& options);

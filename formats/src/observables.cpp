@@ -39,6 +39,8 @@ std::string check_observe(const ObserveOptions& o, double start, double until) {
   if (o.samples < 1) return "--observe-samples must be at least 1";
   if (o.axis != 'x' && o.axis != 'y') return "--observe-axis must be x or y";
   if (o.profile_bins < 1 || o.speed_bins < 1) return "--observe-bins must be at least 1";
+  if (o.rdf_bins < 1) return "--observe-rdf-bins must be at least 1";
+  if (!(o.rdf_max >= 0.0) || !std::isfinite(o.rdf_max)) return "--observe-rdf-max must be a distance >= 0 (0: automatic)";
   return {};
 }
 
@@ -55,7 +57,24 @@ Observer::Observer(sim::World& world, const sim::WorldDef& def, ObserveOptions o
     wall_length_.push_back(norm(w.to - w.from));
     wall_id_.push_back(w.id);
   }
-  for (std::size_t i = 0; i < world.ball_count(); ++i) ++masses_[world.mass(i)];
+  double r_big = 0.0;
+  for (std::size_t i = 0; i < world.ball_count(); ++i) {
+    ++masses_[world.mass(i)];
+    const double r = world.radius(i), m = world.mass(i);
+    r_big = std::max(r_big, r);
+    std::size_t s = 0;
+    while (s < species_.size() && !(species_[s].radius == r && species_[s].mass == m)) ++s;
+    if (s == species_.size()) species_.push_back({r, m, 0});
+    ++species_[s].count;
+    species_of_.push_back(s);
+  }
+  if (species_.empty()) species_.push_back({1.0, 1.0, 0});
+  // g(r) reaches 5 of the largest diameters unless told otherwise, and never beyond what the arena
+  // allows: half the shorter side (the nearest image) when periodic, the centres' room behind walls.
+  const double room = boundary_ == sim::Boundary::periodic ? 0.5 * std::min(width_, height_)
+                      : boundary_ == sim::Boundary::walls  ? std::min(width_, height_) - 2.0 * r_big
+                                                           : std::min(width_, height_);
+  rdf_max_ = std::min(opt_.rdf_max > 0.0 ? opt_.rdf_max : 10.0 * std::max(r_big, 1e-300), room);
   world.set_impulse_log(&impulses_);
 }
 
@@ -75,17 +94,33 @@ Observer::Window Observer::fresh(double t0) const {
   w.wall_push.assign(wall_length_.size(), 0.0);
   w.speeds.assign(static_cast<std::size_t>(opt_.speed_bins), 0.0);
   w.profile.assign(static_cast<std::size_t>(opt_.profile_bins), 0.0);
+  const std::size_t S = species_.size();
+  w.kT_species.assign(S, 0.0);
+  w.pair_norm.assign(S * (S + 1) / 2, 0.0);
+  w.pair_counts.assign(w.pair_norm.size() * static_cast<std::size_t>(opt_.rdf_bins), 0.0);
   return w;
 }
 
 void Observer::advance_to(double t) {
+  // While observing a periodic gas, the world stops often enough to unwrap its coordinates.
+  auto go = [this](double target) {
+    target = std::max(target, world_->time());
+    if (started_ && boundary_ == sim::Boundary::periodic && done_.size() < last_window_) {
+      while (world_->time() < target) {
+        world_->advance_to(std::min(target, world_->time() + unwrap_step()));
+        unwrap();
+      }
+    } else {
+      world_->advance_to(target);
+    }
+  };
   while (world_ && done_.size() < last_window_) {
     // The next stop: the start of the observation, then each sample of the current window.
     const double k = static_cast<double>(done_.size());
     const double stop = !started_ ? opt_.from
                                  : opt_.from + opt_.window * (k + static_cast<double>(next_sample_) / opt_.samples);
     if (stop > t) break;
-    world_->advance_to(std::max(stop, world_->time()));
+    go(stop);
     if (!started_) {
       started_ = true;
       if (forward) forward(impulses_);
@@ -98,17 +133,19 @@ void Observer::advance_to(double t) {
       speed_max_ = n > 0.0 && v2 > 0.0 ? 4.0 * std::sqrt(v2 / n) : 1.0;
       current_ = fresh(opt_.from);
       next_sample_ = 1;
+      start_motion();
       continue;
     }
     take_impulses();
     sample();
     if (++next_sample_ > static_cast<std::size_t>(opt_.samples)) {
+      close_motion(current_);
       done_.push_back(std::move(current_));
       current_ = fresh(opt_.from + opt_.window * (k + 1.0));
       next_sample_ = 1;
     }
   }
-  if (world_ && world_->time() < t) world_->advance_to(t);
+  if (world_ && world_->time() < t) go(t);
   if (world_ && done_.size() >= last_window_) {  // after the last window
     if (forward) forward(impulses_);
     impulses_.clear();
@@ -148,12 +185,15 @@ void Observer::sample() {
   const sim::Vec2 vc = periodic ? p / m_sum : sim::Vec2{};
   const double dof = periodic ? 2.0 * (n - 1.0) : 2.0 * n;
   double twice_ke = 0.0, speed = 0.0;
+  std::vector<double> twice_ke_s(species_.size(), 0.0), n_s(species_.size(), 0.0);
   const double extent = opt_.axis == 'x' ? width_ : height_;
   for (std::size_t i = 0; i < w.ball_count(); ++i) {
     const sim::BallState b = w.ball(i);
     if (!b.alive) continue;
     const sim::Vec2 u = b.vel - vc;
     twice_ke += w.mass(i) * dot(u, u);
+    twice_ke_s[species_of_[i]] += w.mass(i) * dot(u, u);
+    n_s[species_of_[i]] += 1.0;
     const double s = norm(b.vel);
     speed += s;
     const double sb = s / speed_max_ * opt_.speed_bins;
@@ -168,7 +208,11 @@ void Observer::sample() {
   current_.kinetic += twice_ke / 2.0;
   current_.mean_speed += speed / n;
   current_.balls += n;
+  for (std::size_t k = 0; k < species_.size(); ++k)
+    current_.kT_species[k] += n_s[k] > 0.0 ? twice_ke_s[k] / (2.0 * n_s[k]) : 0.0;
   ++current_.samples;
+  sample_pairs();
+  sample_motion();
 }
 
 nlohmann::json Observer::result() const {
@@ -278,7 +322,7 @@ nlohmann::json Observer::result() const {
   nlohmann::json walls = nlohmann::json::array();
   for (std::size_t k = 0; k < wall_length_.size(); ++k)
     walls.push_back({{"id", wall_id_[k]}, {"length", wall_length_[k]}, {"pressure", block(per_wall[k])}});
-  return {{"format", "turtlegas-observables/1"},
+  nlohmann::json out = {{"format", "turtlegas-observables/1"},
           {"name", name_},
           {"boundary", std::string(sim::to_string(boundary_))},
           {"area", area},
@@ -291,6 +335,9 @@ nlohmann::json Observer::result() const {
           {"speed_histogram", speeds},
           {"density_profile", {{"axis", std::string(1, opt_.axis)}, {"edges", pedges}, {"density", pdens}, {"error", perrs}}},
           {"walls", walls}};
+  pair_results(out, out["summary"]);
+  motion_results(out, out["summary"]);
+  return out;
 }
 
 }  // namespace turtlegas::formats

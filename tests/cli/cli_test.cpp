@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -470,7 +471,7 @@ TEST_CASE("cli: --observe writes the gas observables and --svg-trails the balls'
   REQUIRE(plain.code == 0);
   const Result r = run(dir, {"run", gas, "--until", "3", "--events", P("observed.jsonl"), "--observe", P("obs.json"),
                              "--observe-from", "1", "--observe-window", "0.5", "--observe-samples", "5", "--svg",
-                             P("pic.svg"), "--svg-trails", "1"});
+                             P("pic.svg"), "--svg-trails", "1", "--observe-rdf-bins", "30"});
   REQUIRE(r.code == 0);
   // Stopping at the sample times changes nothing: the same event log, byte for byte.
   CHECK(read(dir.path / "observed.jsonl") == read(dir.path / "plain.jsonl"));
@@ -484,6 +485,11 @@ TEST_CASE("cli: --observe writes the gas observables and --svg-trails the balls'
   CHECK(o.at("density_profile").at("density").size() == 20);
   CHECK(o.at("walls").size() > 4);
   CHECK(!o.at("summary").contains("Z_virial"));  // a walled arena: no virial pressure
+  CHECK(o.at("rdf").at("g").size() == 30);
+  CHECK(o.at("msd").at("lag").size() == 6);  // lags 0..samples
+  CHECK(o.at("vacf").at("vacf")[0].get<double>() > 0.0);
+  CHECK(!o.at("species").empty());
+  CHECK(o.at("summary").contains("D_msd"));
   CHECK(contains(read(dir.path / "pic.svg"), "class=\"ball-trail\""));
   SECTION("bad uses are refused with exit 2") {
     Result b = run(dir, {"run", gas, "--until", "3", "--svg-trails", "1"});
@@ -537,4 +543,67 @@ TEST_CASE("cli: --stats and --stats-json report the energy the zero-time rules t
   const json z = json::parse(read(stats)).at("energy_rules");
   CHECK(z.at("total").get<double>() == 0.0);
   CHECK(z.at("bodies").empty());
+}
+
+TEST_CASE("cli: --xyz writes an extended XYZ trajectory that reads back to the run's states") {
+  // Parsed here as OVITO's and ASE's readers read extended XYZ: a count line, a comment line of
+  // key=value pairs (Lattice, Properties, Time, pbc), then that many lines of the named columns.
+  TempDir dir;
+  auto P = [&](const char* name) { return (dir.path / name).string(); };
+  const std::string gas = std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/thermal_gas.json";
+  const Result r = run(dir, {"run", gas, "--until", "3", "--xyz", P("t.xyz"), "--xyz-every", "0.1", "--state-out",
+                             P("end.json"), "--events", P("with.jsonl")});
+  REQUIRE(r.code == 0);
+  // The frames are stops that change nothing.
+  REQUIRE(run(dir, {"run", gas, "--until", "3", "--events", P("without.jsonl")}).code == 0);
+  CHECK(read(dir.path / "with.jsonl") == read(dir.path / "without.jsonl"));
+  std::ifstream in(dir.path / "t.xyz");
+  std::string line;
+  std::vector<double> times;
+  std::vector<std::vector<std::string>> last;
+  while (std::getline(in, line)) {
+    const std::size_t n = std::stoul(line);
+    REQUIRE(std::getline(in, line));
+    CHECK(contains(line, "Lattice=\"120 0 0 0 120 0 0 0 2\""));
+    CHECK(contains(line, "pbc=\"T T F\""));
+    CHECK(contains(line, "Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1:mass:R:1:id:S:1"));
+    const std::size_t at = line.find("Time=");
+    REQUIRE(at != std::string::npos);
+    times.push_back(std::stod(line.substr(at + 5)));
+    last.clear();
+    for (std::size_t k = 0; k < n; ++k) {
+      REQUIRE(std::getline(in, line));
+      std::istringstream cols(line);
+      std::vector<std::string> c;
+      for (std::string w; cols >> w;) c.push_back(w);
+      REQUIRE(c.size() == 10);  // species, x y z, vx vy vz, radius, mass, id
+      last.push_back(c);
+    }
+    CHECK(n == 900);
+  }
+  REQUIRE(times.size() == 31);  // t = 0, 0.1, ..., 3
+  for (std::size_t k = 0; k < times.size(); ++k) CHECK(times[k] == Approx(0.1 * static_cast<double>(k)).margin(1e-12));
+  // The last frame is the state at 3, digit for digit (shortest round-trip decimals).
+  const json end = json::parse(read(dir.path / "end.json"));
+  REQUIRE(end.at("balls").size() == last.size());
+  for (std::size_t i = 0; i < last.size(); ++i) {
+    const json& b = end.at("balls")[i];
+    CHECK(last[i][9] == b.at("id").get<std::string>());
+    CHECK(std::stod(last[i][1]) == b.at("pos")[0].get<double>());
+    CHECK(std::stod(last[i][2]) == b.at("pos")[1].get<double>());
+    CHECK(std::stod(last[i][4]) == b.at("vel")[0].get<double>());
+    CHECK(last[i][0] == "A");
+  }
+  SECTION("--xyz needs --xyz-every, and the other way round; not with turtles") {
+    Result b = run(dir, {"run", gas, "--until", "1", "--xyz", P("x.xyz")});
+    CHECK(b.code == 2);
+    CHECK(contains(b.err, "--xyz-every"));
+    b = run(dir, {"run", gas, "--until", "1", "--xyz-every", "0.5"});
+    CHECK(b.code == 2);
+    b = run(dir, {"run", std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/wander.json", "--until", "1", "--xyz", P("x.xyz"),
+                  "--xyz-every", "0.5"});
+    CHECK(b.code == 2);
+    CHECK(contains(b.err, "turtles"));
+    CHECK(!std::filesystem::exists(dir.path / "x.xyz"));
+  }
 }

@@ -208,7 +208,8 @@ def check_sweep_summary_misspelt():
     p = run("sweep", spec, "--out", path("sm.jsonl"), "--quiet", ok=(2,))
     assert b"/stats/colisions" in p.stderr and b"is in no result line" in p.stderr, p.stderr
     assert b'"/stats/collisions"' not in p.stderr, p.stderr
-    assert os.path.exists(path("sm.jsonl")), "the runs' results were not written"
+    # Refused before any run (issue 35): no runs were wasted on a table with a column of "-".
+    assert not os.path.exists(path("sm.jsonl")) and not os.path.exists(path("sm.jsonl.partial")), "runs were made"
 
 
 def check_sweep_journal_forged():

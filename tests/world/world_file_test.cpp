@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
 #include "turtlegas/world/world_file.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -432,4 +434,67 @@ TEST_CASE("walls that come and go: visibility keys parse, and bad ones name thei
               "/walls/0/visible/1/t", "visibility times must increase");
   CHECK_ERROR(world(R"(, "walls": [{"id": "g", "from": [10, 0], "to": [10, 5], "visible": [{"t": 3, "visible": 1}]}])"),
               "/walls/0/visible/0/visible", "expected");
+}
+
+namespace {
+
+/// The 2-D Maxwell-Boltzmann speed law's distribution function at kT for mass m (Rayleigh).
+double rayleigh_cdf(double v, double kT, double m) { return 1.0 - std::exp(-m * v * v / (2.0 * kT)); }
+
+}  // namespace
+
+TEST_CASE("a thermal gas: Maxwell-Boltzmann velocities, zero momentum, exactly the asked kT, seeded") {
+  const std::string spec = R"({"count": 4000, "radius": 0.5, "mass": 2, "temperature": 3, "seed": 11})";
+  const sim::WorldDef def = gas_world(spec);
+  REQUIRE(def.balls.size() == 4000);
+  const double n = 4000.0, m = 2.0, kT = 3.0;
+  sim::Vec2 p{};
+  double twice_ke = 0.0, x2 = 0.0, x4 = 0.0, xy = 0.0;
+  std::vector<double> speeds;
+  for (const sim::BallDef& b : def.balls) {
+    p += m * b.vel;
+    twice_ke += m * sim::norm2(b.vel);
+    x2 += b.vel.x * b.vel.x, x4 += b.vel.x * b.vel.x * b.vel.x * b.vel.x, xy += b.vel.x * b.vel.y;
+    speeds.push_back(sim::norm(b.vel));
+  }
+  // Zero momentum to round-off (the rms momentum of one ball is sqrt(2 m kT) = 3.5), kT exactly.
+  CHECK(std::abs(p.x) < 1e-9);
+  CHECK(std::abs(p.y) < 1e-9);
+  CHECK(twice_ke / (2.0 * (n - 1.0)) == Approx(kT).epsilon(1e-13));
+  // Moments of one component: <vx^2> = kT/m (to 1/N: the fixed energy), kurtosis 3 for a Gaussian
+  // (standard error sqrt(24/N) = 0.08; a fixed speed in random directions has 1.5), no x-y correlation.
+  const double var = x2 / n;
+  CHECK(var == Approx(kT / m).epsilon(0.04));
+  CHECK(x4 / n / (var * var) == Approx(3.0).margin(4.0 * std::sqrt(24.0 / n)));
+  CHECK(std::abs(xy / n) < 4.0 * var / std::sqrt(n));
+  // Kolmogorov-Smirnov against Rayleigh at kT: D < 1.949/sqrt(N) (significance 1e-3); the same
+  // speeds against the law at 1.2 kT fail it.
+  std::sort(speeds.begin(), speeds.end());
+  auto ks = [&](double t) {
+    double d = 0.0;
+    for (std::size_t i = 0; i < speeds.size(); ++i) {
+      const double f = rayleigh_cdf(speeds[i], t, m);
+      d = std::max({d, std::abs(f - static_cast<double>(i) / n), std::abs(static_cast<double>(i + 1) / n - f)});
+    }
+    return d;
+  };
+  INFO("KS distance " << ks(kT) << ", at 1.2 kT " << ks(1.2 * kT));
+  CHECK(ks(kT) < 1.949 / std::sqrt(n));
+  CHECK(ks(1.2 * kT) > 1.949 / std::sqrt(n));
+  // Seeded: the same seed gives the same velocities, another seed others; the positions are those of
+  // the gas at a fixed speed.
+  const sim::WorldDef again = gas_world(spec);
+  CHECK(again.balls[17].vel == def.balls[17].vel);
+  const sim::WorldDef other = gas_world(R"({"count": 4000, "radius": 0.5, "mass": 2, "temperature": 3, "seed": 12})");
+  CHECK(other.balls[17].vel != def.balls[17].vel);
+  const sim::WorldDef fixed = gas_world(R"({"count": 4000, "radius": 0.5, "mass": 2, "speed": 1, "seed": 11})");
+  CHECK(fixed.balls[17].pos == def.balls[17].pos);
+}
+
+TEST_CASE("a thermal gas's keys are checked") {
+  CHECK_ERROR(world(R"(, "gas": [{"count": 3, "radius": 1, "speed": 1, "temperature": 1}])"), "/gas/0/temperature",
+              "not both");
+  CHECK_ERROR(world(R"(, "gas": [{"count": 3, "radius": 1}])"), "/gas/0", "\"speed\"");
+  CHECK_ERROR(world(R"(, "gas": [{"count": 3, "radius": 1, "temperature": 0}])"), "/gas/0/temperature", "temperature");
+  CHECK_ERROR(world(R"(, "gas": [{"count": 1, "radius": 1, "temperature": 1}])"), "/gas/0/temperature", "at least 2");
 }

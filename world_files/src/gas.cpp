@@ -252,6 +252,8 @@ void centre_range(const GasSpec& gas, const sim::ArenaDef& arena, Vec2& lo, Vec2
   hi = {std::min(gas.hi.x, arena.width) - gas.radius, std::min(gas.hi.y, arena.height) - gas.radius};
 }
 
+void thermalise(sim::WorldDef& def, std::size_t first, const GasSpec& gas);
+
 std::size_t place_gas(sim::WorldDef& def, const GasSpec& gas) {
   Vec2 lo, hi;
   centre_range(gas, def.arena, lo, hi);
@@ -275,9 +277,39 @@ std::size_t place_gas(sim::WorldDef& def, const GasSpec& gas) {
 
   Random rng(gas.seed);
   def.balls.reserve(def.balls.size() + gas.count);
+  const std::size_t first = def.balls.size();
   const double fraction = static_cast<double>(gas.count) * std::numbers::pi * r * r / ((ghi.x - glo.x) * (ghi.y - glo.y));
-  if (fraction > lattice_fraction) return place_lattice(def, gas, grid, lo, hi, rng);
-  return place_random(def, gas, grid, lo, hi, rng);
+  const std::size_t placed = fraction > lattice_fraction ? place_lattice(def, gas, grid, lo, hi, rng)
+                                                         : place_random(def, gas, grid, lo, hi, rng);
+  if (gas.temperature >= 0.0) thermalise(def, first, gas);
+  return placed;
+}
+
+void thermalise(sim::WorldDef& def, std::size_t first, const GasSpec& gas) {
+  const std::size_t n = def.balls.size() - first;
+  if (n == 0) return;
+  // A stream of its own, so that the positions stay those of the same seed at a fixed speed.
+  Random rng(gas.seed ^ 0x9e3779b97f4a7c15ULL);
+  // Marsaglia's polar method: two independent normals from a point uniform in the unit disc (no
+  // sin/cos; std::log and std::sqrt only, so the velocities are bit-identical wherever the C
+  // library's log is, as glibc's is correctly rounded in practice).
+  Vec2 mean{};
+  for (std::size_t i = first; i < def.balls.size(); ++i) {
+    const Vec2 u = rng.in_disc();
+    const double s = sim::norm2(u), k = std::sqrt(-2.0 * std::log(s) / s);
+    def.balls[i].vel = {k * u.x, k * u.y};
+    mean += def.balls[i].vel;
+  }
+  // Zero total momentum (one mass for the whole gas), then the kinetic energy made exactly
+  // (n - 1) kT: kT = sum m |v|^2 / (2 (n - 1)), what a momentum-conserving run measures.
+  mean = mean / static_cast<double>(n);
+  double twice_ke = 0.0;
+  for (std::size_t i = first; i < def.balls.size(); ++i) {
+    def.balls[i].vel -= mean;
+    twice_ke += gas.mass * sim::norm2(def.balls[i].vel);
+  }
+  const double scale = n > 1 && twice_ke > 0.0 ? std::sqrt(2.0 * static_cast<double>(n - 1) * gas.temperature / twice_ke) : 0.0;
+  for (std::size_t i = first; i < def.balls.size(); ++i) def.balls[i].vel *= scale;
 }
 
 }  // namespace turtlegas::world::detail

@@ -16,6 +16,10 @@ struct GasSpec {
   double mass = 1.0;
   double charge = 0.0;  ///< every ball's
   double speed = 0.0;   ///< units/s, >= 0: every ball gets exactly this speed
+  /// kT in energy units (mass x (units/s)^2, Boltzmann's constant 1), > 0; negative: `speed` instead.
+  /// Maxwell-Boltzmann velocities, the gas's total momentum 0 and its kinetic energy exactly
+  /// (count - 1) kT (two degrees of freedom per ball less the two of the fixed momentum).
+  double temperature = -1.0;
   sim::Vec2 lo, hi;     ///< the region's corners, lo < hi
   std::uint64_t seed = 1;
   std::string id_prefix = "g";
@@ -36,6 +40,8 @@ void centre_range(const GasSpec& gas, const sim::ArenaDef& arena, sim::Vec2& lo,
 /// overlapping def's walls, its earlier balls, its turtles or each other; each with speed gas.speed in a
 /// uniformly random direction. Deterministic: the same def and spec give bit-identical balls on
 /// every platform. Returns the number placed (less than count when the region is too full).
+/// With gas.temperature >= 0 the velocities are thermal instead (GasSpec::temperature), from a
+/// stream of their own (the positions are those of the same gas at a fixed speed).
 /// O(count) expected time.
 std::size_t place_gas(sim::WorldDef& def, const GasSpec& gas);
 

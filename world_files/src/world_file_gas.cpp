@@ -19,7 +19,7 @@ std::vector<GasSpec> Reader::read_gases(const json& v, const sim::WorldDef& def)
     const std::string p = at(path, k);
     const json& g = v[k];
     expect_object(g, p, "a gas");
-    check_keys(g, p, "a gas", {"count", "radius", "mass", "charge", "speed", "region", "seed", "id_prefix", "category", "collides_with"});
+    check_keys(g, p, "a gas", {"count", "radius", "mass", "charge", "speed", "temperature", "region", "seed", "id_prefix", "category", "collides_with"});
     GasSpec gas;
     const std::uint64_t count = natural(require(g, p, "count", "a gas"), at(p, "count"));
     constexpr std::uint64_t max_count = 100'000'000;
@@ -30,8 +30,22 @@ std::vector<GasSpec> Reader::read_gases(const json& v, const sim::WorldDef& def)
     gas.radius = positive(require(g, p, "radius", "a gas"), at(p, "radius"), "radius");
     if (const json* x = find(g, "mass")) gas.mass = positive(*x, at(p, "mass"), "mass");
     if (const json* x = find(g, "charge")) gas.charge = number(*x, at(p, "charge"));
-    gas.speed = number(require(g, p, "speed", "a gas"), at(p, "speed"));
-    if (gas.speed < 0.0) fail(at(p, "speed"), "speed must be >= 0 (got " + num(gas.speed) + "); directions are random");
+    const json* temperature = find(g, "temperature");
+    if (temperature && find(g, "speed"))
+      fail(at(p, "temperature"), "a gas has either \"speed\" (every ball at it) or \"temperature\" (Maxwell-Boltzmann "
+                                 "velocities at that kT), not both; leave one out");
+    if (temperature) {
+      gas.temperature = positive(*temperature, at(p, "temperature"), "temperature");
+      if (count < 2)
+        fail(at(p, "temperature"), "a thermal gas needs at least 2 balls (its total momentum is 0); give \"count\" >= 2 "
+                                   "or a \"speed\"");
+    } else {
+      if (!find(g, "speed"))
+        fail(p, "a gas needs \"speed\" (every ball at that speed, random directions) or \"temperature\" (kT: "
+                "Maxwell-Boltzmann velocities)");
+      gas.speed = number(*find(g, "speed"), at(p, "speed"));
+      if (gas.speed < 0.0) fail(at(p, "speed"), "speed must be >= 0 (got " + num(gas.speed) + "); directions are random");
+    }
     gas.lo = {0.0, 0.0};
     gas.hi = {def.arena.width, def.arena.height};
     if (const json* r = find(g, "region")) {

@@ -48,14 +48,13 @@ std::string append_all(int fd, const std::string& text) {
   return {};
 }
 
-/// Whether j is a result line of run k as run_one writes it: k's seed and overrides, and stats.
+}  // namespace
+
 bool is_result_of(const Spec& spec, std::size_t k, const json& j) {
   const auto [idx, seed] = decompose(spec, k);
   return j.is_object() && j.value("seed", json()) == json(seed) && j.value("overrides", json()) == overrides_of(spec, idx) &&
          j.contains("stats") && j["stats"].is_object();
 }
-
-}  // namespace
 
 std::string fingerprint(const Spec& spec) {
   char b[32];

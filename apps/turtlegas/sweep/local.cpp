@@ -89,6 +89,8 @@ int run_local(const SweepOptions& options, const std::vector<std::string>& plugi
               const std::string& out) {
   Results results;
   Journal journal(out, spec, results);
+  if (const std::size_t n = collect_tasks(out, spec, results, journal); n > 0 && !options.quiet)
+    spdlog::info("sweep: {} run(s) collected from the tasks' results in {}", n, tasks_dir(out));
   std::vector<std::size_t> pending;
   for (std::size_t k = 0; k < spec.runs; ++k)
     if (!results.count(k)) pending.push_back(k);

@@ -38,6 +38,8 @@ constexpr int tag_ready = 1, tag_result = 2, tag_work = 3, tag_stop = 4;
 int mpi_master(const SweepOptions& options, const Spec& spec, const std::string& out, int size) {
   Results results;
   Journal journal(out, spec, results);
+  if (const std::size_t n = collect_tasks(out, spec, results, journal); n > 0 && !options.quiet)
+    spdlog::info("sweep: {} run(s) collected from the tasks' results in {}", n, tasks_dir(out));
   std::vector<std::size_t> pending;
   for (std::size_t k = 0; k < spec.runs; ++k)
     if (!results.count(k)) pending.push_back(k);

@@ -107,11 +107,22 @@ std::vector<std::string> summary_not_found(const Spec& spec, const Results& resu
   for (const std::string& p : spec.summary) {
     const json::json_pointer ptr(p);
     bool found = false;
+    std::string kind;
     for (auto it = results.begin(); it != results.end() && !found; ++it) {
       const json j = json::parse(it->second, nullptr, false);
-      found = !j.is_discarded() && j.contains(ptr);
+      if (j.is_discarded() || !j.contains(ptr)) continue;
+      found = j.at(ptr).is_number();
+      if (!found) kind = j.at(ptr).type_name();
     }
-    if (!found) missing.push_back(p);
+    // A pointer at an object or a string is as useless in the table as a misspelt one.
+    if (!found)
+      missing.push_back("\"" + p + "\" " +
+                        (kind.empty() ? "is in no result line (misspelt? a line has /run, /seed, /overrides, /stats/... as "
+                                        "docs/sweeps.md lists, /tag with a game, /expect with an expect list, "
+                                        "/observables with observe)"
+                                      : "points at " + std::string(kind == "object" || kind == "array" ? "an " : "a ") +
+                                            kind + " in the result lines, not a number: name one inside it (\"" + p +
+                                            "/...\")"));
   }
   return missing;
 }
@@ -120,13 +131,11 @@ int finish(const std::string& out, const Spec& spec, Results& results, Journal& 
   std::fputs(summary_table(spec, results).c_str(), stdout);
   // A summary pointer that no result line has is a misspelling, not a column of "-".
   const std::vector<std::string> missing = results.empty() ? std::vector<std::string>{} : summary_not_found(spec, results);
-  for (const std::string& p : missing)
-    spdlog::error("{}: /summary: \"{}\" is in no result line (misspelt? a line has /run, /seed, /overrides, "
-                  "/stats/... as docs/sweeps.md lists, /tag with a game, /expect with an expect list)",
-                  spec.file, p);
+  for (const std::string& m : missing) spdlog::error("{}: /summary: {}", spec.file, m);
   if (results.size() == spec.runs) {
     write_results(out, spec, results);
     journal.remove();
+    remove_tasks(out);
     std::printf("%zu runs; results in %s\n", spec.runs, out.c_str());
     return missing.empty() ? exit_ok : exit_bad_input;
   }

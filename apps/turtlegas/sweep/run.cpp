@@ -53,10 +53,30 @@ json run_one(const Spec& spec, std::size_t k, const turtle::Registry& registry, 
   // turtles (which then owns the engine).
   std::optional<sim::World> bare;
   std::unique_ptr<turtle::WorldServer> server;
+  if (spec.observe && !scene.def.turtles.empty())
+    throw BadInput(label + ": the spec's observe measures a gas run by the bare engine, and this run has turtles");
   if (scene.def.turtles.empty()) {
     bare.emplace(make_world(scene.def, spec.mode, label));
     run.energy_start = bare->energy();
-    bare->advance_to(spec.until);
+    if (spec.observe) {
+      formats::Observer observer(*bare, scene.def, *spec.observe, spec.until);
+      observer.advance_to(spec.until);
+      observer.detach();
+      json o = observer.result();
+      if (spec.observe_full) {
+        line["observables"] = o;
+      } else {
+        json species = json::array();
+        for (json& s : o["species"]) {
+          s.erase("msd");
+          s.erase("vacf");
+          species.push_back(s);
+        }
+        line["observables"] = {{"summary", o["summary"]}, {"species", species}};
+      }
+    } else {
+      bare->advance_to(spec.until);
+    }
   } else {
     server = make_server(scene, registry, options, label);
     std::vector<turtle::LogEvent> events;

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `turtlegas sweep`: the spec (docs/sweeps.md), read, checked and expanded into runs.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -11,6 +12,7 @@
 
 #include "cli_common.hpp"
 #include "sweep/sweep.hpp"
+#include "turtlegas/formats/stats_file.hpp"
 #include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::apps::sweep {
@@ -24,6 +26,122 @@ std::string read_bytes(const std::string& file, const std::string& what) {
   std::stringstream s;
   s << in.rdbuf();
   return std::move(s).str();
+}
+
+/// A JSON pointer's reference tokens, unescaped (RFC 6901: ~1 is /, ~0 is ~).
+std::vector<std::string> tokens_of(const std::string& pointer) {
+  std::vector<std::string> out;
+  std::size_t at = 1;
+  while (at <= pointer.size() && !pointer.empty()) {
+    const std::size_t next = std::min(pointer.find('/', at), pointer.size());
+    std::string t = pointer.substr(at, next - at);
+    for (std::size_t i = 0; (i = t.find('~', i)) != std::string::npos; ++i) t.replace(i, 2, t[i + 1] == '1' ? "/" : "~");
+    out.push_back(t);
+    at = next + 1;
+  }
+  return out;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string s;
+  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+/// Each summary pointer against the shape of a result line, before any run: a misspelt one is
+/// named now, not after the sweep (where it would have been a column of "-").
+void check_summary(const Spec& spec, const std::string& file) {
+  // The keys of "stats" do not depend on the world: those of an empty one.
+  sim::WorldDef empty;
+  empty.arena.width = empty.arena.height = 1.0;
+  const json stats = formats::stats_json(formats::RunFigures{}, sim::World(empty, sim::Mode::exact));
+  bool game = spec.world.contains("game"), expect = spec.world.contains("expect");
+  for (const auto& [ptr, values] : spec.grid) {
+    game = game || ptr.rfind("/game", 0) == 0;
+    expect = expect || ptr.rfind("/expect", 0) == 0;
+  }
+  std::vector<std::string> tops{"run", "seed", "overrides", "stats"};
+  if (game) tops.push_back("tag");
+  if (expect) tops.push_back("expect");
+  if (spec.observe) tops.push_back("observables");
+  for (const std::string& p : spec.summary) {
+    const std::vector<std::string> t = tokens_of(p);
+    auto bad = [&](const std::string& why) {
+      return BadInput(file + ": /summary: \"" + p + "\" is in no result line: " + why + " (docs/sweeps.md, \"Results\")");
+    };
+    if (t.empty()) throw bad("the empty pointer is the whole line, not a number");
+    if (std::find(tops.begin(), tops.end(), t[0]) == tops.end())
+      throw bad("a line has " + joined(tops) +
+                (t[0] == "tag" ? " (\"tag\" with a game)" : t[0] == "expect" ? " (\"expect\" with an expect list)"
+                 : t[0] == "observables" ? " (\"observables\" when the spec has \"observe\")" : ""));
+    if (t.size() == 1 && t[0] != "run" && t[0] != "seed")
+      throw BadInput(file + ": /summary: \"" + p + "\" points at an object in the result lines, not a number: name one "
+                     "inside it (\"" + p + "/...\"; docs/sweeps.md, \"Results\")");
+    if (t[0] == "stats" && t.size() > 1 && !stats.contains(t[1])) {
+      std::vector<std::string> keys;
+      for (const auto& [k, v] : stats.items())
+        if (k != "wall_seconds" && k != "collisions_per_second") keys.push_back(k);
+      throw bad("\"stats\" has " + joined(keys));
+    }
+    if (t[0] == "overrides" && t.size() > 1) {
+      std::vector<std::string> keys;
+      for (const auto& [ptr, values] : spec.grid) keys.push_back(ptr);
+      if (std::find(keys.begin(), keys.end(), t[1]) == keys.end())
+        throw bad("\"overrides\" has the grid's pointers: " + (keys.empty() ? std::string("none") : joined(keys)) +
+                  " (escaped in a pointer: /overrides/~1gas~10~1count for /gas/0/count)");
+    }
+    if (t[0] == "observables" && !spec.observe_full && t.size() > 1 && t[1] != "summary" && t[1] != "species")
+      throw bad("\"observables\" has summary and species (the rest with \"observe\": {\"full\": true})");
+    if (t[0] == "observables" && t.size() > 2 && t[1] == "summary") {
+      const std::vector<std::string> keys{"kT", "mean_speed", "collision_rate", "wall_collision_rate",
+                                          "mean_free_path", "number_density", "pressure_walls", "pressure_virial",
+                                          "Z_virial", "pressure_canonical", "Z_canonical", "D_msd", "D_green_kubo",
+                                          "g_contact"};
+      if (std::find(keys.begin(), keys.end(), t[2]) == keys.end())
+        throw bad("\"observables/summary\" has " + joined(keys) + ", each {\"mean\", \"error\"}");
+    }
+  }
+}
+
+/// The spec's "observe" object: the options of `run --observe`, by their names there.
+void read_observe(Spec& spec, const nlohmann::ordered_json& o, const std::string& file) {
+  auto bad = [&](const std::string& path, const std::string& what) {
+    return BadInput(file + ": /observe" + path + ": " + what);
+  };
+  if (!o.is_object()) throw bad("", "an object: {\"from\": T, \"window\": S, \"samples\": K, ...} (docs/sweeps.md)");
+  formats::ObserveOptions opt;
+  for (const auto& [k, v] : o.items()) {
+    auto number = [&] {
+      if (!v.is_number()) throw bad("/" + k, "a number");
+      return v.get<double>();
+    };
+    auto count = [&] {
+      if (!v.is_number_integer() || v.get<std::int64_t>() < 1 || v.get<std::int64_t>() > 1000000)
+        throw bad("/" + k, "an integer from 1 to 1000000");
+      return static_cast<int>(v.get<std::int64_t>());
+    };
+    if (k == "from") opt.from = number();
+    else if (k == "window") opt.window = number();
+    else if (k == "samples") opt.samples = count();
+    else if (k == "bins") opt.profile_bins = count();
+    else if (k == "speed_bins") opt.speed_bins = count();
+    else if (k == "rdf_bins") opt.rdf_bins = count();
+    else if (k == "rdf_max") opt.rdf_max = number();
+    else if (k == "axis") {
+      if (!v.is_string() || (v != "x" && v != "y")) throw bad("/axis", "\"x\" or \"y\"");
+      opt.axis = v.get<std::string>()[0];
+    } else if (k == "full") {
+      if (!v.is_boolean()) throw bad("/full", "true or false");
+      spec.observe_full = v.get<bool>();
+    } else {
+      throw bad("/" + k, "unknown key; observe has from, window, samples, axis, bins, speed_bins, rdf_bins, rdf_max, full");
+    }
+  }
+  if (const std::string why = formats::check_observe(opt, 0.0, spec.until); !why.empty()) throw bad("", why);
+  const json& turtles = spec.world.contains("turtles") ? spec.world["turtles"] : json::array();
+  if (turtles.is_array() && !turtles.empty())
+    throw bad("", "observe measures a gas run by the bare engine; " + spec.world_file + " has turtles");
+  spec.observe = opt;
 }
 
 }  // namespace
@@ -41,8 +159,8 @@ Spec parse_spec(const std::string& file, const Inputs* given) {
   if (!ordered.is_object()) throw bad("/", "a sweep spec is a JSON object");
   for (const auto& [k, v] : ordered.items())
     if (k != "format" && k != "world" && k != "until" && k != "mode" && k != "seeds" && k != "grid" && k != "summary" &&
-        k.rfind("x-", 0) != 0)
-      throw bad("/" + k, "unknown key; a sweep spec has format, world, until, mode, seeds, grid, summary (and x-...)");
+        k != "observe" && k.rfind("x-", 0) != 0)
+      throw bad("/" + k, "unknown key; a sweep spec has format, world, until, mode, seeds, grid, summary, observe (and x-...)");
   if (ordered.value("format", "") != "turtlegas-sweep/1") throw bad("/format", "must be \"turtlegas-sweep/1\"");
   if (!ordered.contains("world") || !ordered["world"].is_string())
     throw bad("/world", "the world file to sweep, relative to this file");
@@ -115,6 +233,8 @@ Spec parse_spec(const std::string& file, const Inputs* given) {
   }
   spec.runs = points * spec.seeds.size();
   if (spec.runs > max_runs) throw bad("/seeds", "more than " + std::to_string(max_runs) + " runs");
+  if (ordered.contains("observe")) read_observe(spec, ordered["observe"], file);
+  check_summary(spec, file);
   return spec;
 }
 /// Run k's grid point (one value index per axis, the first axis slowest) and seed.

@@ -6,6 +6,7 @@
 //   results.cpp  the summary table and the results file
 //   local.cpp    the runs as child processes of this machine (--jobs)
 //   mpi.cpp      the runs over MPI ranks (mpirun), or why not
+//   tasks.cpp    one task of a sweep (--task-index, job arrays) and gathering the tasks' results
 // Private to the sweep command: nothing here is seen by the other commands.
 #pragma once
 
@@ -20,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "child_processes.hpp"
+#include "turtlegas/formats/observables.hpp"
 #include "sweep_command.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/turtle/registry.hpp"
@@ -52,6 +54,10 @@ struct Spec {
   std::vector<std::pair<std::string, std::vector<json>>> grid;  ///< pointer -> values, in the spec's order
   std::vector<std::string> summary;                             ///< pointers into a result line
   std::size_t runs = 0;
+  /// The spec's "observe": each run measures the gas (formats/observables.hpp) and its line carries
+  /// "observables": the summary and the species, or (observe.full) the whole measurement.
+  std::optional<formats::ObserveOptions> observe;
+  bool observe_full = false;
 };
 
 /// Reads and checks a spec and its world file (or, given, the bytes the sweep read at its start);
@@ -84,6 +90,8 @@ using Results = std::map<std::size_t, std::string>;
 json parse_or_discard(const std::string& text);
 
 std::string fingerprint(const Spec& spec);
+/// Whether j is a result line of run k as run_one writes it: k's seed and overrides, and stats.
+bool is_result_of(const Spec& spec, std::size_t k, const json& j);
 
 /// The journal beside the results (<out>.partial): a header line with the spec's fingerprint,
 /// then one line per finished run, appended as each ends. A line cut short by a kill is dropped.
@@ -111,7 +119,8 @@ class Journal {
 std::string summary_table(const Spec& spec, const Results& results);
 /// <spec's stem>.results.jsonl, here.
 std::string default_out(const std::string& spec);
-/// The summary pointers that no result line has (misspelt).
+/// What is wrong with each summary pointer that no result line has as a number: in none (misspelt;
+/// parse_spec names most before any run), or at an object, array or string in all.
 std::vector<std::string> summary_not_found(const Spec& spec, const Results& results);
 /// The end of a sweep: the summary table, and the results file when every run has a result (the
 /// journal then removed). exit_ok; exit_failure when runs are missing; exit_bad_input when a
@@ -131,5 +140,23 @@ int run_local(const SweepOptions& options, const std::vector<std::string>& plugi
 /// on this machine (run_local).
 int run_launched(const SweepOptions& options, const turtle::Registry& registry, const std::vector<std::string>& plugins,
                  const Spec& spec, const std::string& out);
+
+/// The folder of the tasks' results beside the results file: <out>.tasks.
+std::string tasks_dir(const std::string& out);
+/// How many tasks a sweep has: --tasks, else one per run.
+std::size_t task_count(const Spec& spec, std::optional<std::size_t> tasks);
+/// Runs task `index` (its runs k = index mod the task count) in this process, each result to a file
+/// of its own in tasks_dir(out); a run that has one already is not run again. `from` says where the
+/// index came from (" (SLURM_ARRAY_TASK_ID)"), for messages.
+int run_task(const SweepOptions& options, const turtle::Registry& registry, const Spec& spec, const std::string& out,
+             std::size_t index, const std::string& from);
+/// Adds the tasks' results that `results` lacks (valid ones of this spec), each recorded in the
+/// journal; how many.
+std::size_t collect_tasks(const std::string& out, const Spec& spec, Results& results, Journal& journal);
+/// The results file is whole: the tasks' folder goes.
+void remove_tasks(const std::string& out);
+/// `sweep --gather`: the journal's and the tasks' results, the results file when every run has one
+/// (exit_ok), else the runs and tasks missing (exit_failure). Runs nothing.
+int gather(const SweepOptions& options, const Spec& spec, const std::string& out);
 
 }  // namespace turtlegas::apps::sweep

@@ -2,7 +2,10 @@
 // Gas observables (`turtlegas run --observe F.json`, docs/physics.md "Gas observables"):
 // temperature, wall pressure from collision impulses, virial pressure (periodic arenas), collision
 // rates, mean free path, the speed histogram beside the 2-D Maxwell-Boltzmann (Rayleigh)
-// distribution and a density profile, over consecutive time windows with block-average error bars.
+// distribution and a density profile, over consecutive time windows with block-average error bars;
+// the radial distribution function g(r) with its contact values, the mean-squared displacement of
+// unwrapped coordinates and the velocity autocorrelation function with the diffusion coefficient
+// from each (Einstein and Green-Kubo), per species (balls of one radius and mass) for mixtures.
 // Computed from what the engine reports: the impulse of every collision (World::set_impulse_log)
 // and state samples taken at fixed times. The physics does not depend on where a run is cut, so
 // stopping at the sample times changes nothing.
@@ -29,6 +32,8 @@ struct ObserveOptions {
   char axis = 'y';         ///< the density profile's axis, 'x' or 'y'
   int profile_bins = 20;   ///< across the arena's extent along the axis
   int speed_bins = 40;     ///< from 0 to 4 times the rms speed at `from`
+  int rdf_bins = 200;      ///< bins of g(r), from 0 to rdf_max
+  double rdf_max = 0.0;    ///< world units; 0: 5 largest diameters, at most what the arena allows
 };
 
 /// Checks the options against a run to `until` from `start`; returns an empty string or what is
@@ -57,6 +62,11 @@ class Observer {
   nlohmann::json result() const;
 
  private:
+  /// Balls of one radius and mass, in the order they first appear in the world.
+  struct Species {
+    double radius = 0.0, mass = 0.0;
+    std::size_t count = 0;
+  };
   struct Window {
     double t0 = 0.0, t1 = 0.0;
     std::uint64_t ball_ball = 0, ball_wall = 0;
@@ -66,7 +76,21 @@ class Observer {
     double kT = 0.0, kinetic = 0.0, mean_speed = 0.0, balls = 0.0;  ///< sums over samples
     std::vector<double> speeds, profile;             ///< counts over samples
     double speed_overflow = 0.0;
+    std::vector<double> kT_species;                  ///< sums over samples, per species
+    std::vector<double> pair_counts;                 ///< per species pair (a <= b) and r bin
+    std::vector<double> pair_norm;                   ///< per species pair: sum over samples of pairs
+    std::vector<double> msd, vacf;                   ///< per lag 0..samples, then per species and lag
   };
+  void sample_pairs();
+  void start_motion();
+  void unwrap();
+  void sample_motion();
+  void close_motion(Window& w);
+  double unwrap_step() const;
+  std::size_t pair_index(std::size_t a, std::size_t b) const;
+  double expected_pairs(std::size_t a, std::size_t b, double r0, double r1) const;
+  void pair_results(nlohmann::json& out, nlohmann::json& summary) const;
+  void motion_results(nlohmann::json& out, nlohmann::json& summary) const;
   void take_impulses();
   void sample();
   Window fresh(double t0) const;
@@ -81,6 +105,12 @@ class Observer {
   std::vector<double> wall_length_;
   std::vector<std::string> wall_id_;
   std::map<double, std::size_t> masses_;  ///< the balls' masses and how many have each
+  std::vector<Species> species_;
+  std::vector<std::size_t> species_of_;   ///< per ball
+  double rdf_max_ = 0.0;
+  std::vector<sim::Vec2> unwrapped_, last_pos_;  ///< since `from`; positions at the last unwrap
+  /// Per window: frames 0..samples of unwrapped positions and velocities (NaN x: not alive).
+  std::vector<std::vector<sim::Vec2>> frame_pos_, frame_vel_;
   std::vector<sim::Impulse> impulses_;
   Window current_;
   std::vector<Window> done_;
