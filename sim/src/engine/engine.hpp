@@ -287,6 +287,28 @@ class Engine final : public EngineBase {
   /// Body i, brought to now and placed at pos (unlinked already, or new), enters its cell and
   /// predicts afresh.
   void place(std::uint32_t i, Vec2 pos);
+  /// The sliding flight (docs/physics.md, "The sliding flight"): only a GravityFlight's balls
+  /// slide, so only exact mode under gravity pays for it.
+  static constexpr bool kSlides = requires(F f, std::uint32_t i) { f.end_slide(i); };
+  /// Ball i lands on fixed wall w, having met `before` last: whether the bounces that would follow
+  /// form a Zeno sequence short enough to be its limit, the slide, which it then starts
+  /// (contacts/resolve.hpp). False: an ordinary bounce.
+  bool slide_landing(std::uint32_t i, std::uint32_t w, LastPartner before);
+  /// Something strikes body i, or it strikes something: if it slides, it is a disc again (brought
+  /// to now first; the response that follows bumps its counter).
+  void unslide(std::uint32_t i) {
+    if constexpr (kSlides) {
+      if (motion_.flight().sliding(i)) [[unlikely]] {
+        sync(i);
+        motion_.flight().end_slide(i);
+      }
+    }
+  }
+  /// The jammed chain (docs/physics.md, "Clusters: a jammed chain"): ball i has just met fixed
+  /// wall w after ball `before`; if it heads a straight chain of touching balls that ends on a
+  /// parallel fixed wall facing w, every ball's velocity along the chain is taken (the limit of the
+  /// zero-time sequence), and true is returned (contacts/resolve.hpp).
+  bool jammed_chain(std::uint32_t i, std::uint32_t w, LastPartner before);
   /// The squeeze rule (contacts/squeeze.hpp) for body i after its contact with bodies_.last[i]; `before`:
   /// its partner before that. Returns false when the body was crushed (and removed).
   bool squeezed(std::uint32_t i, LastPartner before);
@@ -515,6 +537,7 @@ void Engine<F, kBallBall, kStep, kExtras>::retire(std::uint32_t i) {
   b.cell = kNone;
   ++b.count;  // predictions made against it are now stale
   heap_.remove(i);
+  if constexpr (kSlides) motion_.flight().end_slide(i);
   if (is_turtle(i)) turtles_.exit(i - bodies_.balls(), b, bodies_.end[i]);
 }
 
@@ -563,6 +586,14 @@ void Engine<F, kBallBall, kStep, kExtras>::keyframe() {
     Body& b = bodies_.body[i];
     if (b.cell == kNone) continue;
     sync(i);
+    if constexpr (kSlides) {
+      // A slide is the limit of bounces off a wall that stays put: a keyframe (which may hide that
+      // wall) ends it; it starts again at its next landing if the wall is still there.
+      if (motion_.flight().sliding(i)) {
+        motion_.flight().end_slide(i);
+        ++b.count;
+      }
+    }
     if (is_turtle(i)) push_ends(turtles_, i - nb, b, schedule_.keyed);  // contacts/carried.hpp
     if (keyed_partner(bodies_.last[i], walls_, schedule_)) bodies_.last[i] = LastPartner::none();  // contacts.hpp
     repredict(i);

@@ -11,6 +11,17 @@ namespace {
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
 inline void Engine<F, kBallBall, kStep, kExtras>::cross(std::uint32_t i) {
   const int dir = bodies_.pending[i].cross_dir;
+  if constexpr (kSlides) {
+    if (dir == kSlideEnd) [[unlikely]] {
+      // The foot of a sliding ball has reached an end of its wall: it flies under the field again
+      // (docs/physics.md, "The sliding flight"), from the end, with its velocity along the wall.
+      sync(i);
+      motion_.flight().end_slide(i);
+      parts().changed(i);
+      repredict(i);
+      return;
+    }
+  }
   if constexpr (F::kBoundedHorizon) {
     if (dir == kReplan) {
       // The prediction's horizon, not a crossing: the body stays in its cell and looks again.

@@ -141,7 +141,20 @@ struct FreeFlight {
   static constexpr double potential(std::uint32_t, Vec2) { return 0.0; }
 };
 
-/// Parabolic flight under a uniform acceleration shared by all balls (gravity).
+/// A cell "exit" that ends a sliding flight: the ball's foot has reached an end of its wall.
+inline constexpr std::uint8_t kSlideEnd = 5;
+
+/// A ball sliding along a fixed wall (docs/physics.md, "The sliding flight"): the exact limit of
+/// the Zeno sequence of ever lower bounces of a ball the field presses onto the wall at e < 1.
+struct Slide {
+  Vec2 a;           ///< the field's acceleration along the wall, g - (g.n) n
+  Segment s;        ///< the wall's line, to leave it at an end
+  Vec2 p2;          ///< the wall's second end, as its ends are stored (s.p1 is the first)
+  std::uint32_t wall = kNone;  ///< kNone: not sliding
+};
+
+/// Parabolic flight under a uniform acceleration shared by all balls (gravity), but for the balls
+/// that slide along a wall (Slide), whose acceleration is the field's part along it.
 struct GravityFlight {
   static constexpr std::string_view kName = "gravity";
   static constexpr bool kBoundedHorizon = false;
@@ -150,29 +163,90 @@ struct GravityFlight {
   explicit GravityFlight(const WorldDef& def) : a(def.effects.gravity) {}
 
   Vec2 a{};
-  Vec2 pos(std::uint32_t, Vec2 x, Vec2 v, double dt) const { return x + dt * v + (0.5 * dt * dt) * a; }
-  Vec2 vel(std::uint32_t, Vec2 v, double dt) const { return v + dt * a; }
-  CellExit cell_exit(std::uint32_t, Vec2 x, Vec2 v, const CellBox& b) const {
-    return earlier_exit(axis_exit(x.x, v.x, a.x, b.x_lo, b.x_hi), axis_exit(x.y, v.y, a.y, b.y_lo, b.y_hi));
+  /// Ball `ball`'s acceleration: the field's, or along its wall while it slides. (One compare
+  /// while no ball slides: the gas pays nothing more.)
+  Vec2 accel(std::uint32_t ball) const {
+    if (sliding_ == 0) [[likely]] return a;
+    return sliding(ball) ? slides_[ball].a : a;
   }
-  /// Both balls fall alike, so their relative motion is a straight line.
-  double toi_balls(std::uint32_t, std::uint32_t, Vec2 r, Vec2 vi, Vec2 vj, double sigma, double) const {
+  Vec2 pos(std::uint32_t ball, Vec2 x, Vec2 v, double dt) const { return x + dt * v + (0.5 * dt * dt) * accel(ball); }
+  Vec2 vel(std::uint32_t ball, Vec2 v, double dt) const { return v + dt * accel(ball); }
+  CellExit cell_exit(std::uint32_t ball, Vec2 x, Vec2 v, const CellBox& b) const {
+    const Vec2 acc = accel(ball);
+    CellExit e = earlier_exit(axis_exit(x.x, v.x, acc.x, b.x_lo, b.x_hi), axis_exit(x.y, v.y, acc.y, b.y_lo, b.y_hi));
+    if (sliding_ != 0 && sliding(ball)) [[unlikely]] {
+      // The slide ends when the foot of the centre leaves the wall: a parabola along its line.
+      const Slide& sl = slides_[ball];
+      const AxisExit end = axis_exit(dot(x - sl.s.p1, sl.s.u), dot(v, sl.s.u), dot(sl.a, sl.s.u), 0.0, sl.s.len);
+      if (end.t < e.t) e = {end.t, kSlideEnd};
+    }
+    return e;
+  }
+  /// Both balls fall alike, so their relative motion is a straight line; a sliding ball's is a
+  /// parabola relative to a falling one (the quartic of a disc and an accelerating point).
+  double toi_balls(std::uint32_t i, std::uint32_t j, Vec2 r, Vec2 vi, Vec2 vj, double sigma, double t_max) const {
+    if (sliding_ != 0) [[unlikely]] {
+      const Vec2 ai = accel(i), aj = accel(j);
+      if (!(ai == aj)) return toi_disc_point_accel(-r, vi - vj, ai - aj, sigma, t_max);
+    }
     return toi_disc_disc(r, vj - vi, sigma);
   }
-  double toi_point(std::uint32_t, Vec2 rel, Vec2 v, Vec2, double sigma, double t_max) const {
-    return toi_disc_point_accel(rel, v, a, sigma, t_max);
+  double toi_point(std::uint32_t ball, Vec2 rel, Vec2 v, Vec2, double sigma, double t_max) const {
+    return toi_disc_point_accel(rel, v, accel(ball), sigma, t_max);
   }
-  double toi_segment(std::uint32_t, Vec2 rel, Vec2 v, Vec2, const Segment& s, double radius, double) const {
-    return toi_disc_segment(rel, v, a, s, radius);
+  double toi_segment(std::uint32_t ball, Vec2 rel, Vec2 v, Vec2, const Segment& s, double radius, double) const {
+    return toi_disc_segment(rel, v, accel(ball), s, radius);
   }
-  double toi_deforming_segment(std::uint32_t, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const {
-    return toi_disc_deforming_segment(rel, v, a, d0, w, radius, t_max);
+  double toi_deforming_segment(std::uint32_t ball, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const {
+    return toi_disc_deforming_segment(rel, v, accel(ball), d0, w, radius, t_max);
   }
   static constexpr bool straight(std::uint32_t) { return false; }
-  static constexpr bool straight_pair(std::uint32_t, std::uint32_t) { return true; }
-  double normal_accel(std::uint32_t, Vec2, Vec2 n) const { return dot(a, n); }
+  bool straight_pair(std::uint32_t i, std::uint32_t j) const { return sliding_ == 0 || accel(i) == accel(j); }
+  double normal_accel(std::uint32_t ball, Vec2, Vec2 n) const { return dot(accel(ball), n); }
+  /// The field's potential: a sliding ball's too (the wall's reaction does no work).
   double potential(std::uint32_t, Vec2 x) const { return -dot(a, x); }
+
+  /// Whether ball `ball` slides now, and along which wall (kNone: it does not).
+  bool sliding(std::uint32_t ball) const { return ball < slides_.size() && slides_[ball].wall != kNone; }
+  std::uint32_t slide_wall(std::uint32_t ball) const { return sliding(ball) ? slides_[ball].wall : kNone; }
+  const Slide& slide(std::uint32_t ball) const { return slides_[ball]; }
+  /// Ball `ball` (brought to now, touching wall `wall` on the side of unit normal n, its velocity
+  /// along the wall) slides along it from now on.
+  void start_slide(std::uint32_t ball, std::uint32_t wall, const Segment& s, Vec2 p2, Vec2 n) {
+    if (slides_.size() <= ball) slides_.resize(ball + 1);
+    if (slides_[ball].wall == kNone) ++sliding_;
+    slides_[ball] = {a - dot(a, n) * n, s, p2, wall};
+  }
+  /// Ball `ball` (brought to now) flies under the field again.
+  void end_slide(std::uint32_t ball) {
+    if (!sliding(ball)) return;
+    slides_[ball].wall = kNone;
+    --sliding_;
+  }
+
+ private:
+  std::vector<Slide> slides_;  ///< by ball index, grown at a ball's first slide
+  std::uint32_t sliding_ = 0;  ///< how many balls slide now
 };
+
+/// Whether body i slides along wall w (only a GravityFlight's balls ever slide).
+template <class F>
+inline bool slides_on(const F& f, std::uint32_t i, std::uint32_t w) {
+  if constexpr (requires { f.slide_wall(i); }) return f.slide_wall(i) == w && w != kNone;
+  else return false;
+}
+
+/// Whether body i slides along a wall one of whose ends is p (it cannot meet them while it slides).
+template <class F>
+inline bool slides_to(const F& f, std::uint32_t i, Vec2 p) {
+  if constexpr (requires { f.slide(i); }) {
+    if (!f.sliding(i)) return false;
+    const Slide& s = f.slide(i);
+    return p == s.s.p1 || p == s.p2;
+  } else {
+    return false;
+  }
+}
 
 /// Flight under gravity, electric and magnetic fields (field_flight.hpp, field_toi.hpp): each ball
 /// flies a parabola, a circle or a trochoid, by its charge-to-mass ratio. Balls are grouped into
@@ -297,6 +371,7 @@ class Motion {
   explicit Motion(const WorldDef& def) : flight_(def), balls_(static_cast<std::uint32_t>(def.balls.size())) {}
 
   const F& flight() const { return flight_; }
+  F& flight() { return flight_; }
   bool is_turtle(std::uint32_t id) const { return kExtras && id >= balls_; }
   /// A ball spawned at run time takes id balls_ (world_changes.hpp; flights with per-ball data refuse).
   void add_ball() { ++balls_; }

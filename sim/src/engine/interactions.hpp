@@ -177,6 +177,8 @@ template <Flight F, bool kExtras>
                   Pending& p) {
   // skip() in two halves (contacts.hpp): the wall just met is left out before the search.
   if (!l.meets_wall(i, w) || just_met(l.bodies, l.motion.straight(i), i, LastPartner::of(Partner::wall, w))) return;
+  // A ball sliding along the wall keeps touching it without meeting it (the sliding flight).
+  if (slides_on(l.motion.flight(), i, w)) [[unlikely]] return;
   const Segment& s = l.walls.segments[w];
   // Relative to the wall's first end, so walls far from the origin lose nothing.
   const double t = l.now + l.motion.toi_segment(i, bi.x - (s.p1 + shift), bi.v, Vec2{}, s, bi.r, p.t_coll - l.now);
@@ -263,6 +265,9 @@ template <Flight F, bool kExtras>
   const Vec2 rel = bi.x - (l.walls.ends[e].p + shift);
   const double t = l.now + l.motion.toi_point(i, rel, bi.v, Vec2{}, bi.r, p.t_coll - l.now);
   if (t < p.t_coll && !(l.bodies.held_against(i, LastPartner::of(Partner::end, e), t))) {
+    // A ball sliding along a wall passes its ends at the contact distance only when the slide
+    // ends there (the sliding flight's own event): until then it cannot meet them.
+    if (slides_to(l.motion.flight(), i, l.walls.ends[e].p)) [[unlikely]] return;
     // A straight path that passes an end at the contact distance (a disc sliding along a wall
     // past the joint with the next one) "touches and approaches" it by round-off only: a graze
     // (contacts.hpp, kEndGraze).

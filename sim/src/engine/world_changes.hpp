@@ -166,6 +166,7 @@ void Engine<F, kBallBall, kStep, kExtras>::remove_body(bool turtle, std::size_t 
   b.cell = kNone;
   ++b.count;  // predictions made against it are now stale
   heap_.remove(i);
+  if constexpr (kSlides) motion_.flight().end_slide(i);
   if (turtle) turtles_.exit(k, b, bodies_.end[i]);
 }
 
@@ -187,6 +188,7 @@ void Engine<F, kBallBall, kStep, kExtras>::teleport_ball(std::size_t k, Vec2 pos
   check_clear(pos, d.radius, layers, i);
   sync(i);
   unlink(i);
+  if constexpr (kSlides) motion_.flight().end_slide(i);  // a disc again where it is put
   bodies_.body[i].v = vel;
   place(i, pos);
 }

@@ -25,6 +25,7 @@ struct Stats {
   std::uint64_t wedged = 0;   ///< the squeeze rule took a body's velocity (docs/physics.md)
   std::uint64_t crushed = 0;  ///< bodies removed by the squeeze rule
   std::uint64_t folded = 0;   ///< elastic wedges served in closed form (their reflections count as ball_wall*)
+  std::uint64_t slides = 0;   ///< sliding flights begun (docs/physics.md, "The sliding flight"; each landing counts as ball_wall)
   /// The energy ledger of the zero-time rules (docs/physics.md, "The energy ledger"): the kinetic
   /// energy each rule took from the balls it acted on (negative: gave), and for `crushed` the
   /// energy (kinetic plus potential) of the balls it removed. Turtles have no energy to count.
