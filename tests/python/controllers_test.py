@@ -73,6 +73,25 @@ class TwinsTest(unittest.TestCase):
         self.twin("worlds/tests/braitenberg_no_touch.json", 120, "exact", chunk=10, must_have=("sense",))
 
 
+class ThreadsTest(unittest.TestCase):
+    def test_worlds_with_programs_in_threads(self):
+        # Runs of worlds with turtles take turns (one simulation thread at a time, fiber.hpp);
+        # each gives the log it gives alone.
+        import threading
+        alone, _ = python_events("worlds/tag.json", 30, "exact")
+        worlds = [turtlegas.World.load("worlds/tag.json", programs={"t5": controllers.tag_random, "t1": controllers.tag_chaser,
+                                                                     "t2": controllers.tag_chaser, "t3": controllers.tag_evader,
+                                                                     "t4": controllers.tag_evader}) for _ in range(3)]
+        threads = [threading.Thread(target=w.run, args=(30,)) for w in worlds]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        for w in worlds:
+            self.assertEqual(w.time, 30.0)
+            self.assertEqual(w.event_lines().encode(), alone)
+
+
 class ProtocolTest(unittest.TestCase):
     ROOM = {"format": "turtlegas-world/1", "seed": 4, "arena": {"width": 200, "height": 200, "boundary": "walls"},
             "turtles": [{"id": "t", "pos": [100, 100], "heading": 90, "speed": 50, "turn_rate": 180,
