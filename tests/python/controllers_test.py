@@ -72,6 +72,19 @@ class TwinsTest(unittest.TestCase):
     def test_braitenberg(self):
         self.twin("worlds/tests/braitenberg_no_touch.json", 120, "exact", chunk=10, must_have=("sense",))
 
+    def test_braitenberg_with_a_noisy_ring(self):
+        # The noise and the program's uniform() draw from one stream, in C++ and in Python alike.
+        with open("worlds/tests/braitenberg_no_touch.json") as f:
+            world = json.load(f)
+        world.pop("expect")
+        world["turtles"][0]["senses"][0]["noise"] = {"sd": 2.0, "dropout": 0.1}
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "noisy.json")
+            with open(path, "w") as f:
+                json.dump(world, f)
+            w = self.twin(path, 60, "exact", must_have=("sense",))
+        self.assertEqual(w.time, 60.0)
+
 
 class ThreadsTest(unittest.TestCase):
     def test_worlds_with_programs_in_threads(self):
