@@ -35,6 +35,7 @@ LAYERS = {
     "formats": 4,         # the output contracts: event log, state file, stats, SVG
     "server": 5,          # the network world server (on runtime, world_files and formats)
     "apps": 6,            # the programs (the turtlegas CLI)
+    "python": 6,          # the Python module (pybind11), beside the programs
     "bench": 7,           # benchmarks and tests see everything, private headers included
     "tests": 7,
     "fuzz": 7,            # the libFuzzer harnesses, like the tests

@@ -8,6 +8,7 @@ packages=(
   nlohmann-json3-dev libspdlog-dev libcli11-dev catch2
   libboost-dev libboost-context-dev   # libboost-dev: Asio and Beast (header-only) for server/
   python3
+  python3-dev pybind11-dev python3-numpy   # the Python module (python/, docs/python.md)
   dpkg-dev binutils   # the Debian package: cpack (dpkg-shlibdeps), tests/package/deb_test.py (readelf)
   clang libclang-rt-14-dev clang-tidy   # the clang and fuzz presets, scripts/clang_tidy.sh
   libopenmpi-dev openmpi-bin   # turtlegas sweep under mpirun (optional at build time; its test runs mpirun)

@@ -10,6 +10,7 @@
   - `apt-get install --simulate ./turtlegas_*.deb` accepts it (when apt-get is there).
 """
 import argparse
+import os
 import re
 import shutil
 import subprocess
@@ -98,6 +99,17 @@ def main():
             if not (root / rel).exists():
                 fail("the package does not hold /" + rel)
         check_installed_viewer(turtlegas, root / "usr/share/turtlegas/web", worlds / "tag.json", fail)
+
+        # The Python module, when the build made it: in Debian's system dist-packages.
+        if list((a.build / "python/turtlegas").glob("_turtlegas*.so")):
+            place = root / "usr/lib/python3/dist-packages"
+            if not (place / "turtlegas/__init__.py").exists() or not list((place / "turtlegas").glob("_turtlegas*.so")):
+                fail("the package does not hold the Python module in /usr/lib/python3/dist-packages/turtlegas")
+            script = ("import turtlegas, turtlegas.client, sys; w = turtlegas.World.load(sys.argv[1]); w.run(0.5); "
+                      "assert turtlegas.__file__.startswith(sys.argv[2]); print('ok')")
+            r = run([sys.executable, "-c", script, worlds / "gas.json", place], env=dict(os.environ, PYTHONPATH=str(place)))
+            if r.stdout.strip() != "ok":
+                fail("the packaged Python module printed " + repr(r.stdout))
 
         if not list(root.glob("usr/lib*/**/cmake/turtlegas/turtlegasConfig.cmake")):
             fail("the package does not hold the CMake package (usr/lib/.../cmake/turtlegas)")

@@ -8,7 +8,8 @@ Installs the build tree into a temporary prefix with `cmake --install`, then:
   - the example plugin, copied out of the prefix as an out-of-tree project (the <= 10-line
     CMakeLists.txt that docs/controllers.md shows), configures with find_package(turtlegas), builds
     with turtlegas_add_plugin's flags and runs under the installed program;
-  - the same plugin built with `pkg-config --cflags --libs turtlegas` gives the same event log.
+  - the same plugin built with `pkg-config --cflags --libs turtlegas` gives the same event log;
+  - the Python module (when built) imports from where it was installed and runs a world.
 Exits non-zero with a message on the first thing that is wrong.
 """
 import argparse
@@ -35,6 +36,23 @@ def run(cmd, **kw):
         fail("{} exited with {}\nstdout:\n{}\nstderr:\n{}".format(" ".join(map(str, cmd)), r.returncode, r.stdout[-3000:],
                                                               r.stderr[-3000:]))
     return r
+
+
+def check_python_package(build, prefix, world):
+    """The Python module, when the build made it: installed under lib/python3.X/dist-packages (the
+    place Debian's python3 reads under a prefix other than /usr, docs/python.md), it imports from
+    there with its client and runs a world."""
+    if not list((build / "python/turtlegas").glob("_turtlegas*.so")):
+        return
+    found = sorted(prefix.glob("lib/python3*/*-packages/turtlegas/__init__.py"))
+    if len(found) != 1:
+        fail("cmake --install put the Python package in {} places under lib/python3*/: {}".format(len(found), found))
+    place = found[0].parent.parent
+    script = ("import turtlegas, turtlegas.client, sys; w = turtlegas.World.load(sys.argv[1]); w.run(0.5); "
+              "assert w.stats['collisions'] > 0; assert turtlegas.__file__.startswith(sys.argv[2]); print('ok')")
+    r = run([sys.executable, "-c", script, world, place], env=dict(os.environ, PYTHONPATH=str(place)), cwd=prefix)
+    if r.stdout.strip() != "ok":
+        fail("the installed Python module printed " + repr(r.stdout))
 
 
 def count_touches(events):
@@ -75,6 +93,7 @@ def main():
             fail("turtlegas --version printed " + repr(version))
 
         check_installed_viewer(turtlegas, prefix / "share/turtlegas/web", prefix / "share/turtlegas/worlds/tag.json", fail)
+        check_python_package(a.build, prefix, prefix / "share/turtlegas/worlds/gas.json")
 
         # Every installed header on its own: a missing include shows here, not in a user's build.
         headers = sorted((prefix / "include").rglob("*.hpp"))
