@@ -12,21 +12,19 @@
 
 #include "turtlegas/sim/angles.hpp"
 #include "turtlegas/sim/ray_cast.hpp"
+#include "ring_cast.hpp"
 #include "worker_pool.hpp"
 
 namespace turtlegas::learn {
 namespace {
 
-/// One ray of a turtle's range sensors: its bearing from the heading (radians, clockwise) and range.
-struct RaySpec {
-  double bearing = 0.0;
-  double range = 0.0;
-};
-
 /// What VecWorld keeps of a turtle's program: its sensors.
 struct TurtleSenses {
   std::vector<turtle::SensorArc> arcs;  // degrees, as the runtime keeps them
-  std::vector<RaySpec> rays;            // every range sensor's rays, in declaration order
+  // Every range sensor's rays, in declaration order: the sine and cosine of each ray's bearing
+  // (so that a ray's direction is the heading's turned by it, one sincos a turtle) and its range.
+  std::vector<double> sin_bearing, cos_bearing, ranges;
+  double reach = 0.0;  // the longest range
   bool gps = false;
 };
 
@@ -74,6 +72,9 @@ class VecWorld::Impl {
     std::vector<double> turned;          // per turtle: radians turned in the last step (clockwise)
     std::vector<double> turn_sign, move_sign;  // of the commands given this step
     std::vector<sim::TurtleContact> scratch;
+    std::optional<detail::RingCaster> caster;  // when it applies to the scene (ring_cast.hpp)
+    std::vector<sim::Vec2> dirs;
+    std::vector<sim::RayHit> hits;
   };
 
   Impl(const world::Scene& scene, std::size_t n, VecWorldOptions opt)
@@ -88,10 +89,15 @@ class VecWorld::Impl {
       const turtle::TurtleProgram& p = scene.programs.at(k);
       s.arcs = p.sensors;
       for (const turtle::RangeSensor& r : p.senses)
-        for (double b : r.bearings) s.rays.push_back({sim::to_radians(b), r.range});
+        for (double b : r.bearings) {
+          s.sin_bearing.push_back(std::sin(sim::to_radians(b)));
+          s.cos_bearing.push_back(std::cos(sim::to_radians(b)));
+          s.ranges.push_back(r.range);
+          s.reach = std::max(s.reach, r.range);
+        }
       s.gps = p.gps;
       lay.touch_count = std::max(lay.touch_count, std::min<std::size_t>(s.arcs.size(), 64));
-      lay.range_count = std::max(lay.range_count, s.rays.size());
+      lay.range_count = std::max(lay.range_count, s.ranges.size());
       if (s.gps) lay.gps_count = 1;
       senses.push_back(std::move(s));
       ids.push_back(def.turtles[k].id);
@@ -152,6 +158,7 @@ class VecWorld::Impl {
       }
     }
     w.take_turtle_contacts();
+    if (!c.caster && detail::RingCaster::applies(w, def)) c.caster.emplace(w, def);
     c.steps = 0;
     c.contacts = 0;
     c.terminated = c.truncated = false;
@@ -267,9 +274,10 @@ class VecWorld::Impl {
   }
 
   /// Copy i's rows of obs, as its world stands now.
-  void observe(std::size_t i, float* obs) const {
-    const Copy& c = copies[i];
+  void observe(std::size_t i, float* obs) {
+    Copy& c = copies[i];
     const sim::World& w = *c.world;
+    if (c.caster) c.caster->begin(w);
     sim::Ray ray;
     for (std::size_t k = 0; k < turtles(); ++k) {
       float* row = obs + k * lay.size;
@@ -280,24 +288,36 @@ class VecWorld::Impl {
       row[lay.odometry + 1] = static_cast<float>(c.turned[k]);
       if (!w.turtle_alive(k)) continue;  // a turtle gone: its rays read nothing, its pose 0
       const sim::TurtleState st = w.turtle(k);
-      row[lay.heading] = static_cast<float>(std::sin(st.heading));
-      row[lay.heading + 1] = static_cast<float>(std::cos(st.heading));
-      if (senses[k].gps) {
+      const double sh = std::sin(st.heading), ch = std::cos(st.heading);
+      row[lay.heading] = static_cast<float>(sh);
+      row[lay.heading + 1] = static_cast<float>(ch);
+      const TurtleSenses& ts = senses[k];
+      if (ts.gps) {
         row[lay.gps] = static_cast<float>(st.pos.x);
         row[lay.gps + 1] = static_cast<float>(st.pos.y);
       }
-      const std::vector<RaySpec>& rays = senses[k].rays;
-      if (rays.empty()) continue;
-      ray.origin = st.pos;
-      ray.layers = def.turtles[k].layers;
-      ray.self = static_cast<std::uint32_t>(k);
-      for (std::size_t r = 0; r < rays.size(); ++r) {
-        ray.range = rays[r].range;
-        const double h = st.heading + rays[r].bearing;
-        ray.dir = {std::sin(h), std::cos(h)};  // Logo: 0 is +y, clockwise
-        const sim::RayHit hit = w.cast_ray(ray);
-        if (hit.hit()) row[lay.range + r] = static_cast<float>(hit.distance / rays[r].range);
+      const std::size_t nr = ts.ranges.size();
+      if (nr == 0) continue;
+      // Heading h turned by bearing b: (sin(h + b), cos(h + b)), Logo's 0 at +y, clockwise.
+      c.dirs.resize(nr);
+      for (std::size_t r = 0; r < nr; ++r)
+        c.dirs[r] = {sh * ts.cos_bearing[r] + ch * ts.sin_bearing[r], ch * ts.cos_bearing[r] - sh * ts.sin_bearing[r]};
+      const sim::Layers& layers = def.turtles[k].layers;
+      if (c.caster) {
+        c.caster->cast(w, st.pos, layers, static_cast<std::uint32_t>(k), c.dirs, ts.ranges, ts.reach, c.hits);
+      } else {
+        c.hits.resize(nr);
+        ray.origin = st.pos;
+        ray.layers = layers;
+        ray.self = static_cast<std::uint32_t>(k);
+        for (std::size_t r = 0; r < nr; ++r) {
+          ray.range = ts.ranges[r];
+          ray.dir = c.dirs[r];
+          c.hits[r] = w.cast_ray(ray);
+        }
       }
+      for (std::size_t r = 0; r < nr; ++r)
+        if (c.hits[r].hit()) row[lay.range + r] = static_cast<float>(c.hits[r].distance / ts.ranges[r]);
     }
   }
 
