@@ -24,6 +24,8 @@ struct TurtleSenses {
   // Every range sensor's rays, in declaration order: the sine and cosine of each ray's bearing
   // (so that a ray's direction is the heading's turned by it, one sincos a turtle) and its range.
   std::vector<double> sin_bearing, cos_bearing, ranges;
+  std::vector<double> noise, dropout;  // each ray's sensor's (RangeSensor::noise, dropout)
+  bool noisy = false;
   double reach = 0.0;  // the longest range
   bool gps = false;
 };
@@ -63,6 +65,7 @@ class VecWorld::Impl {
   struct Copy {
     std::optional<sim::World> world;
     std::mt19937_64 actions_rng;
+    std::mt19937_64 noise_rng;  // the range sensors' noise, drawn in turtle and ray order
     std::uint64_t steps = 0;
     std::uint64_t contacts = 0;
     bool terminated = false;
@@ -93,6 +96,9 @@ class VecWorld::Impl {
           s.sin_bearing.push_back(std::sin(sim::to_radians(b)));
           s.cos_bearing.push_back(std::cos(sim::to_radians(b)));
           s.ranges.push_back(r.range);
+          s.noise.push_back(r.noise);
+          s.dropout.push_back(r.dropout);
+          s.noisy = s.noisy || r.noise > 0.0 || r.dropout > 0.0;
           s.reach = std::max(s.reach, r.range);
         }
       s.gps = p.gps;
@@ -137,6 +143,7 @@ class VecWorld::Impl {
     sim::World& w = *c.world;
     std::mt19937_64 place(mix(mix(seed) ^ mix(2 * i + 1)));
     c.actions_rng.seed(mix(mix(seed + 1) ^ mix(2 * i + 2)));
+    c.noise_rng.seed(mix(mix(seed + 2) ^ mix(2 * i + 1)));
     if (options.random_start) {
       const double width = def.arena.width, height = def.arena.height;
       for (std::size_t k = 0; k < turtles(); ++k) {
@@ -273,6 +280,25 @@ class VecWorld::Impl {
     end_step(c);
   }
 
+  /// Sensor noise on the hits of one turtle's rays, as the runtime's Turtle::scan adds it
+  /// (turtle_runtime/src/senses.cpp): a hit dropped with probability `dropout`, else a Gaussian of
+  /// sd `noise` added (not below 0; beyond the range it reads as nothing). From the copy's stream.
+  static void add_noise(Copy& c, const TurtleSenses& ts) {
+    auto uniform = [&] { return uniform01(c.noise_rng); };
+    for (std::size_t r = 0; r < c.hits.size(); ++r) {
+      sim::RayHit& hit = c.hits[r];
+      if (!hit.hit() || (ts.noise[r] <= 0.0 && ts.dropout[r] <= 0.0)) continue;
+      if (ts.dropout[r] > 0.0 && uniform() < ts.dropout[r]) {
+        hit = {};
+      } else if (ts.noise[r] > 0.0) {
+        // Box-Muller: 1 - u is in (0, 1], so the logarithm is finite.
+        const double g = std::sqrt(-2.0 * std::log(1.0 - uniform())) * std::cos(2.0 * std::numbers::pi * uniform());
+        hit.distance = std::max(0.0, hit.distance + ts.noise[r] * g);
+        if (hit.distance > ts.ranges[r]) hit = {};
+      }
+    }
+  }
+
   /// Copy i's rows of obs, as its world stands now.
   void observe(std::size_t i, float* obs) {
     Copy& c = copies[i];
@@ -316,6 +342,7 @@ class VecWorld::Impl {
           c.hits[r] = w.cast_ray(ray);
         }
       }
+      if (ts.noisy) add_noise(c, ts);
       for (std::size_t r = 0; r < nr; ++r)
         if (c.hits[r].hit()) row[lay.range + r] = static_cast<float>(c.hits[r].distance / ts.ranges[r]);
     }

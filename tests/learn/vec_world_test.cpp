@@ -301,6 +301,46 @@ TEST_CASE("VecWorld: gps where granted; truncated after max_steps; terminated wh
   CHECK(!v.world(0).turtle_alive(0));
 }
 
+TEST_CASE("VecWorld: range sensor noise and dropout, from each copy's own stream") {
+  // The front ray reads the wall 28 units away: sd 0.5, dropout 0.1, over 200 copies x 10 steps.
+  const std::string noisy = R"({"format": "turtlegas-world/1", "dt": 0.1,
+    "arena": {"width": 400, "height": 300, "boundary": "walls"},
+    "walls": [{"id": "w", "from": [128, 0], "to": [128, 300]}],
+    "turtles": [{"id": "t", "pos": [100, 150], "heading": 90, "radius": 10, "controller": "remote",
+                 "senses": [{"name": "f", "bearing": 0, "range": 100, "noise": {"sd": 0.5, "dropout": 0.1}}]}]})";
+  tl::VecWorldOptions o;
+  o.random_start = false;
+  o.threads = 2;
+  auto readings = [&](std::uint64_t seed) {
+    tl::VecWorld v(tw::parse_scene(noisy, "noisy.json", registry()), 200, o);
+    Run r(v);
+    std::vector<float> out;
+    v.reset(seed, r.obs);
+    const std::vector<float> still(200 * 2, 0.0f);
+    for (int s = 0; s < 10; ++s) {
+      v.step(still, r.obs, r.term, r.trunc);
+      for (std::size_t i = 0; i < 200; ++i) out.push_back(r.obs[i * v.obs_size() + v.layout().range]);
+    }
+    return out;
+  };
+  const std::vector<float> a = readings(5), b = readings(5), c = readings(6);
+  CHECK(a == b);
+  CHECK(a != c);
+  double n = 0, sum = 0, sum2 = 0, dropped = 0;
+  for (float x : a) {
+    if (x == 1.0f) {
+      ++dropped;
+      continue;
+    }
+    const double d = 100.0 * x;
+    ++n, sum += d, sum2 += d * d;
+  }
+  const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean), p = dropped / 2000.0;
+  CHECK(std::fabs(mean - 28.0) < 5 * 0.5 / std::sqrt(n));
+  CHECK(std::fabs(sd - 0.5) < 0.05);
+  CHECK(std::fabs(p - 0.1) < 5 * std::sqrt(0.1 * 0.9 / 2000.0));
+}
+
 TEST_CASE("VecWorld: refuses no copies and a world without turtles") {
   CHECK_THROWS_AS(tl::VecWorld(swarm(), 0), std::invalid_argument);
   const std::string empty = R"({"format": "turtlegas-world/1", "arena": {"width": 100, "height": 100}})";

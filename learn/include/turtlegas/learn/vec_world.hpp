@@ -15,8 +15,9 @@
 //   actions logo (one integer per turtle): 0 wait, 1 forward, 2 back, 3 left, 4 right, each for
 //   the whole control step at the turtle's speed or turn rate.
 //   3. At t + dt each turtle's observation is written (ObsLayout): the touch arcs fired by the
-//      step's contacts, its range sensors cast now (sim::World::cast_ray), its odometry of the
-//      step, its heading, and its position where the world file grants it "gps".
+//      step's contacts, its range sensors cast now (sim::World::cast_ray's answers, with the
+//      sensor's noise and dropout drawn from the copy's own stream), its odometry of the step, its
+//      heading, and its position where the world file grants it "gps".
 // The copies share nothing: each has its own sim::World and random stream, so the results do not
 // depend on the number of threads or on which thread steps which copy.
 #pragma once
