@@ -34,6 +34,7 @@ LAYERS = {
     "world_files": 4,     # reading world files: loader, gas, draw, expect, games, tournaments
     "formats": 4,         # the output contracts: event log, state file, stats, SVG
     "server": 5,          # the network world server (on runtime, world_files and formats)
+    "learn": 5,           # vectorised worlds for learning: VecWorld (on the engine and world_files)
     "apps": 6,            # the programs (the turtlegas CLI)
     "python": 6,          # the Python module (pybind11), beside the programs
     "bench": 7,           # benchmarks and tests see everything, private headers included

@@ -29,7 +29,7 @@ def expect(program, args, code, stream, text):
         failures.append(f"{program} {' '.join(args)}: exit {rc} (want {code}), {stream} {got!r} (want {text!r})")
 
 
-for program in ["gas_bench", "accuracy_bench", "turtle_bench", "turtle_soak"]:
+for program in ["gas_bench", "accuracy_bench", "turtle_bench", "turtle_soak", "vec_bench"]:
     expect(program, ["--help"], 0, "out", "usage: " + program)
     expect(program, ["-h"], 0, "out", "usage: " + program)
 
@@ -41,6 +41,8 @@ expect("turtle_bench", ["--steps", "2.5"], 2, "err", "--steps needs a whole numb
 expect("turtle_bench", ["--stack-kib", "8"], 2, "err", "--stack-kib needs a whole number from 16")
 expect("turtle_soak", ["--turtle-steps"], 2, "err", "--turtle-steps needs a value")
 expect("turtle_bench", ["--frobnicate", "1"], 2, "err", "unknown option --frobnicate")
+expect("vec_bench", ["--threads", "0"], 2, "err", "--threads needs a whole number from 1 to 1024, got '0'")
+expect("vec_bench", ["--actions", "jump"], 2, "err", "--actions takes velocity, wheels or logo, got 'jump'")
 
 for f in failures:
     print("FAIL:", f)
