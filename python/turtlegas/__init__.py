@@ -10,5 +10,6 @@ turtlegas.client is the network client of `turtlegas serve` (docs/protocol.md).
 
 from ._turtlegas import Event, World, WorldError
 from . import controllers, programs
+from .vec import VecWorld
 
-__all__ = ["Event", "World", "WorldError", "controllers", "programs"]
+__all__ = ["Event", "VecWorld", "World", "WorldError", "controllers", "programs"]

@@ -16,7 +16,7 @@ import os
 
 import numpy as np
 
-from . import _core
+from . import _turtlegas as _core
 
 ACTION_KINDS = ("velocity", "wheels", "logo")
 LOGO_ACTIONS = ("wait", "forward", "back", "left", "right")
