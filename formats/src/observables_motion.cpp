@@ -50,12 +50,15 @@ void Observer::unwrap() {
     for (std::size_t i = 0; i < w.ball_count(); ++i) unwrapped_[i] = w.ball(i).pos;
     return;
   }
+  // The unwrapped position is the wrapped one plus whole periods, counted: it does not depend on
+  // where the run stopped on the way (the CLI and the Python module stop at different times, and a
+  // sum of displacements would differ in its last digits).
   for (std::size_t i = 0; i < w.ball_count(); ++i) {
     const sim::Vec2 p = w.ball(i).pos;
-    sim::Vec2 d = p - last_pos_[i];
-    d.x -= width_ * std::round(d.x / width_);
-    d.y -= height_ * std::round(d.y / height_);
-    unwrapped_[i] += d;
+    const sim::Vec2 d = p - last_pos_[i];
+    images_[i].x -= std::round(d.x / width_);
+    images_[i].y -= std::round(d.y / height_);
+    unwrapped_[i] = {p.x + images_[i].x * width_, p.y + images_[i].y * height_};
     last_pos_[i] = p;
   }
 }
@@ -64,6 +67,7 @@ void Observer::start_motion() {
   const sim::World& w = *world_;
   unwrapped_.resize(w.ball_count());
   last_pos_.resize(w.ball_count());
+  images_.assign(w.ball_count(), sim::Vec2{});
   for (std::size_t i = 0; i < w.ball_count(); ++i) unwrapped_[i] = last_pos_[i] = w.ball(i).pos;
   frame_pos_.clear();
   frame_vel_.clear();

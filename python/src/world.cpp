@@ -217,16 +217,17 @@ void World::run_in_reads(double until, const std::function<void(double)>& advanc
       const sim::Vec2 at = w.ball(i).pos;
       unwrapped_[2 * i] = last_wrapped_[2 * i] = at.x;
       unwrapped_[2 * i + 1] = last_wrapped_[2 * i + 1] = at.y;
+      images_[2 * i] = images_[2 * i + 1] = 0.0;
     }
     restart_.clear();
+    // Wrapped position plus whole periods crossed, counted: the same wherever the run stopped.
     for (std::size_t i = 0; i < w.ball_count(); ++i) {
       const sim::BallState b = w.ball(i);
       if (!b.alive) continue;
-      double dx = b.pos.x - last_wrapped_[2 * i], dy = b.pos.y - last_wrapped_[2 * i + 1];
-      dx -= a.width * std::round(dx / a.width);
-      dy -= a.height * std::round(dy / a.height);
-      unwrapped_[2 * i] += dx;
-      unwrapped_[2 * i + 1] += dy;
+      images_[2 * i] -= std::round((b.pos.x - last_wrapped_[2 * i]) / a.width);
+      images_[2 * i + 1] -= std::round((b.pos.y - last_wrapped_[2 * i + 1]) / a.height);
+      unwrapped_[2 * i] = b.pos.x + images_[2 * i] * a.width;
+      unwrapped_[2 * i + 1] = b.pos.y + images_[2 * i + 1] * a.height;
       last_wrapped_[2 * i] = b.pos.x;
       last_wrapped_[2 * i + 1] = b.pos.y;
     }
@@ -240,6 +241,7 @@ void World::note_new_balls() {
     const sim::BallState b = w.ball(i);
     unwrapped_.insert(unwrapped_.end(), {b.pos.x, b.pos.y});
     last_wrapped_.insert(last_wrapped_.end(), {b.pos.x, b.pos.y});
+    images_.insert(images_.end(), {0.0, 0.0});
     min_mass_ = i == 0 ? w.mass(i) : std::min(min_mass_, w.mass(i));
   }
 }

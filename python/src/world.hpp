@@ -128,6 +128,7 @@ class World {
   // ball can cross a quarter of the arena (run_in_reads).
   bool unwrap_ = false;
   std::vector<double> unwrapped_, last_wrapped_;
+  std::vector<double> images_;  // whole periods crossed per coordinate (integers)
   std::vector<std::size_t> restart_;  // teleported balls: their unwrapped track starts again
   double min_mass_ = 0.0;
   // The ball arrays radii(), masses(), charges() hand out; rebuilt when balls are added.

@@ -109,6 +109,7 @@ class Observer {
   std::vector<std::size_t> species_of_;   ///< per ball
   double rdf_max_ = 0.0;
   std::vector<sim::Vec2> unwrapped_, last_pos_;  ///< since `from`; positions at the last unwrap
+  std::vector<sim::Vec2> images_;  ///< per ball: whole periods crossed since `from` (integers)
   /// Per window: frames 0..samples of unwrapped positions and velocities (NaN x: not alive).
   std::vector<std::vector<sim::Vec2>> frame_pos_, frame_vel_;
   std::vector<sim::Impulse> impulses_;
