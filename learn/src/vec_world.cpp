@@ -203,6 +203,16 @@ class VecWorld::Impl {
     if (options.max_steps && c.steps >= options.max_steps) c.truncated = true;
   }
 
+  /// Commands turtle k to turn or move by `amount`, or to stop when it is 0; returns its sign.
+  static double command(sim::World& w, std::size_t k, sim::TurtleCommand::Kind kind, double amount) {
+    if (amount == 0.0) {
+      w.command_turtle(k, {sim::TurtleCommand::Kind::stop, 0.0});
+      return 0.0;
+    }
+    w.command_turtle(k, {kind, amount});
+    return amount > 0.0 ? 1.0 : -1.0;
+  }
+
   void step_continuous(std::size_t i, const float* a) {
     Copy& c = copies[i];
     if (c.terminated || c.truncated) return;
@@ -218,12 +228,7 @@ class VecWorld::Impl {
       // Wheels (l, r): a differential drive whose full opposite wheels turn at the full rate.
       const double omega = options.actions == ActionKind::wheels ? 0.5 * (x - y) : y;
       const double angle = omega * def.turtles[k].turn_rate * dt * 0.5;
-      if (angle != 0.0) {
-        w.command_turtle(k, {sim::TurtleCommand::Kind::turn, angle});
-        c.turn_sign[k] = angle > 0 ? 1.0 : -1.0;
-      } else {
-        w.command_turtle(k, {sim::TurtleCommand::Kind::stop, 0.0});
-      }
+      c.turn_sign[k] = command(w, k, sim::TurtleCommand::Kind::turn, angle);
     }
     w.advance_to(t0 + 0.5 * dt);
     collect_contacts(c);
@@ -234,12 +239,7 @@ class VecWorld::Impl {
       const double x = clamp_action(a[2 * k]), y = clamp_action(a[2 * k + 1]);
       const double v = options.actions == ActionKind::wheels ? 0.5 * (x + y) : x;
       const double distance = v * def.turtles[k].speed * dt * 0.5;
-      if (distance != 0.0) {
-        w.command_turtle(k, {sim::TurtleCommand::Kind::move, distance});
-        c.move_sign[k] = distance > 0 ? 1.0 : -1.0;
-      } else {
-        w.command_turtle(k, {sim::TurtleCommand::Kind::stop, 0.0});
-      }
+      c.move_sign[k] = command(w, k, sim::TurtleCommand::Kind::move, distance);
     }
     w.advance_to(t0 + dt);
     collect_contacts(c);

@@ -13,18 +13,11 @@ import sys
 import tempfile
 from pathlib import Path
 
-
-def fail(msg):
-    print("sweep_observe_test: FAIL: " + msg, file=sys.stderr)
-    sys.exit(1)
+from sweeptest import Checker
 
 
-def run(cmd, cwd, ok=(0,), env=None):
-    r = subprocess.run([str(c) for c in cmd], cwd=cwd, capture_output=True, text=True, timeout=600, env=env)
-    if r.returncode not in ok:
-        fail("{} exited with {}\nstdout:\n{}\nstderr:\n{}".format(" ".join(map(str, cmd)), r.returncode, r.stdout[-3000:],
-                                                              r.stderr[-3000:]))
-    return r
+CHECK = Checker("sweep_observe_test")
+fail, run = CHECK.fail, CHECK.run
 
 
 def main():

@@ -13,20 +13,17 @@ import sys
 import tempfile
 from pathlib import Path
 
+from sweeptest import Checker
 
-def fail(msg):
-    print("sweep_tasks_test: FAIL: " + msg, file=sys.stderr)
-    sys.exit(1)
+
+CHECK = Checker("sweep_tasks_test")
+fail = CHECK.fail
 
 
 def run(cmd, cwd, ok=(0,), env_add=None):
     env = {k: v for k, v in os.environ.items() if k not in ("SLURM_ARRAY_TASK_ID", "PBS_ARRAY_INDEX", "PBS_ARRAYID")}
     env.update(env_add or {})
-    r = subprocess.run([str(c) for c in cmd], cwd=cwd, capture_output=True, text=True, timeout=600, env=env)
-    if r.returncode not in ok:
-        fail("{} ({}) exited with {}\nstdout:\n{}\nstderr:\n{}".format(" ".join(map(str, cmd)), env_add, r.returncode,
-                                                                    r.stdout[-3000:], r.stderr[-3000:]))
-    return r
+    return CHECK.run(cmd, cwd, env=env, ok=ok, note=env_add)
 
 
 def main():

@@ -16,18 +16,11 @@ import tempfile
 import time
 from pathlib import Path
 
-
-def fail(msg):
-    print("sweep_test: FAIL: " + msg, file=sys.stderr)
-    sys.exit(1)
+from sweeptest import Checker
 
 
-def run(cmd, cwd, env=None, ok=(0,)):
-    r = subprocess.run([str(c) for c in cmd], cwd=cwd, env=env, capture_output=True, text=True, timeout=600)
-    if r.returncode not in ok:
-        fail("{} exited with {}\nstdout:\n{}\nstderr:\n{}".format(" ".join(map(str, cmd)), r.returncode, r.stdout[-3000:],
-                                                              r.stderr[-3000:]))
-    return r
+CHECK = Checker("sweep_test")
+fail, run = CHECK.fail, CHECK.run
 
 
 def check_mpi_crash(mpirun, tg, plugin, tmp, env):
