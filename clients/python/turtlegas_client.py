@@ -488,7 +488,7 @@ class World:
         if takeover:
             msg["takeover"] = True
         reply = self.request(msg)
-        t = RemoteTurtle(self, turtle, reply.get("sensors", []))
+        t = RemoteTurtle(self, turtle, reply.get("sensors", []), reply.get("senses", []))
         self._turtles[turtle] = t
         return t
 
@@ -594,10 +594,11 @@ class World:
 class RemoteTurtle:
     """A claimed turtle. Its commands block until their result, like the C++ Turtle's."""
 
-    def __init__(self, world, turtle_id, sensors):
+    def __init__(self, world, turtle_id, sensors, senses=()):
         self.world = world
         self.id = turtle_id
-        self.sensors = sensors
+        self.sensors = sensors  # the touch arcs' names
+        self.senses = list(senses)  # range sensors: {"name", "bearings", "range"}, for sense(name)
         self._inbox = collections.deque()  # touches, messages, faults (filed by World._dispatch)
         self.touches = []    # every touch interrupt, in order
         self.messages = []   # every message, in order

@@ -80,12 +80,7 @@ void WorldHost::on_claim(ClientState& c, const json& m, const std::string& /*typ
   if (server_->is_remote(i)) {
     s.owner = c.client->id;
     ++c.claims;
-    json r = {{"type", "claimed"}};
-    if (!id.is_null()) r["id"] = id;
-    json sensors = json::array();
-    for (const turtle::SensorArc& a : scene_.programs[i].sensors) sensors.push_back(a.name);
-    r.update({{"turtle", tid}, {"index", i}, {"sensors", sensors}, {"takeover", false}, {"t", server_->time()}, {"step", server_->step()}});
-    reply(c, r);
+    reply(c, claimed_reply(id, i, false, server_->time(), server_->step()));
     return;
   }
   if (!takeover)
@@ -159,13 +154,7 @@ void WorldHost::apply_takeovers(turtle::WorldServer& server, std::uint64_t step)
     Slot& s = slots_[t.turtle];
     s = Slot{};
     s.owner = t.client;
-    json r = {{"type", "claimed"}};
-    if (!t.id.is_null()) r["id"] = t.id;
-    json sensors = json::array();
-    for (const turtle::SensorArc& a : scene_.programs[t.turtle].sensors) sensors.push_back(a.name);
-    r.update({{"turtle", scene_.def.turtles[t.turtle].id}, {"index", t.turtle}, {"sensors", sensors}, {"takeover", true},
-              {"t", server.time()}, {"step", step}});
-    reply(it->second, r);
+    reply(it->second, claimed_reply(t.id, t.turtle, true, server.time(), step));
   }
 }
 

@@ -38,15 +38,32 @@ json WorldHost::status_json() const {
   return st;
 }
 
+json WorldHost::sensors_json(std::size_t i) const {
+  json sensors = json::array();
+  for (const turtle::SensorArc& a : scene_.programs[i].sensors) sensors.push_back(a.name);
+  return sensors;
+}
+
+json WorldHost::senses_json(std::size_t i) const {
+  json senses = json::array();  // range sensors: the viewer draws their rays (docs/viewer.md)
+  for (const turtle::RangeSensor& r : scene_.programs[i].senses)
+    senses.push_back({{"name", r.name}, {"bearings", r.bearings}, {"range", r.range}});
+  return senses;
+}
+
+json WorldHost::claimed_reply(const json& id, std::size_t i, bool takeover, double t, std::uint64_t step) const {
+  json r = {{"type", "claimed"}};
+  if (!id.is_null()) r["id"] = id;
+  r.update({{"turtle", scene_.def.turtles[i].id}, {"index", i}, {"sensors", sensors_json(i)},
+            {"senses", senses_json(i)}, {"takeover", takeover}, {"t", t}, {"step", step}});
+  return r;
+}
+
 json WorldHost::world_json() const {
   const sim::WorldDef& def = scene_.def;
   json turtles = json::array();
   for (std::size_t i = 0; i < server_->turtle_count(); ++i) {
-    json sensors = json::array();
-    for (const turtle::SensorArc& a : scene_.programs[i].sensors) sensors.push_back(a.name);
-    json senses = json::array();  // range sensors: the viewer draws their rays (docs/viewer.md)
-    for (const turtle::RangeSensor& r : scene_.programs[i].senses)
-      senses.push_back({{"name", r.name}, {"bearings", r.bearings}, {"range", r.range}});
+    const json sensors = sensors_json(i), senses = senses_json(i);
     turtles.push_back({{"id", def.turtles[i].id},
                        {"index", i},
                        {"controller", server_->controller(i)},

@@ -16,6 +16,8 @@ from turtlegas_client import ServerError, World
 
 def drive(w):
     t = w.claim("t1")
+    check([(x["name"], x["bearings"], x["range"]) for x in t.senses] == [("front", [0], 500), ("ring", [0, 90, 180, 270], 160)],
+          "the claimed reply lists the range sensors: %r" % t.senses)
     w.resume()
     front = t.sense("front")
     check(len(front) == 1, "one ray: %r" % front)

@@ -195,6 +195,12 @@ class WorldHost {
   void broadcast_status();
   nlohmann::json status_json() const;
   nlohmann::json world_json() const;
+  /// Turtle i's touch arcs (names) and range sensors ({name, bearings, range}), as the world
+  /// message and the claimed reply give them.
+  nlohmann::json sensors_json(std::size_t i) const;
+  nlohmann::json senses_json(std::size_t i) const;
+  /// The reply to a claim of turtle i granted at time t, control step `step` (docs/protocol.md).
+  nlohmann::json claimed_reply(const nlohmann::json& id, std::size_t i, bool takeover, double t, std::uint64_t step) const;
   nlohmann::json ok(const nlohmann::json& m, const char* request) const;
   std::size_t turtle_index(const nlohmann::json& m, const char* example) const;
   void require_live() const;
