@@ -88,3 +88,56 @@ TEST_CASE("3-D world file errors name the JSON path and the fix, exit 2") {
     CHECK(contains(r.err, c.says));
   }
 }
+
+TEST_CASE("test of a 3-D world: a wrong expectation fails naming its entry and the values seen") {
+  TempDir dir;
+  // The box bounce's sphere meets arena-x1 at t = 2, 10, 18; each wrong entry below must fail.
+  const auto world = dir.write("bad.json", R"({"format": "turtlegas-world/1", "dimensions": 3,
+    "arena": {"width": 10, "height": 10, "depth": 10, "boundary": "walls"},
+    "balls": [{"id": "s", "pos": [5, 5, 5], "vel": [2, 1, 0.5], "radius": 1}],
+    "expect": [{"until": 19}, {"count": "ball-wall", "b": "arena-x1", "min": 4},
+               {"near": [7, 8, 3.5], "who": "s", "within": 1e-9},
+               {"near": [7, 8, 3.6], "who": "s", "within": 1e-3},
+               {"velocity": [2, 1, -0.5], "who": "s", "within": 1e-9, "at": 19},
+               {"event": "ball-wall", "b": "arena-z0"},
+               {"no_event": "ball-wall", "b": "arena-y1"},
+               {"inside": [[1, 1, 1], [9, 9, 8]]}]})");
+  const auto r = run(dir, {"test", world.string()});
+  INFO(r.out << r.err);
+  CHECK(r.code == 1);
+  CHECK(contains(r.out, "FAIL"));
+  CHECK(contains(r.out, "expect[1] count ball-wall b arena-x1 = 3, wanted >= 4"));
+  CHECK(!contains(r.out, "expect[2]"));
+  CHECK(contains(r.out, "expect[3] near [7, 8, 3.6]: s is at [7, 8, 3.5"));
+  CHECK(contains(r.out, "expect[4] velocity [2, 1, -0.5]: s moves at [-2, 1, -0.5"));
+  CHECK(contains(r.out, "expect[5] event ball-wall b arena-z0: none happened"));
+  CHECK(contains(r.out, "expect[6] no_event ball-wall b arena-y1: 1 happened, the first at t = 4"));
+  CHECK(contains(r.out, "expect[7] inside"));
+}
+
+TEST_CASE("test of 3-D worlds: the project's pass, and bad entries are errors at their JSON path") {
+  TempDir dir;
+  auto r = run(dir, {"test", "worlds/tests/box_bounce3d.json", "worlds/tests/edge_corner3d.json"});
+  INFO(r.out << r.err);
+  CHECK(r.code == 0);
+  CHECK(contains(r.out, "PASS worlds/tests/box_bounce3d.json (3-D, 18 assertions"));
+  struct Case { const char* expect; const char* says; };
+  const Case cases[] = {
+      {R"([{"until": 1}, {"count": "ball-wal", "min": 1}])", "/expect/1/count: \"ball-wal\" is not an event of a 3-D world"},
+      {R"([{"until": 1}, {"near": [1, 2], "who": "s", "within": 1}])", "/expect/1/near: expected [x, y, z]"},
+      {R"([{"until": 1}, {"near": [1, 2, 3], "who": "nobody", "within": 1}])", "/expect/1/who: no ball has the id \"nobody\""},
+      {R"([{"until": 1}, {"heading": 90, "who": "s"}])", "/expect/1: no assertion kind; a 3-D expectation names one of"},
+      {R"([{"until": 1}, {"mode": "step"}])", "/expect/1/mode: a 3-D world runs in exact mode only"},
+      {R"([{"until": 1}, {"count": "exit", "min": 1, "mx": 2}])", "/expect/1/mx: unknown key \"mx\" in a \"count\""},
+      {R"([{"count": "exit", "min": 1}])", "no {\"until\": T}"},
+  };
+  for (const Case& c : cases) {
+    const auto world = dir.write("e.json", std::string(R"({"format": "turtlegas-world/1", "dimensions": 3,
+      "arena": {"width": 10, "height": 10, "depth": 10}, "balls": [{"id": "s", "pos": [5, 5, 5], "radius": 1}],
+      "expect": )") + c.expect + "}");
+    r = run(dir, {"test", world.string()});
+    INFO(c.expect << "\n" << r.out << r.err);
+    CHECK(r.code == 2);
+    CHECK(contains(r.out + r.err, c.says));
+  }
+}
