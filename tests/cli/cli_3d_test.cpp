@@ -141,3 +141,22 @@ TEST_CASE("test of 3-D worlds: the project's pass, and bad entries are errors at
     CHECK(contains(r.out + r.err, c.says));
   }
 }
+
+TEST_CASE("run --observe of a 3-D world: the observables in three dimensions") {
+  TempDir dir;
+  const auto out = dir.path / "o.json";
+  auto r = run(dir, {"run", "worlds/gas3d_box.json", "--until", "3", "--observe", out.string(), "--observe-from", "1"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const auto o = nlohmann::json::parse(read(out));
+  CHECK(o["dimensions"] == 3);
+  CHECK(o["volume"].get<double>() == 60.0 * 60.0 * 60.0);
+  CHECK(o["summary"]["number_density"]["mean"].get<double>() == Approx(601.0 / 216000.0));
+  CHECK(o["summary"]["collision_rate"]["mean"].get<double>() > 0.0);
+  CHECK(o["speed_histogram"].contains("maxwell"));
+  CHECK(!o["summary"].contains("pressure_walls"));  // not reported per wall in 3-D yet
+  r = run(dir, {"run", "worlds/gas3d_box.json", "--until", "3", "--observe", out.string(), "--events",
+                (dir.path / "e.jsonl").string()});
+  CHECK(r.code == 2);
+  CHECK(contains(r.err, "--observe and --events of a 3-D world"));
+}
