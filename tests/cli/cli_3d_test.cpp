@@ -160,3 +160,31 @@ TEST_CASE("run --observe of a 3-D world: the observables in three dimensions") {
   CHECK(r.code == 2);
   CHECK(contains(r.err, "--observe and --events of a 3-D world"));
 }
+
+TEST_CASE("sweep of a 3-D world: stats, observables and the expect list per run") {
+  TempDir dir;
+  const auto out = dir.path / "r.jsonl";
+  const auto r = run(dir, {"sweep", "worlds/sweeps/gas3d_density.json", "--out", out.string(), "--jobs", "1"});
+  INFO(r.out << r.err);
+  REQUIRE(r.code == 0);
+  std::istringstream lines(read(out));
+  std::string line;
+  REQUIRE(std::getline(lines, line));  // the header
+  int runs = 0;
+  double rate[2] = {0, 0};
+  while (std::getline(lines, line)) {
+    const auto j = nlohmann::json::parse(line);
+    CHECK(j["stats"]["dimensions"] == 3);
+    CHECK(j["stats"]["collisions"].get<double>() > 0);
+    CHECK(std::abs(j["stats"]["energy_end"].get<double>() / j["stats"]["energy_start"].get<double>() - 1) < 1e-12);
+    CHECK(j["expect"]["assertions"] == 7);
+    if (runs >= 2) CHECK(j["expect"]["passed"] == true);  // 300 spheres: the test world itself
+    rate[runs / 2] += j["observables"]["summary"]["collision_rate"]["mean"].get<double>() / 2;
+    ++runs;
+  }
+  CHECK(runs == 4);
+  // Twice the spheres in the same box: the collision rate per sphere about doubles (n sigma^2 v,
+  // with chi a little above 1).
+  CHECK(rate[1] / rate[0] > 1.7);
+  CHECK(rate[1] / rate[0] < 2.6);
+}
