@@ -188,3 +188,28 @@ TEST_CASE("sweep of a 3-D world: stats, observables and the expect list per run"
   CHECK(rate[1] / rate[0] > 1.7);
   CHECK(rate[1] / rate[0] < 2.6);
 }
+
+TEST_CASE("render of a 3-D world: seen along -z, the nearer sphere drawn last and lighter") {
+  TempDir dir;
+  const auto world = dir.write("two.json", R"({"format": "turtlegas-world/1", "dimensions": 3,
+    "arena": {"width": 20, "height": 10, "depth": 10},
+    "balls": [{"id": "near", "pos": [5, 5, 8], "vel": [1, 0, 0], "radius": 1},
+              {"id": "far", "pos": [15, 5, 2], "vel": [0, 1, 0], "radius": 2}]})");
+  const auto svg = dir.path / "p.svg";
+  auto r = run(dir, {"render", world.string(), "--at", "2", "--out", svg.string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const std::string text = read(svg);
+  const auto near_at = text.find(R"(<circle cx="7" cy="5" r="1")");   // moved 2 along x
+  const auto far_at = text.find(R"(<circle cx="15" cy="7" r="2")");   // moved 2 along y
+  REQUIRE(near_at != std::string::npos);
+  REQUIRE(far_at != std::string::npos);
+  CHECK(far_at < near_at);  // the far one first, under the near one
+  CHECK(contains(text, "width=\"800\" height=\"400\""));
+  const auto png = dir.path / "p.png";
+  r = run(dir, {"render", world.string(), "--at", "2", "--out", png.string()});
+  REQUIRE(r.code == 0);
+  CHECK(read(png).substr(1, 3) == "PNG");
+  r = run(dir, {"render", world.string(), "--frames", (dir.path / "f").string(), "--from", "0", "--to", "1"});
+  CHECK(r.code == 2);
+}
