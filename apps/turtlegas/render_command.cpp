@@ -20,6 +20,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cairo_frame.hpp"
+#include "run3d.hpp"
 #include "cli_common.hpp"
 #include "output_file.hpp"
 #include "run_loop.hpp"
@@ -283,6 +284,10 @@ int render_command(const RenderOptions& opt, const turtle::Registry& registry) {
   if (!opt.out.empty()) OutputFile probe(opt.out, "--out");  // a bad path costs nothing
   if (!opt.video.empty()) OutputFile probe(opt.video, "--video");
 
+  if (const auto w3 = load_world3_if_3d(opt.input)) {
+    if (!one) throw BadInput("render of a 3-D world draws one picture: --at T --out F.svg or F.png (no frames or video yet)");
+    return render3d(opt.input, *opt.at, opt.out, opt.width, *w3);
+  }
   Source source = load_source(opt.input, registry);
   auto within = [&](double t, const char* what) {
     if (source.end && t > *source.end)

@@ -1,15 +1,21 @@
 // SPDX-License-Identifier: MIT
 #include "run3d.hpp"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
+#include <memory>
+#include <numeric>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
+#include <cairo.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
 #include "output_file.hpp"
+#include "turtlegas/formats/observables.hpp"
 #include "turtlegas/world/file_error.hpp"
 
 namespace turtlegas::apps {
@@ -57,7 +63,7 @@ int check3d(const std::string& file, const world::World3File& w) {
 
 int run3d(const RunOptions& opt, const world::World3File& w) {
   if (opt.mode && *opt.mode != "exact") throw BadInput("--mode step is not simulated in 3-D yet; use --mode exact");
-  for (const auto& [set, name] : {std::pair{!opt.svg.empty(), "--svg"}, {!opt.observe.empty(), "--observe"},
+  for (const auto& [set, name] : {std::pair{!opt.svg.empty(), "--svg"},
                                   {!opt.record.empty(), "--record"}, {!opt.checkpoint.empty(), "--checkpoint"},
                                   {!opt.resume.empty(), "--resume"}, {!opt.inputs.empty(), "--inputs"}})
     if (set) throw BadInput(std::string(name) + " does not read 3-D worlds yet; drop it");
@@ -68,7 +74,24 @@ int run3d(const RunOptions& opt, const world::World3File& w) {
   } catch (const std::invalid_argument& e) {
     throw BadInput(opt.world + ": " + e.what());
   }
-  std::optional<OutputFile> events_file, state_file, stats_file;
+  std::optional<OutputFile> events_file, state_file, stats_file, observe_file;
+  std::optional<formats::Observer> observer;
+  if (!opt.observe.empty()) {
+    if (!opt.events.empty())
+      throw BadInput("--observe and --events of a 3-D world are not written by one run yet; run it twice");
+    formats::ObserveOptions o;
+    o.from = opt.observe_from;
+    o.window = opt.observe_window;
+    o.samples = opt.observe_samples;
+    o.axis = opt.observe_axis.empty() ? 'y' : opt.observe_axis[0];
+    o.profile_bins = opt.observe_bins;
+    o.speed_bins = opt.observe_speed_bins;
+    o.rdf_bins = opt.observe_rdf_bins;
+    o.rdf_max = opt.observe_rdf_max;
+    if (const std::string bad = formats::check_observe(o, 0.0, opt.until); !bad.empty()) throw BadInput(bad);
+    observe_file.emplace(opt.observe, "--observe");
+    observer.emplace(*world, w.def, w.name, o, opt.until);
+  }
   if (!opt.events.empty()) events_file.emplace(opt.events, "--events");
   if (!opt.state_out.empty()) state_file.emplace(opt.state_out, "--state-out");
   if (!opt.stats_json.empty()) stats_file.emplace(opt.stats_json, "--stats-json");
@@ -80,7 +103,8 @@ int run3d(const RunOptions& opt, const world::World3File& w) {
   while (world->time() < opt.until) {
     const double t = std::min(opt.until, world->time() + chunk);
     log.clear();
-    world->advance_to(t, events_file ? &log : nullptr);
+    if (observer) observer->advance_to(t);  // stops at its sample times on the way
+    else world->advance_to(t, events_file ? &log : nullptr);
     if (opt.max_events && world->events() >= *opt.max_events) break;
     if (events_file) {
       std::string text;
@@ -117,9 +141,118 @@ int run3d(const RunOptions& opt, const world::World3File& w) {
     std::printf("3-D run to t = %g: %llu collisions, %llu events, energy %.15g -> %.15g, max overlap %.3g r, %.3f s\n",
                 world->time(), static_cast<unsigned long long>(world->collisions()),
                 static_cast<unsigned long long>(world->events()), e0, world->energy(), std::max(overlap, 0.0), wall);
+  if (observe_file) {
+    observe_file->stream() << observer->result().dump(1) << '\n';
+    observe_file->commit();
+  }
   if (events_file) events_file->commit();
   if (state_file) state_file->commit();
   if (stats_file) stats_file->commit();
+  return exit_ok;
+}
+
+namespace {
+
+cairo_status_t write_png_bytes(void* closure, const unsigned char* data, unsigned int length) {
+  auto* out = static_cast<std::ostream*>(closure);
+  out->write(reinterpret_cast<const char*>(data), length);
+  return *out ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
+}
+
+/// A sphere's grey-blue at depth z: near the viewer (high z) light, far dark.
+std::array<double, 3> depth_shade(double z, double depth) {
+  const double f = std::clamp(depth > 0.0 ? z / depth : 0.5, 0.0, 1.0);
+  return {0.15 + 0.55 * f, 0.25 + 0.55 * f, 0.45 + 0.5 * f};
+}
+
+}  // namespace
+
+int render3d(const std::string& file, double at, const std::string& out, double width_px, const world::World3File& w) {
+  std::optional<sim::World3> world;
+  try {
+    world.emplace(w.def);
+  } catch (const std::invalid_argument& e) {
+    throw BadInput(file + ": " + e.what());
+  }
+  world->advance_to(at);
+  // The orthographic view along -z: x right, y up, nearer spheres (higher z) drawn last, over the
+  // farther ones, and lighter.
+  const sim::Vec3 size = w.def.size;
+  const double scale = width_px / std::max(size.x, size.y);
+  const int W = std::max(1, static_cast<int>(std::lround(size.x * scale))), H = std::max(1, static_cast<int>(std::lround(size.y * scale)));
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < world->sphere_count(); ++i)
+    if (world->alive(i)) order.push_back(i);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return world->position(a).z < world->position(b).z; });
+  OutputFile o(out, "--out");
+  const bool svg = out.size() >= 4 && out.substr(out.size() - 4) == ".svg";
+  if (svg) {
+    std::string text;
+    char b[256];
+    std::snprintf(b, sizeof b, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %g %g\">\n", W, H, size.x, size.y);
+    text += b;
+    text += "<title>" + w.name + " at t = " + fmt(at) + " (3-D, seen along -z)</title>\n";
+    std::snprintf(b, sizeof b, "<rect width=\"%g\" height=\"%g\" fill=\"#ffffff\" stroke=\"#444\" stroke-width=\"%g\"/>\n", size.x, size.y, 1.0 / scale);
+    text += b;
+    text += "<g transform=\"translate(0 " + fmt(size.y) + ") scale(1 -1)\">\n";
+    for (std::size_t k = 0; k < w.def.walls.size(); ++k) {
+      text += "<polygon points=\"";
+      for (const sim::Vec3& c : w.def.walls[k].corners) text += fmt(c.x) + "," + fmt(c.y) + " ";
+      std::snprintf(b, sizeof b, "\" fill=\"#c8b070\" fill-opacity=\"0.35\" stroke=\"#806020\" stroke-width=\"%g\"/>\n", 1.0 / scale);
+      text += b;
+    }
+    for (std::size_t i : order) {
+      const sim::Vec3 p = world->position(i);
+      const auto c = depth_shade(p.z, size.z);
+      std::snprintf(b, sizeof b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"%.6g\" fill=\"rgb(%d,%d,%d)\" stroke=\"#102030\" stroke-width=\"%g\"/>\n",
+                    p.x, p.y, w.def.spheres[i].radius, static_cast<int>(255 * c[0]), static_cast<int>(255 * c[1]),
+                    static_cast<int>(255 * c[2]), 0.5 / scale);
+      text += b;
+    }
+    text += "</g>\n</svg>\n";
+    o.stream() << text;
+  } else {
+    std::unique_ptr<cairo_surface_t, void (*)(cairo_surface_t*)> surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H),
+                                                                          cairo_surface_destroy);
+    std::unique_ptr<cairo_t, void (*)(cairo_t*)> cr_owner(cairo_create(surface.get()), cairo_destroy);
+    cairo_t* cr = cr_owner.get();
+    cairo_set_source_rgb(cr, 1, 1, 1);
+    cairo_paint(cr);
+    cairo_translate(cr, 0, H);
+    cairo_scale(cr, scale, -scale);
+    for (const sim::Wall3Def& wall : w.def.walls) {
+      for (std::size_t k = 0; k < wall.corners.size(); ++k)
+        (k == 0 ? cairo_move_to : cairo_line_to)(cr, wall.corners[k].x, wall.corners[k].y);
+      cairo_close_path(cr);
+      cairo_set_source_rgba(cr, 0.78, 0.69, 0.44, 0.35);
+      cairo_fill_preserve(cr);
+      cairo_set_source_rgb(cr, 0.5, 0.38, 0.13);
+      cairo_set_line_width(cr, 1.0 / scale);
+      cairo_stroke(cr);
+    }
+    for (std::size_t i : order) {
+      const sim::Vec3 p = world->position(i);
+      const double r = w.def.spheres[i].radius;
+      const auto c = depth_shade(p.z, size.z);
+      // A sphere's shading: lit from the upper left, its colour that of its depth.
+      cairo_pattern_t* g = cairo_pattern_create_radial(p.x - 0.35 * r, p.y + 0.35 * r, 0.1 * r, p.x, p.y, r);
+      cairo_pattern_add_color_stop_rgb(g, 0.0, std::min(1.0, c[0] + 0.3), std::min(1.0, c[1] + 0.3), std::min(1.0, c[2] + 0.3));
+      cairo_pattern_add_color_stop_rgb(g, 1.0, 0.6 * c[0], 0.6 * c[1], 0.6 * c[2]);
+      cairo_arc(cr, p.x, p.y, r, 0, 6.283185307179586);
+      cairo_set_source(cr, g);
+      cairo_fill(cr);
+      cairo_pattern_destroy(g);
+    }
+    cairo_identity_matrix(cr);
+    cairo_set_source_rgb(cr, 0.27, 0.27, 0.27);
+    cairo_rectangle(cr, 0.5, 0.5, W - 1, H - 1);
+    cairo_set_line_width(cr, 1.0);
+    cairo_stroke(cr);
+    cairo_surface_flush(surface.get());
+    if (cairo_surface_write_to_png_stream(surface.get(), write_png_bytes, &o.stream()) != CAIRO_STATUS_SUCCESS)
+      throw std::runtime_error("could not write the PNG");
+  }
+  o.commit();
   return exit_ok;
 }
 

@@ -16,5 +16,8 @@ namespace turtlegas::apps {
 std::optional<world::World3File> load_world3_if_3d(const std::string& file);
 int run3d(const RunOptions& opt, const world::World3File& w);
 int check3d(const std::string& file, const world::World3File& w);
+/// `render WORLD3D.json --at T --out F.svg|F.png`: the world at T seen along -z (orthographic),
+/// `width_px` across the arena's longer side, spheres shaded by depth (nearer: lighter, on top).
+int render3d(const std::string& file, double at, const std::string& out, double width_px, const world::World3File& w);
 
 }  // namespace turtlegas::apps

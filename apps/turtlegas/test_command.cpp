@@ -7,8 +7,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -18,10 +20,12 @@
 #include "child_processes.hpp"
 #include "cli_common.hpp"
 #include "output_file.hpp"
+#include "run3d.hpp"
 #include "run_loop.hpp"
 #include "signals.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/expect.hpp"
+#include "turtlegas/world/expect3.hpp"
 #include "turtlegas/world/scenario.hpp"
 #include "turtlegas/world/world_file.hpp"
 
@@ -111,9 +115,82 @@ Outcome stopped_by_limit(const std::string& limit, const WorldProgress& at, std:
   return o;
 }
 
+std::string read_text(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// Runs one 3-D world ("dimensions": 3) against its `expect` list (world/expect3.hpp).
+Outcome test_one_3d(const std::string& file, const tw::World3File& w, const TestOptions& options) {
+  Outcome o;
+  tw::Expectations3 expect;
+  try {
+    expect = tw::parse_expect3(read_text(file), file, w);
+  } catch (const tw::WorldFileError& e) {
+    o.message = e.what();
+    return o;
+  }
+  if (!expect.present) {
+    o.message = file + ": no \"expect\" list; a test world needs one, e.g. \"expect\": [{\"until\": 10}, ...]";
+    return o;
+  }
+  if (expect.until < 0.0) {
+    o.message = file + ": /expect: no {\"until\": T}; add one to say how long the test runs";
+    return o;
+  }
+  if (options.mode && *options.mode != "exact") {
+    o.message = file + ": --mode " + *options.mode + ": a 3-D world runs in exact mode only (step mode is not simulated in 3-D yet)";
+    return o;
+  }
+  const auto start = Clock::now();
+  const std::optional<double> wall = options.limits.wall_seconds();
+  const std::optional<std::uint64_t> max_events = options.limits.events();
+  ProgressReports reports;
+  WorldProgress at;
+  at.until = expect.until;
+  at.mode = "exact";
+  tw::Expect3Result r;
+  try {
+    r = tw::run_expect3(w, expect, [&](const sim::World3& world) {
+      at.t = world.time();
+      if (wall && seconds_since(start) >= *wall) throw sim::StopRequested("--max-wall-seconds");
+      if (max_events && world.events() >= *max_events) throw sim::EventLimitReached("--max-events");
+      reports.report(at);
+    });
+  } catch (const std::invalid_argument& e) {
+    o.message = file + ": " + e.what();
+    return o;
+  } catch (const sim::StopRequested&) {
+    return stopped_by_limit("--max-wall-seconds " + fmt(*wall), at, 0);
+  } catch (const sim::EventLimitReached&) {
+    return stopped_by_limit("--max-events " + std::to_string(*max_events), at, *max_events);
+  }
+  o.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  o.assertions = r.assertions;
+  for (const std::string& f : r.failures) o.message += (o.message.empty() ? "" : "; ") + f;
+  if (!r.failures.empty()) {
+    o.status = Outcome::Status::fail;
+    return o;
+  }
+  o.status = Outcome::Status::pass;
+  char line[160];
+  std::snprintf(line, sizeof line, "(3-D, %zu assertion%s, %.2f s)", o.assertions, o.assertions == 1 ? "" : "s",
+                o.seconds);
+  o.message = line;
+  return o;
+}
+
 /// Runs one world in this process: the child's whole job.
 Outcome test_one(const std::string& file, const TestOptions& options, const turtle::Registry& registry) {
   Outcome o;
+  try {
+    if (const std::optional<tw::World3File> w3 = load_world3_if_3d(file)) return test_one_3d(file, *w3, options);
+  } catch (const BadInput& e) {
+    o.message = e.what();
+    return o;
+  }
   tw::Scene scene;
   try {
     scene = tw::load_scene(file, registry);

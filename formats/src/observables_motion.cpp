@@ -2,7 +2,7 @@
 // Motion observables of the Observer (observables.hpp): unwrapped coordinates, the mean-squared
 // displacement MSD(tau) and the velocity autocorrelation C(tau) = <v(0) . v(tau)> over the sample
 // grid of each window, every sample a time origin, and the diffusion coefficient from each: the
-// Einstein relation MSD = 4 D tau (two dimensions) and Green-Kubo's D = (1/2) int_0^tau C. In a
+// Einstein relation MSD = 2 d D tau and Green-Kubo's D = (1/d) int_0^tau C, d = 2 or 3. In a
 // periodic arena positions and velocities are taken about the centre of mass's, which moves
 // uniformly there (the total momentum is conserved); behind walls in the lab frame.
 #include <algorithm>
@@ -30,45 +30,44 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 double Observer::unwrap_step() const {
   // No ball is faster than sqrt(2 K / m_min), K the kinetic energy of all of them (conserved, or
   // lost to restitution, in a gas without fields). Stopping before any ball can cross a quarter of
-  // the shorter side keeps the nearest image of each displacement the true one, with a factor of
+  // the shortest side keeps the nearest image of each displacement the true one, with a factor of
   // two to spare for a field's work between stops.
-  const sim::World& w = *world_;
   double k = 0.0, m_min = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < w.ball_count(); ++i) {
-    const sim::BallState b = w.ball(i);
-    if (!b.alive) continue;
-    k += 0.5 * w.mass(i) * dot(b.vel, b.vel);
-    m_min = std::min(m_min, w.mass(i));
+  for (std::size_t i = 0; i < count(); ++i) {
+    if (!alive(i)) continue;
+    const sim::Vec3 v = vel(i);
+    k += 0.5 * mass(i) * dot(v, v);
+    m_min = std::min(m_min, mass(i));
   }
   if (!(k > 0.0)) return std::numeric_limits<double>::infinity();
-  return 0.25 * std::min(width_, height_) / std::sqrt(2.0 * k / m_min);
+  double side = std::min(size_.x, size_.y);
+  if (dims_ == 3) side = std::min(side, size_.z);
+  return 0.25 * side / std::sqrt(2.0 * k / m_min);
 }
 
 void Observer::unwrap() {
-  const sim::World& w = *world_;
   if (boundary_ != sim::Boundary::periodic) {  // coordinates are not wrapped: taken as they are
-    for (std::size_t i = 0; i < w.ball_count(); ++i) unwrapped_[i] = w.ball(i).pos;
+    for (std::size_t i = 0; i < count(); ++i) unwrapped_[i] = pos(i);
     return;
   }
   // The unwrapped position is the wrapped one plus whole periods, counted: it does not depend on
   // where the run stopped on the way (the CLI and the Python module stop at different times, and a
   // sum of displacements would differ in its last digits).
-  for (std::size_t i = 0; i < w.ball_count(); ++i) {
-    const sim::Vec2 p = w.ball(i).pos;
-    const sim::Vec2 d = p - last_pos_[i];
-    images_[i].x -= std::round(d.x / width_);
-    images_[i].y -= std::round(d.y / height_);
-    unwrapped_[i] = {p.x + images_[i].x * width_, p.y + images_[i].y * height_};
+  for (std::size_t i = 0; i < count(); ++i) {
+    const sim::Vec3 p = pos(i);
+    const sim::Vec3 d = p - last_pos_[i];
+    for (int k = 0; k < dims_; ++k) images_[i][k] -= std::round(d[k] / size_[k]);
+    unwrapped_[i] = p;
+    for (int k = 0; k < dims_; ++k) unwrapped_[i][k] += images_[i][k] * size_[k];
     last_pos_[i] = p;
   }
 }
 
 void Observer::start_motion() {
-  const sim::World& w = *world_;
-  unwrapped_.resize(w.ball_count());
-  last_pos_.resize(w.ball_count());
-  images_.assign(w.ball_count(), sim::Vec2{});
-  for (std::size_t i = 0; i < w.ball_count(); ++i) unwrapped_[i] = last_pos_[i] = w.ball(i).pos;
+  unwrapped_.resize(count());
+  last_pos_.resize(count());
+  images_.assign(count(), sim::Vec3{});
+  for (std::size_t i = 0; i < count(); ++i) unwrapped_[i] = last_pos_[i] = pos(i);
   frame_pos_.clear();
   frame_vel_.clear();
   sample_motion();
@@ -76,26 +75,23 @@ void Observer::start_motion() {
 
 void Observer::sample_motion() {
   unwrap();
-  const sim::World& w = *world_;
   const bool periodic = boundary_ == sim::Boundary::periodic;
-  sim::Vec2 r{}, p{};
+  sim::Vec3 r{}, p{};
   double m = 0.0;
-  for (std::size_t i = 0; i < w.ball_count(); ++i) {
-    const sim::BallState b = w.ball(i);
-    if (!b.alive) continue;
-    r += w.mass(i) * unwrapped_[i];
-    p += w.mass(i) * b.vel;
-    m += w.mass(i);
+  for (std::size_t i = 0; i < count(); ++i) {
+    if (!alive(i)) continue;
+    r += mass(i) * unwrapped_[i];
+    p += mass(i) * vel(i);
+    m += mass(i);
   }
-  const sim::Vec2 rc = periodic && m > 0.0 ? r / m : sim::Vec2{}, vc = periodic && m > 0.0 ? p / m : sim::Vec2{};
-  std::vector<sim::Vec2> pos(w.ball_count()), vel(w.ball_count());
-  for (std::size_t i = 0; i < w.ball_count(); ++i) {
-    const sim::BallState b = w.ball(i);
-    pos[i] = b.alive ? unwrapped_[i] - rc : sim::Vec2{kNaN, kNaN};
-    vel[i] = b.vel - vc;
+  const sim::Vec3 rc = periodic && m > 0.0 ? sim::Vec3{r.x / m, r.y / m, r.z / m} : sim::Vec3{}, vc = periodic && m > 0.0 ? sim::Vec3{p.x / m, p.y / m, p.z / m} : sim::Vec3{};
+  std::vector<sim::Vec3> ps(count()), vs(count());
+  for (std::size_t i = 0; i < count(); ++i) {
+    ps[i] = alive(i) ? unwrapped_[i] - rc : sim::Vec3{kNaN, kNaN, kNaN};
+    vs[i] = vel(i) - vc;
   }
-  frame_pos_.push_back(std::move(pos));
-  frame_vel_.push_back(std::move(vel));
+  frame_pos_.push_back(std::move(ps));
+  frame_vel_.push_back(std::move(vs));
 }
 
 void Observer::close_motion(Window& w) {
@@ -109,7 +105,7 @@ void Observer::close_motion(Window& w) {
       const auto &p0 = frame_pos_[i], &p1 = frame_pos_[i + k], &v0 = frame_vel_[i], &v1 = frame_vel_[i + k];
       for (std::size_t b = 0; b < p0.size(); ++b) {
         if (std::isnan(p0[b].x) || std::isnan(p1[b].x)) continue;
-        const sim::Vec2 d = p1[b] - p0[b];
+        const sim::Vec3 d = p1[b] - p0[b];
         const double d2 = dot(d, d), c = dot(v0[b], v1[b]);
         for (std::size_t row : {std::size_t{0}, species_of_[b] + 1}) {
           w.msd[row * lags + k] += d2;
@@ -148,10 +144,10 @@ void Observer::motion_results(nlohmann::json& out, nlohmann::json& summary) cons
         sx += x, sy += m[k], sxx += x * x, sxy += x * m[k], n += 1.0;
       }
       const double slope = n > 1.0 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : sy / sx;
-      d_msd.push_back(slope / 4.0);
+      d_msd.push_back(slope / (2.0 * dims_));  // MSD = 2 d D tau
       double integral = 0.0;
       for (std::size_t k = 0; k + 1 < lags; ++k) integral += 0.5 * (c[k] + c[k + 1]) * step;
-      d_gk.push_back(integral / 2.0);
+      d_gk.push_back(integral / dims_);  // D = (1/d) int C
     }
     nlohmann::json mm = nlohmann::json::array(), me = nlohmann::json::array(), cm = nlohmann::json::array(),
                    ce = nlohmann::json::array();

@@ -3,6 +3,7 @@
 // and its contact values g(sigma+) (docs/physics.md, "Gas observables": for hard discs the virial
 // gives Z = 1 + 2 eta g(sigma+), which the tests hold the contact value to).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <utility>
@@ -49,6 +50,21 @@ std::size_t Observer::pair_index(std::size_t a, std::size_t b) const {
 }
 
 double Observer::expected_pairs(std::size_t a, std::size_t b, double r0, double r1) const {
+  if (dims_ == 3) {
+    if (boundary_ == sim::Boundary::periodic) return 4.0 / 3.0 * kPi * (r1 * r1 * r1 - r0 * r0 * r0) / volume();
+    // Two centres uniform in an a x b x c box are at distance r with density 4 pi r^2 K(r) / V^2,
+    // K(r) = abc - r (ab + bc + ca)/2 + 2 r^2 (a + b + c)/(3 pi) - r^3/(4 pi) the box's set
+    // covariance averaged over directions (r <= min(a, b, c)); F below is its integral over r. With
+    // walls the centres keep their radii from the faces, as in 2-D.
+    const double inset = boundary_ == sim::Boundary::walls ? species_[a].radius + species_[b].radius : 0.0;
+    const double x = size_.x - inset, y = size_.y - inset, z = size_.z - inset;
+    const double v = x * y * z, s2 = x * y + y * z + z * x, s1 = x + y + z;
+    auto F = [&](double r) {
+      const double r3 = r * r * r;
+      return 4.0 * kPi * (v * r3 / 3.0 - s2 * r3 * r / 8.0 + 2.0 * s1 * r3 * r * r / (15.0 * kPi) - r3 * r3 / (24.0 * kPi));
+    };
+    return (F(r1) - F(r0)) / (v * v);
+  }
   if (boundary_ == sim::Boundary::periodic) return kPi * (r1 * r1 - r0 * r0) / (width_ * height_);
   // Two centres uniform in an a x b rectangle are at distance r with density 2 pi r K(r) / (a b)^2,
   // K(r) = a b - 2 r (a + b)/pi + r^2/pi the rectangle's set covariance averaged over directions
@@ -61,21 +77,20 @@ double Observer::expected_pairs(std::size_t a, std::size_t b, double r0, double 
 }
 
 void Observer::sample_pairs() {
-  const sim::World& w = *world_;
   const bool periodic = boundary_ == sim::Boundary::periodic;
   const std::size_t S = species_.size();
   std::vector<std::size_t> alive_count(S, 0);
   struct Item {
-    sim::Vec2 p;
+    sim::Vec3 p;
     std::size_t species;
   };
   std::vector<Item> items;
-  items.reserve(w.ball_count());
-  for (std::size_t i = 0; i < w.ball_count(); ++i) {
-    const sim::BallState b = w.ball(i);
-    if (!b.alive) continue;
-    sim::Vec2 p = b.pos;
-    if (periodic) p.x -= width_ * std::floor(p.x / width_), p.y -= height_ * std::floor(p.y / height_);
+  items.reserve(count());
+  for (std::size_t i = 0; i < count(); ++i) {
+    if (!alive(i)) continue;
+    sim::Vec3 p = pos(i);
+    if (periodic)
+      for (int k = 0; k < dims_; ++k) p[k] -= size_[k] * std::floor(p[k] / size_[k]);
     items.push_back({p, species_of_[i]});
     ++alive_count[species_of_[i]];
   }
@@ -86,50 +101,60 @@ void Observer::sample_pairs() {
     }
   const std::size_t bins = static_cast<std::size_t>(opt_.rdf_bins);
   const double inv_width = static_cast<double>(bins) / rdf_max_, max2 = rdf_max_ * rdf_max_;
-  auto count = [&](const Item& p, const Item& q) {
-    sim::Vec2 d = q.p - p.p;
-    if (periodic) {
-      d.x -= width_ * std::round(d.x / width_);
-      d.y -= height_ * std::round(d.y / height_);
-    }
+  auto count_pair = [&](const Item& p, const Item& q) {
+    sim::Vec3 d = q.p - p.p;
+    if (periodic)
+      for (int k = 0; k < dims_; ++k) d[k] -= size_[k] * std::round(d[k] / size_[k]);
     const double r2 = dot(d, d);
     if (r2 >= max2) return;
     const auto bin = static_cast<std::size_t>(std::sqrt(r2) * inv_width);
     if (bin < bins) current_.pair_counts[pair_index(p.species, q.species) * bins + bin] += 1.0;
   };
   // Cells at least rdf_max wide: every pair within rdf_max lies in one cell or two neighbours.
-  const int nx = std::max(1, static_cast<int>(width_ / rdf_max_)), ny = std::max(1, static_cast<int>(height_ / rdf_max_));
-  if (periodic && (nx < 3 || ny < 3)) {  // a neighbour would be met twice around the box: all pairs
+  int n[3] = {1, 1, 1};
+  for (int k = 0; k < dims_; ++k) n[k] = std::max(1, static_cast<int>(size_[k] / rdf_max_));
+  if (periodic && (n[0] < 3 || n[1] < 3 || (dims_ == 3 && n[2] < 3))) {  // a neighbour met twice: all pairs
     for (std::size_t i = 0; i < items.size(); ++i)
-      for (std::size_t j = i + 1; j < items.size(); ++j) count(items[i], items[j]);
+      for (std::size_t j = i + 1; j < items.size(); ++j) count_pair(items[i], items[j]);
     return;
   }
-  auto cell_of = [&](sim::Vec2 p) {
-    const int cx = std::clamp(static_cast<int>(p.x / width_ * nx), 0, nx - 1);
-    const int cy = std::clamp(static_cast<int>(p.y / height_ * ny), 0, ny - 1);
-    return cy * nx + cx;
+  auto cell_of = [&](const sim::Vec3& p) {
+    int c[3] = {0, 0, 0};
+    for (int k = 0; k < dims_; ++k) c[k] = std::clamp(static_cast<int>(p[k] / size_[k] * n[k]), 0, n[k] - 1);
+    return (c[2] * n[1] + c[1]) * n[0] + c[0];
   };
-  std::vector<std::uint32_t> start(static_cast<std::size_t>(nx * ny) + 1, 0), order(items.size());
+  const std::size_t cells = static_cast<std::size_t>(n[0] * n[1] * n[2]);
+  std::vector<std::uint32_t> start(cells + 1, 0), order(items.size());
   for (const Item& it : items) ++start[static_cast<std::size_t>(cell_of(it.p)) + 1];
   std::partial_sum(start.begin(), start.end(), start.begin());
   std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
   for (std::size_t i = 0; i < items.size(); ++i) order[fill[static_cast<std::size_t>(cell_of(items[i].p))]++] = static_cast<std::uint32_t>(i);
-  // Each cell with itself and four of its neighbours (a half stencil): every pair once.
-  constexpr int kHalf[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
-  for (int cy = 0; cy < ny; ++cy)
-    for (int cx = 0; cx < nx; ++cx) {
-      const std::size_t c = static_cast<std::size_t>(cy * nx + cx);
-      for (std::uint32_t i = start[c]; i < start[c + 1]; ++i)
-        for (std::uint32_t j = i + 1; j < start[c + 1]; ++j) count(items[order[i]], items[order[j]]);
-      for (const auto& off : kHalf) {
-        int ox = cx + off[0], oy = cy + off[1];
-        if (periodic) ox = (ox + nx) % nx, oy = (oy + ny) % ny;
-        else if (ox < 0 || ox >= nx || oy >= ny) continue;
-        const std::size_t o = static_cast<std::size_t>(oy * nx + ox);
+  // Each cell with itself and half of its neighbours (those after it: dz > 0, or dz = 0 and dy > 0,
+  // or dz = dy = 0 and dx > 0): every pair once. In 2-D only the plane's four.
+  std::vector<std::array<int, 3>> half;
+  for (int dz = 0; dz <= (dims_ == 3 ? 1 : 0); ++dz)
+    for (int dy = dz > 0 ? -1 : 0; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (dz > 0 || dy > 0 || dx > 0) half.push_back({dx, dy, dz});
+  for (int cz = 0; cz < n[2]; ++cz)
+    for (int cy = 0; cy < n[1]; ++cy)
+      for (int cx = 0; cx < n[0]; ++cx) {
+        const std::size_t c = static_cast<std::size_t>((cz * n[1] + cy) * n[0] + cx);
         for (std::uint32_t i = start[c]; i < start[c + 1]; ++i)
-          for (std::uint32_t j = start[o]; j < start[o + 1]; ++j) count(items[order[i]], items[order[j]]);
+          for (std::uint32_t j = i + 1; j < start[c + 1]; ++j) count_pair(items[order[i]], items[order[j]]);
+        for (const auto& off : half) {
+          int o[3] = {cx + off[0], cy + off[1], cz + off[2]};
+          bool out = false;
+          for (int k = 0; k < 3; ++k) {
+            if (periodic) o[k] = (o[k] + n[k]) % n[k];
+            else if (o[k] < 0 || o[k] >= n[k]) out = true;
+          }
+          if (out) continue;
+          const std::size_t oc = static_cast<std::size_t>((o[2] * n[1] + o[1]) * n[0] + o[0]);
+          for (std::uint32_t i = start[c]; i < start[c + 1]; ++i)
+            for (std::uint32_t j = start[oc]; j < start[oc + 1]; ++j) count_pair(items[order[i]], items[order[j]]);
+        }
       }
-    }
 }
 
 void Observer::pair_results(nlohmann::json& out, nlohmann::json& summary) const {

@@ -88,3 +88,128 @@ TEST_CASE("3-D world file errors name the JSON path and the fix, exit 2") {
     CHECK(contains(r.err, c.says));
   }
 }
+
+TEST_CASE("test of a 3-D world: a wrong expectation fails naming its entry and the values seen") {
+  TempDir dir;
+  // The box bounce's sphere meets arena-x1 at t = 2, 10, 18; each wrong entry below must fail.
+  const auto world = dir.write("bad.json", R"({"format": "turtlegas-world/1", "dimensions": 3,
+    "arena": {"width": 10, "height": 10, "depth": 10, "boundary": "walls"},
+    "balls": [{"id": "s", "pos": [5, 5, 5], "vel": [2, 1, 0.5], "radius": 1}],
+    "expect": [{"until": 19}, {"count": "ball-wall", "b": "arena-x1", "min": 4},
+               {"near": [7, 8, 3.5], "who": "s", "within": 1e-9},
+               {"near": [7, 8, 3.6], "who": "s", "within": 1e-3},
+               {"velocity": [2, 1, -0.5], "who": "s", "within": 1e-9, "at": 19},
+               {"event": "ball-wall", "b": "arena-z0"},
+               {"no_event": "ball-wall", "b": "arena-y1"},
+               {"inside": [[1, 1, 1], [9, 9, 8]]}]})");
+  const auto r = run(dir, {"test", world.string()});
+  INFO(r.out << r.err);
+  CHECK(r.code == 1);
+  CHECK(contains(r.out, "FAIL"));
+  CHECK(contains(r.out, "expect[1] count ball-wall b arena-x1 = 3, wanted >= 4"));
+  CHECK(!contains(r.out, "expect[2]"));
+  CHECK(contains(r.out, "expect[3] near [7, 8, 3.6]: s is at [7, 8, 3.5"));
+  CHECK(contains(r.out, "expect[4] velocity [2, 1, -0.5]: s moves at [-2, 1, -0.5"));
+  CHECK(contains(r.out, "expect[5] event ball-wall b arena-z0: none happened"));
+  CHECK(contains(r.out, "expect[6] no_event ball-wall b arena-y1: 1 happened, the first at t = 4"));
+  CHECK(contains(r.out, "expect[7] inside"));
+}
+
+TEST_CASE("test of 3-D worlds: the project's pass, and bad entries are errors at their JSON path") {
+  TempDir dir;
+  auto r = run(dir, {"test", "worlds/tests/box_bounce3d.json", "worlds/tests/edge_corner3d.json"});
+  INFO(r.out << r.err);
+  CHECK(r.code == 0);
+  CHECK(contains(r.out, "PASS worlds/tests/box_bounce3d.json (3-D, 18 assertions"));
+  struct Case { const char* expect; const char* says; };
+  const Case cases[] = {
+      {R"([{"until": 1}, {"count": "ball-wal", "min": 1}])", "/expect/1/count: \"ball-wal\" is not an event of a 3-D world"},
+      {R"([{"until": 1}, {"near": [1, 2], "who": "s", "within": 1}])", "/expect/1/near: expected [x, y, z]"},
+      {R"([{"until": 1}, {"near": [1, 2, 3], "who": "nobody", "within": 1}])", "/expect/1/who: no ball has the id \"nobody\""},
+      {R"([{"until": 1}, {"heading": 90, "who": "s"}])", "/expect/1: no assertion kind; a 3-D expectation names one of"},
+      {R"([{"until": 1}, {"mode": "step"}])", "/expect/1/mode: a 3-D world runs in exact mode only"},
+      {R"([{"until": 1}, {"count": "exit", "min": 1, "mx": 2}])", "/expect/1/mx: unknown key \"mx\" in a \"count\""},
+      {R"([{"count": "exit", "min": 1}])", "no {\"until\": T}"},
+  };
+  for (const Case& c : cases) {
+    const auto world = dir.write("e.json", std::string(R"({"format": "turtlegas-world/1", "dimensions": 3,
+      "arena": {"width": 10, "height": 10, "depth": 10}, "balls": [{"id": "s", "pos": [5, 5, 5], "radius": 1}],
+      "expect": )") + c.expect + "}");
+    r = run(dir, {"test", world.string()});
+    INFO(c.expect << "\n" << r.out << r.err);
+    CHECK(r.code == 2);
+    CHECK(contains(r.out + r.err, c.says));
+  }
+}
+
+TEST_CASE("run --observe of a 3-D world: the observables in three dimensions") {
+  TempDir dir;
+  const auto out = dir.path / "o.json";
+  auto r = run(dir, {"run", "worlds/gas3d_box.json", "--until", "3", "--observe", out.string(), "--observe-from", "1"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const auto o = nlohmann::json::parse(read(out));
+  CHECK(o["dimensions"] == 3);
+  CHECK(o["volume"].get<double>() == 60.0 * 60.0 * 60.0);
+  CHECK(o["summary"]["number_density"]["mean"].get<double>() == Approx(601.0 / 216000.0));
+  CHECK(o["summary"]["collision_rate"]["mean"].get<double>() > 0.0);
+  CHECK(o["speed_histogram"].contains("maxwell"));
+  CHECK(!o["summary"].contains("pressure_walls"));  // not reported per wall in 3-D yet
+  r = run(dir, {"run", "worlds/gas3d_box.json", "--until", "3", "--observe", out.string(), "--events",
+                (dir.path / "e.jsonl").string()});
+  CHECK(r.code == 2);
+  CHECK(contains(r.err, "--observe and --events of a 3-D world"));
+}
+
+TEST_CASE("sweep of a 3-D world: stats, observables and the expect list per run") {
+  TempDir dir;
+  const auto out = dir.path / "r.jsonl";
+  const auto r = run(dir, {"sweep", "worlds/sweeps/gas3d_density.json", "--out", out.string(), "--jobs", "1"});
+  INFO(r.out << r.err);
+  REQUIRE(r.code == 0);
+  std::istringstream lines(read(out));
+  std::string line;
+  REQUIRE(std::getline(lines, line));  // the header
+  int runs = 0;
+  double rate[2] = {0, 0};
+  while (std::getline(lines, line)) {
+    const auto j = nlohmann::json::parse(line);
+    CHECK(j["stats"]["dimensions"] == 3);
+    CHECK(j["stats"]["collisions"].get<double>() > 0);
+    CHECK(std::abs(j["stats"]["energy_end"].get<double>() / j["stats"]["energy_start"].get<double>() - 1) < 1e-12);
+    CHECK(j["expect"]["assertions"] == 7);
+    if (runs >= 2) CHECK(j["expect"]["passed"] == true);  // 300 spheres: the test world itself
+    rate[runs / 2] += j["observables"]["summary"]["collision_rate"]["mean"].get<double>() / 2;
+    ++runs;
+  }
+  CHECK(runs == 4);
+  // Twice the spheres in the same box: the collision rate per sphere about doubles (n sigma^2 v,
+  // with chi a little above 1).
+  CHECK(rate[1] / rate[0] > 1.7);
+  CHECK(rate[1] / rate[0] < 2.6);
+}
+
+TEST_CASE("render of a 3-D world: seen along -z, the nearer sphere drawn last and lighter") {
+  TempDir dir;
+  const auto world = dir.write("two.json", R"({"format": "turtlegas-world/1", "dimensions": 3,
+    "arena": {"width": 20, "height": 10, "depth": 10},
+    "balls": [{"id": "near", "pos": [5, 5, 8], "vel": [1, 0, 0], "radius": 1},
+              {"id": "far", "pos": [15, 5, 2], "vel": [0, 1, 0], "radius": 2}]})");
+  const auto svg = dir.path / "p.svg";
+  auto r = run(dir, {"render", world.string(), "--at", "2", "--out", svg.string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const std::string text = read(svg);
+  const auto near_at = text.find(R"(<circle cx="7" cy="5" r="1")");   // moved 2 along x
+  const auto far_at = text.find(R"(<circle cx="15" cy="7" r="2")");   // moved 2 along y
+  REQUIRE(near_at != std::string::npos);
+  REQUIRE(far_at != std::string::npos);
+  CHECK(far_at < near_at);  // the far one first, under the near one
+  CHECK(contains(text, "width=\"800\" height=\"400\""));
+  const auto png = dir.path / "p.png";
+  r = run(dir, {"render", world.string(), "--at", "2", "--out", png.string()});
+  REQUIRE(r.code == 0);
+  CHECK(read(png).substr(1, 3) == "PNG");
+  r = run(dir, {"render", world.string(), "--frames", (dir.path / "f").string(), "--from", "0", "--to", "1"});
+  CHECK(r.code == 2);
+}

@@ -40,7 +40,7 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
   if (doc.contains("turtles"))
     rd.fail("/turtles", "turtles stay in the plane: a 3-D world cannot have turtles (drop \"dimensions\": 3 or the turtles)");
   rd.check_keys(doc, "", "a 3-D world file",
-                {"format", "dimensions", "name", "seed", "dt", "arena", "effects", "walls", "balls", "gas"});
+                {"format", "dimensions", "name", "seed", "dt", "arena", "effects", "walls", "balls", "gas", "expect"});
   World3File out;
   if (const json* f = rd.find(doc, "format"); f && rd.string(*f, "/format") != "turtlegas-world/1")
     rd.fail("/format", "expected \"turtlegas-world/1\"");

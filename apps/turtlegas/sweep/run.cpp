@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `turtlegas sweep`: one run, in this process.
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -11,7 +12,10 @@
 #include "sweep/sweep.hpp"
 #include "turtlegas/formats/stats_file.hpp"
 #include "turtlegas/world/scenario.hpp"
+#include "turtlegas/world/expect3.hpp"
+#include "turtlegas/world/file_error.hpp"
 #include "turtlegas/world/world_file.hpp"
+#include "turtlegas/world/world_file_3d.hpp"
 
 namespace turtlegas::apps::sweep {
 
@@ -22,6 +26,67 @@ turtle::ServerOptions server_options(const SweepOptions& o) {
   return s;
 }
 
+namespace {
+
+/// What a result line keeps of the observables: all of them, or the summary and the species
+/// without their curves.
+json observables_of(json o, bool full) {
+  if (full) return o;
+  json species = json::array();
+  for (json& s : o["species"]) {
+    s.erase("msd");
+    s.erase("vacf");
+    species.push_back(s);
+  }
+  return {{"summary", o["summary"]}, {"species", species}};
+}
+
+/// Run k of a sweep of a 3-D world ("dimensions": 3): its stats, observables and expect list as
+/// the 3-D run and test give them.
+json run_one_3d(const Spec& spec, const json& w, json line, const std::string& label) {
+  world::World3File f;
+  try {
+    f = world::parse_world3(w.dump(), label);
+  } catch (const world::WorldFileError& e) {
+    throw BadInput(e.what());
+  }
+  if (spec.mode != sim::Mode::exact) throw BadInput(label + ": a 3-D world runs in exact mode only; drop \"mode\"");
+  std::optional<sim::World3> world;
+  try {
+    world.emplace(f.def);
+  } catch (const std::invalid_argument& e) {
+    throw BadInput(label + ": " + e.what());
+  }
+  const double e0 = world->energy();
+  if (spec.observe) {
+    formats::Observer observer(*world, f.def, f.name, *spec.observe, spec.until);
+    observer.advance_to(spec.until);
+    observer.detach();
+    line["observables"] = observables_of(observer.result(), spec.observe_full);
+  } else {
+    world->advance_to(spec.until);
+  }
+  line["stats"] = {{"dimensions", 3},
+                   {"collisions", world->collisions()},
+                   {"events", world->events()},
+                   {"energy_start", e0},
+                   {"energy_end", world->energy()},
+                   {"max_overlap", world->sphere_count() <= 4096 ? std::max(world->max_overlap_now(), 0.0) : 0.0}};
+  world::Expectations3 expect;
+  try {
+    expect = world::parse_expect3(w.dump(), label, f);
+  } catch (const world::WorldFileError& e) {
+    throw BadInput(e.what());
+  }
+  if (expect.present && expect.until >= 0.0) {
+    const world::Expect3Result r = world::run_expect3(f, expect);
+    line["expect"] = {{"passed", r.failures.empty()}, {"assertions", r.assertions}, {"failures", r.failures}};
+  }
+  return line;
+}
+
+}  // namespace
+
 /// Runs run k in this process: its result line (without a newline). Deterministic: no wall-clock
 /// figures in it.
 json run_one(const Spec& spec, std::size_t k, const turtle::Registry& registry, const turtle::ServerOptions& base) {
@@ -31,6 +96,8 @@ json run_one(const Spec& spec, std::size_t k, const turtle::Registry& registry, 
   for (const auto& [ptr, value] : overrides.items()) w[json::json_pointer(ptr)] = value;
   w["seed"] = seed;
   const std::string label = spec.world_file + " (sweep run " + std::to_string(k) + ")";
+  if (w.contains("dimensions") && w["dimensions"] == 3)
+    return run_one_3d(spec, w, {{"run", k}, {"seed", seed}, {"overrides", overrides}}, label);
   world::Scene scene;
   try {
     scene = world::parse_scene(w.dump(), label, registry);
@@ -62,18 +129,7 @@ json run_one(const Spec& spec, std::size_t k, const turtle::Registry& registry, 
       formats::Observer observer(*bare, scene.def, *spec.observe, spec.until);
       observer.advance_to(spec.until);
       observer.detach();
-      json o = observer.result();
-      if (spec.observe_full) {
-        line["observables"] = o;
-      } else {
-        json species = json::array();
-        for (json& s : o["species"]) {
-          s.erase("msd");
-          s.erase("vacf");
-          species.push_back(s);
-        }
-        line["observables"] = {{"summary", o["summary"]}, {"species", species}};
-      }
+      line["observables"] = observables_of(observer.result(), spec.observe_full);
     } else {
       bare->advance_to(spec.until);
     }

@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "turtlegas/sim/world.hpp"
+#include "turtlegas/sim/world3d.hpp"
 #include "turtlegas/sim/world_def.hpp"
 
 namespace turtlegas::formats {
@@ -29,7 +30,7 @@ struct ObserveOptions {
   double from = 0.0;       ///< seconds: what happens before is not observed (equilibration)
   double window = 0.0;     ///< seconds per window (block); 0: a tenth of (until - from)
   int samples = 20;        ///< state samples per window, evenly spaced, the last at its end
-  char axis = 'y';         ///< the density profile's axis, 'x' or 'y'
+  char axis = 'y';         ///< the density profile's axis, 'x' or 'y' ('z' too in 3-D)
   int profile_bins = 20;   ///< across the arena's extent along the axis
   int speed_bins = 40;     ///< from 0 to 4 times the rms speed at `from`
   int rdf_bins = 200;      ///< bins of g(r), from 0 to rdf_max
@@ -45,6 +46,10 @@ class Observer {
   /// For a run of `world` (built from `def`) to `until`. Installs its impulse log in the world
   /// (World::set_impulse_log); the world must outlive the observer or be detached first.
   Observer(sim::World& world, const sim::WorldDef& def, ObserveOptions options, double until);
+  /// For a run of the 3-D gas `world` (built from `def`, named `name`) to `until`: the same
+  /// measurements in three dimensions (docs/observables.md, "3-D"), except the walls' pressure,
+  /// which the 3-D engine does not report per wall yet. The world must outlive the observer.
+  Observer(sim::World3& world, const sim::World3Def& def, std::string name, ObserveOptions options, double until);
   Observer(const Observer&) = delete;
   Observer& operator=(const Observer&) = delete;
   ~Observer();
@@ -92,14 +97,31 @@ class Observer {
   void pair_results(nlohmann::json& out, nlohmann::json& summary) const;
   void motion_results(nlohmann::json& out, nlohmann::json& summary) const;
   void take_impulses();
+  // The gas read through one interface in 2 or 3 dimensions (a 2-D ball has z = 0).
+  std::size_t count() const;
+  bool alive(std::size_t i) const;
+  sim::Vec3 pos(std::size_t i) const;
+  sim::Vec3 vel(std::size_t i) const;
+  double mass(std::size_t i) const;
+  double radius(std::size_t i) const;
+  double now() const;
+  void step_to(double t);
+  double volume() const { return dims_ == 3 ? size_.x * size_.y * size_.z : size_.x * size_.y; }
+  void init_species();
   void sample();
   Window fresh(double t0) const;
 
-  sim::World* world_;
+  sim::World* world_ = nullptr;
+  sim::World3* world3_ = nullptr;
+  int dims_ = 2;
+  sim::Vec3 size_;                   ///< width, height and (3-D) depth
+  double virial3_ = 0.0;             ///< the 3-D world's virial_sum at the last take
+  std::vector<sim::Event3> events3_;  ///< the 3-D world's events since the last take
+  std::vector<double> mass3_, radius3_;  ///< per 3-D sphere, from its def
   ObserveOptions opt_;
   std::string name_;
   sim::Boundary boundary_;
-  double width_, height_;
+  double width_ = 0.0, height_ = 0.0;
   double speed_max_ = 0.0;
   bool started_ = false;
   std::vector<double> wall_length_;
@@ -108,10 +130,10 @@ class Observer {
   std::vector<Species> species_;
   std::vector<std::size_t> species_of_;   ///< per ball
   double rdf_max_ = 0.0;
-  std::vector<sim::Vec2> unwrapped_, last_pos_;  ///< since `from`; positions at the last unwrap
-  std::vector<sim::Vec2> images_;  ///< per ball: whole periods crossed since `from` (integers)
+  std::vector<sim::Vec3> unwrapped_, last_pos_;  ///< since `from`; positions at the last unwrap
+  std::vector<sim::Vec3> images_;  ///< per ball: whole periods crossed since `from` (integers)
   /// Per window: frames 0..samples of unwrapped positions and velocities (NaN x: not alive).
-  std::vector<std::vector<sim::Vec2>> frame_pos_, frame_vel_;
+  std::vector<std::vector<sim::Vec3>> frame_pos_, frame_vel_;
   std::vector<sim::Impulse> impulses_;
   Window current_;
   std::vector<Window> done_;
@@ -123,5 +145,12 @@ class Observer {
 /// value g(sigma) = (1 - 7 eta/16) / (1 - eta)^2 (Z = 1 + 2 eta g), eta the area fraction.
 double henderson_z(double eta);
 double henderson_contact(double eta);
+/// Carnahan-Starling's equation of state of hard spheres, Z = (1 + eta + eta^2 - eta^3) / (1 - eta)^3,
+/// and its contact value g(sigma) = (1 - eta/2) / (1 - eta)^3 (Z = 1 + 4 eta g), eta the volume fraction.
+double carnahan_starling_z(double eta);
+double carnahan_starling_contact(double eta);
+/// Kolafa, Labik and Malijevsky's (2004) equation of state of hard spheres, closer than
+/// Carnahan-Starling to simulations at eta >= 0.45: Z_CS + eta^2 (... ) terms (observables.cpp).
+double klm_z(double eta);
 
 }  // namespace turtlegas::formats
