@@ -42,6 +42,29 @@ TEST_CASE("run of a 3-D world: an edge contact at its closed-form time, named by
   CHECK(st["energy_start"] == st["energy_end"]);
 }
 
+TEST_CASE("run of a 3-D world with restitution: the scene's e, a ball's own, a wall's, in closed form") {
+  TempDir dir;
+  // Sphere a (the scene's e = 0.5) falls onto the shelf (e = 0.8) with normal speed 2: it leaves
+  // at 2 * 0.5 * 0.8 = 0.8 after t = 2.5. Sphere b (its own e = 1) meets the elastic arena floor: it leaves at 2.
+  const auto world = dir.write("e.json", R"({"format": "turtlegas-world/1", "dimensions": 3,
+    "arena": {"width": 20, "height": 20, "depth": 20, "boundary": "walls"},
+    "effects": {"restitution": 0.5, "tc": 0.001},
+    "walls": [{"id": "shelf", "corners": [[2, 2, 1], [8, 2, 1], [8, 8, 1], [2, 8, 1]], "restitution": 0.8}],
+    "balls": [{"id": "a", "pos": [5, 5, 7], "vel": [0, 0, -2], "radius": 1},
+              {"id": "b", "pos": [15, 15, 5], "vel": [0, 0, -2], "radius": 1, "restitution": 1}]})");
+  const auto r = run(dir, {"run", world.string(), "--until", "2.6", "--events", (dir.path / "e.jsonl").string(),
+                           "--state-out", (dir.path / "s.json").string(), "--stats-json", (dir.path / "st.json").string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const auto s = nlohmann::json::parse(read(dir.path / "s.json"));
+  CHECK(std::abs(s["balls"][0]["vel"][2].get<double>() - 0.8) < 1e-12);
+  CHECK(std::abs(s["balls"][1]["vel"][2].get<double>() - 2.0) < 1e-12);
+  const auto st = nlohmann::json::parse(read(dir.path / "st.json"));
+  CHECK(st["collisions"] == 2);
+  // a loses (1 - 0.4^2) / 2 * 4 = 1.68 of kinetic energy; b nothing.
+  CHECK(std::abs(st["energy_start"].get<double>() - st["energy_end"].get<double>() - 1.68) < 1e-12);
+}
+
 TEST_CASE("check and run of worlds/gas3d_box.json") {
   TempDir dir;
   auto r = run(dir, {"check", "worlds/gas3d_box.json"});
@@ -73,6 +96,13 @@ TEST_CASE("3-D world file errors name the JSON path and the fix, exit 2") {
        "not convex"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "turtles": []})", "turtles stay in the plane"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "effects": {"magnetic": 1}})", "/effects/magnetic"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "effects": {"restitution": 1.5}})",
+       "/effects/restitution: restitution must be in [0, 1]"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "balls": [{"id": "a", "pos": [5, 5, 5], "radius": 1, "restitution": -0.1}]})",
+       "/balls/0/restitution"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "restitution": 2}]})",
+       "/walls/0/restitution"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "effects": {"tc": -1}})", "/effects/tc"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "balls": [{"id": "a", "pos": [5, 5, 5], "radius": 1}, {"id": "b", "pos": [6.5, 5, 5], "radius": 1}]})",
        "sphere 0 and sphere 1 overlap"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]]}], "balls": [{"id": "a", "pos": [5, 5, 5.5], "radius": 1}]})",

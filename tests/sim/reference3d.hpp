@@ -5,11 +5,16 @@
 // is 1-Lipschitz in position), so no contact can be stepped over; a contact is served when a gap
 // is below 1e-12 of a radius and closing. The distance to a polygon is computed from scratch
 // (inside test on the plane, else the nearest point of each edge), and the contact's kind from
-// where the nearest point lies. O(N^2 + N W) per step: small scenes only.
+// where the nearest point lies. O(N^2 + N W) per step: small scenes only. Restitution as
+// docs/physics.md "3-D: restitution" states it, written from that text: a pair's e the larger of
+// its spheres' (1 for one that changed course less than tc ago), a wall's the product, normal
+// speeds leaving at 2^-40 of the speeds at least, and at |a_n| tc / 2 where pressed.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <random>
 #include <vector>
 
 #include "turtlegas/sim/vec3.hpp"
@@ -53,16 +58,24 @@ inline Nearest nearest_on_polygon(const std::vector<Vec3>& c, Vec3 q) {
 }
 
 struct Reference3 {
-  struct Ball { Vec3 x, v, a; double r, m; };
+  struct Ball { Vec3 x, v, a; double r, m, e, last; };
   std::vector<Ball> balls;
   std::vector<std::vector<Vec3>> walls;
+  std::vector<double> wall_e;
+  double tc = 0.0;
   double t = 0.0;
 
-  explicit Reference3(const sim::World3Def& def) {
+  explicit Reference3(const sim::World3Def& def) : tc(def.tc) {
     for (const auto& s : def.spheres)
-      balls.push_back({s.pos, s.vel, def.gravity + (s.charge / s.mass) * def.electric, s.radius, s.mass});
-    for (const auto& w : def.walls) walls.push_back(w.corners);
+      balls.push_back({s.pos, s.vel, def.gravity + (s.charge / s.mass) * def.electric, s.radius, s.mass,
+                       s.restitution, -1e300});
+    for (const auto& w : def.walls) {
+      walls.push_back(w.corners);
+      wall_e.push_back(w.restitution);
+    }
   }
+
+  double e_of(const Ball& b) const { return t - b.last < tc ? 1.0 : b.e; }
 
   // The time a gap g can certainly not close in, at relative speed w and acceleration b.
   static double safe(double g, double w, double b) {
@@ -90,7 +103,10 @@ struct Reference3 {
           if (g < 1e-12 * balls[i].r && closing > 0.0) {
             const Vec3 nn = (1.0 / sim::norm(d)) * d;
             const double mu = balls[i].m * balls[j].m / (balls[i].m + balls[j].m);
-            const double jn = 2.0 * mu * sim::dot(w, nn);
+            const double s_in = -sim::dot(w, nn), e = std::max(e_of(balls[i]), e_of(balls[j]));
+            const double s_out = e == 1.0 ? s_in : std::max(e * s_in, 0x1p-40 * sim::norm(w));
+            const double jn = -mu * (s_in + s_out);
+            balls[i].last = balls[j].last = t;
             balls[i].v = balls[i].v + (jn / balls[i].m) * nn;
             balls[j].v = balls[j].v - (jn / balls[j].m) * nn;
             out.push_back({t, sim::Event3Kind::ball_ball, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), 0});
@@ -107,7 +123,14 @@ struct Reference3 {
           const double b = sim::norm(balls[i].a);
           if (g < 1e-12 * balls[i].r && closing > 0.0) {
             const Vec3 nn = (1.0 / nw.dist) * d;
-            balls[i].v = balls[i].v - (2.0 * sim::dot(balls[i].v, nn)) * nn;
+            const double e = balls[i].e * wall_e[k], s_in = -sim::dot(balls[i].v, nn);
+            double s_out = s_in;
+            if (e != 1.0) {
+              s_out = std::max(e * s_in, 0x1p-40 * sim::norm(balls[i].v));
+              if (sim::dot(balls[i].a, nn) < 0.0) s_out = std::max(s_out, -sim::dot(balls[i].a, nn) * tc / 2.0);
+            }
+            balls[i].v = balls[i].v + (s_in + s_out) * nn;
+            balls[i].last = t;
             out.push_back({t, nw.kind, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k), nw.feature});
             served = true;
           } else if (closing > 0.0 || b > 0.0) {
@@ -122,5 +145,36 @@ struct Reference3 {
     }
   }
 };
+
+/// 8 spheres or so in a closed box of six polygons of our own (so the reference sees them), with a
+/// slanted triangle and a slanted quad; gravity and an electric field on random charges optional.
+inline sim::World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool electric = false) {
+  std::mt19937_64 gen(seed);
+  auto u = [&](double lo, double hi) { return lo + (hi - lo) * static_cast<double>(gen() >> 11) * 0x1.0p-53; };
+  sim::World3Def def;
+  def.size = {12, 12, 12};
+  def.boundary = sim::Boundary3::none;
+  if (gravity) def.gravity = {0.3, -0.5, -2.0};
+  if (electric) def.electric = {0.8, 1.5, -1.0};
+  // A closed box of our own walls (so the reference sees them too), and two slanted polygons.
+  const double L = 12;
+  def.walls.push_back({{{0, 0, 0}, {0, L, 0}, {0, L, L}, {0, 0, L}}});
+  def.walls.push_back({{{L, 0, 0}, {L, 0, L}, {L, L, L}, {L, L, 0}}});
+  def.walls.push_back({{{0, 0, 0}, {0, 0, L}, {L, 0, L}, {L, 0, 0}}});
+  def.walls.push_back({{{0, L, 0}, {L, L, 0}, {L, L, L}, {0, L, L}}});
+  def.walls.push_back({{{0, 0, 0}, {L, 0, 0}, {L, L, 0}, {0, L, 0}}});
+  def.walls.push_back({{{0, 0, L}, {0, L, L}, {L, L, L}, {L, 0, L}}});
+  def.walls.push_back({{{3, 3, 4}, {8, 4, 5}, {5, 8, 6}}});
+  def.walls.push_back({{{7, 6, 8}, {10, 6, 9}, {10, 9, 9}, {7, 9, 8}}});
+  while (static_cast<int>(def.spheres.size()) < n) {
+    const double r = u(0.4, 0.8);
+    const Vec3 x{u(1, 11), u(1, 11), u(1, 11)};
+    bool ok = true;
+    for (const auto& s : def.spheres) ok = ok && sim::norm(s.pos - x) > s.radius + r + 0.05;
+    for (const auto& wd : def.walls) ok = ok && nearest_on_polygon(wd.corners, x).dist > r + 0.05;
+    if (ok) def.spheres.push_back({x, {u(-2, 2), u(-2, 2), u(-2, 2)}, r, u(0.5, 2.0), electric ? u(-1.5, 1.5) : 0.0});
+  }
+  return def;
+}
 
 }  // namespace turtlegas::test3

@@ -11,6 +11,7 @@
 #include "turtlegas/sim/world3d.hpp"
 
 using namespace turtlegas::sim;
+using turtlegas::test3::random_scene;
 
 namespace {
 
@@ -110,39 +111,6 @@ TEST_CASE("toi_sphere_sphere under a relative acceleration finds the second appr
   CHECK(t == Approx(1.0 + std::sqrt(3.0)).epsilon(1e-13));
   CHECK(toi_sphere_sphere({3, 0, 0}, {1, 0, 0}, {0, 0, 0}, 2.0, 100.0) == kNever);
 }
-
-namespace {
-
-World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool electric = false) {
-  std::mt19937_64 gen(seed);
-  auto u = [&](double lo, double hi) { return lo + (hi - lo) * static_cast<double>(gen() >> 11) * 0x1.0p-53; };
-  World3Def def;
-  def.size = {12, 12, 12};
-  def.boundary = Boundary3::none;
-  if (gravity) def.gravity = {0.3, -0.5, -2.0};
-  if (electric) def.electric = {0.8, 1.5, -1.0};
-  // A closed box of our own walls (so the reference sees them too), and two slanted polygons.
-  const double L = 12;
-  def.walls.push_back({{{0, 0, 0}, {0, L, 0}, {0, L, L}, {0, 0, L}}});
-  def.walls.push_back({{{L, 0, 0}, {L, 0, L}, {L, L, L}, {L, L, 0}}});
-  def.walls.push_back({{{0, 0, 0}, {0, 0, L}, {L, 0, L}, {L, 0, 0}}});
-  def.walls.push_back({{{0, L, 0}, {L, L, 0}, {L, L, L}, {0, L, L}}});
-  def.walls.push_back({{{0, 0, 0}, {L, 0, 0}, {L, L, 0}, {0, L, 0}}});
-  def.walls.push_back({{{0, 0, L}, {0, L, L}, {L, L, L}, {L, 0, L}}});
-  def.walls.push_back({{{3, 3, 4}, {8, 4, 5}, {5, 8, 6}}});
-  def.walls.push_back({{{7, 6, 8}, {10, 6, 9}, {10, 9, 9}, {7, 9, 8}}});
-  while (static_cast<int>(def.spheres.size()) < n) {
-    const double r = u(0.4, 0.8);
-    const Vec3 x{u(1, 11), u(1, 11), u(1, 11)};
-    bool ok = true;
-    for (const auto& s : def.spheres) ok = ok && norm(s.pos - x) > s.radius + r + 0.05;
-    for (const auto& wd : def.walls) ok = ok && turtlegas::test3::nearest_on_polygon(wd.corners, x).dist > r + 0.05;
-    if (ok) def.spheres.push_back({x, {u(-2, 2), u(-2, 2), u(-2, 2)}, r, u(0.5, 2.0), electric ? u(-1.5, 1.5) : 0.0});
-  }
-  return def;
-}
-
-}  // namespace
 
 TEST_CASE("the engine agrees event for event with the brute-force reference (faces, edges, corners)") {
   int kinds[4] = {0, 0, 0, 0};

@@ -63,15 +63,23 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
     else if (s == "periodic") def.boundary = sim::Boundary3::periodic;
     else rd.fail("/arena/boundary", "expected \"none\", \"walls\" or \"periodic\", got \"" + s + "\"");
   }
+  // A restitution: a number in [0, 1] (docs/physics.md, "3-D: restitution").
+  auto restitution = [&](const json& v, const std::string& path) {
+    const double e = rd.number(v, path);
+    if (!(e >= 0.0 && e <= 1.0))
+      rd.fail(path, "restitution must be in [0, 1] (got " + v.dump() + "); 1 is elastic, 0 perfectly inelastic");
+    return e;
+  };
+  double scene_e = 1.0;  // every ball's and gas's restitution unless it gives its own
   if (const json* e = rd.find(doc, "effects")) {
     rd.expect_object(*e, "/effects", "effects");
-    rd.check_keys(*e, "/effects", "effects", {"gravity", "electric", "magnetic", "restitution", "ball_ball"});
+    rd.check_keys(*e, "/effects", "effects", {"gravity", "electric", "magnetic", "restitution", "tc", "ball_ball"});
     if (const json* g = rd.find(*e, "gravity")) def.gravity = vec3(rd, *g, "/effects/gravity");
     if (const json* g = rd.find(*e, "electric")) def.electric = vec3(rd, *g, "/effects/electric");
     if (const json* m = rd.find(*e, "magnetic"); m && !(m->is_number() && m->get<double>() == 0.0))
       rd.fail("/effects/magnetic", "a magnetic field is not simulated in 3-D yet (helices); remove it or set 0");
-    if (const json* r = rd.find(*e, "restitution"); r && rd.number(*r, "/effects/restitution") != 1.0)
-      rd.fail("/effects/restitution", "3-D collisions are elastic only for now: restitution must be 1");
+    if (const json* r = rd.find(*e, "restitution")) scene_e = restitution(*r, "/effects/restitution");
+    if (const json* t = rd.find(*e, "tc")) def.tc = rd.non_negative(*t, "/effects/tc");
     if (const json* b = rd.find(*e, "ball_ball"); b && !rd.boolean(*b, "/effects/ball_ball"))
       rd.fail("/effects/ball_ball", "3-D spheres always collide with each other for now: ball_ball must be true");
   }
@@ -87,11 +95,12 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
       const std::string path = "/walls/" + std::to_string(k);
       const json& w = (*ws)[k];
       rd.expect_object(w, path, "a wall");
-      rd.check_keys(w, path, "a 3-D wall", {"id", "corners"});
+      rd.check_keys(w, path, "a 3-D wall", {"id", "corners", "restitution"});
       out.wall_ids.push_back(take_id(w, path, "a wall"));
       const json& cs = rd.require(w, path, "corners", "a 3-D wall (its corners, [[x, y, z], ...], in order)");
       rd.expect_array(cs, path + "/corners", "corners");
       sim::Wall3Def wd;
+      if (const json* r = rd.find(w, "restitution")) wd.restitution = restitution(*r, path + "/restitution");
       for (std::size_t c = 0; c < cs.size(); ++c) wd.corners.push_back(vec3(rd, cs[c], path + "/corners/" + std::to_string(c)));
       def.walls.push_back(wd);
       sim::World3Def one;
@@ -108,7 +117,7 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
       const std::string path = "/balls/" + std::to_string(k);
       const json& b = (*bs)[k];
       rd.expect_object(b, path, "a ball");
-      rd.check_keys(b, path, "a 3-D ball", {"id", "pos", "vel", "radius", "mass", "charge"});
+      rd.check_keys(b, path, "a 3-D ball", {"id", "pos", "vel", "radius", "mass", "charge", "restitution"});
       out.ball_ids.push_back(take_id(b, path, "a ball"));
       sim::Sphere3Def s;
       s.pos = vec3(rd, rd.require(b, path, "pos", "a ball"), path + "/pos");
@@ -116,6 +125,7 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
       s.radius = rd.positive(rd.require(b, path, "radius", "a ball"), path + "/radius", "radius");
       if (const json* m = rd.find(b, "mass")) s.mass = rd.positive(*m, path + "/mass", "mass");
       if (const json* q = rd.find(b, "charge")) s.charge = rd.number(*q, path + "/charge");
+      s.restitution = rd.find(b, "restitution") ? restitution(b["restitution"], path + "/restitution") : scene_e;
       for (int a = 0; a < 3; ++a)
         if (s.pos[a] < 0.0 || s.pos[a] >= def.size[a])
           rd.fail(path + "/pos", "lies outside the arena [0, width) x [0, height) x [0, depth)");
@@ -128,11 +138,12 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
       const std::string path = "/gas/" + std::to_string(k);
       const json& g = (*gs)[k];
       rd.expect_object(g, path, "a gas");
-      rd.check_keys(g, path, "a 3-D gas", {"count", "radius", "mass", "speed", "region", "seed", "id_prefix"});
+      rd.check_keys(g, path, "a 3-D gas", {"count", "radius", "mass", "speed", "region", "seed", "id_prefix", "restitution"});
       const std::uint64_t count = rd.natural(rd.require(g, path, "count", "a gas"), path + "/count");
       const double r = rd.positive(rd.require(g, path, "radius", "a gas"), path + "/radius", "radius");
       const double mass = rd.find(g, "mass") ? rd.positive(g["mass"], path + "/mass", "mass") : 1.0;
       const double speed = rd.find(g, "speed") ? rd.non_negative(g["speed"], path + "/speed") : 0.0;
+      const double ge = rd.find(g, "restitution") ? restitution(g["restitution"], path + "/restitution") : scene_e;
       sim::Vec3 lo{0, 0, 0}, hi = def.size;
       if (const json* reg = rd.find(g, "region")) {
         if (!reg->is_array() || reg->size() != 2) rd.fail(path + "/region", "expected [[x0, y0, z0], [x1, y1, z1]]");
@@ -156,7 +167,7 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
             ok = sim::distance_to_polygon(x, def.walls[w].corners) > r;
           if (!ok) continue;
           const double cz = u(-1, 1), phi = u(0, 6.283185307179586), sz = std::sqrt(1 - cz * cz);
-          def.spheres.push_back({x, {speed * sz * std::cos(phi), speed * sz * std::sin(phi), speed * cz}, r, mass, 0.0});
+          def.spheres.push_back({x, {speed * sz * std::cos(phi), speed * sz * std::sin(phi), speed * cz}, r, mass, 0.0, ge});
           placed = true;
         }
         if (!placed)

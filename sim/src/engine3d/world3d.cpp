@@ -54,6 +54,10 @@ struct Record {
 
 constexpr std::uint32_t kNone = EventQueue::kAbsent;
 
+/// 2-D's departure floor (contacts.hpp): an inelastic response leaves at 2^-40 of the speeds at
+/// least, far below any physics and far above the round-off of its products.
+constexpr double kDepartFloor = 0x1p-40;
+
 }  // namespace
 
 double distance_to_polygon(const Vec3& x, const std::vector<Vec3>& corners) {
@@ -119,12 +123,15 @@ std::string check_world3(const World3Def& def) {
   for (int a = 0; a < 3; ++a)
     if (!(def.size[a] > 0.0) || !std::isfinite(def.size[a])) return "the arena's width, height and depth must be finite and > 0";
   if (!is_finite(def.gravity) || !is_finite(def.electric)) return "gravity and electric must be finite";
+  if (!(def.tc >= 0.0) || !std::isfinite(def.tc)) return "tc must be finite and >= 0";
   for (std::size_t i = 0; i < def.spheres.size(); ++i) {
     const Sphere3Def& s = def.spheres[i];
     const std::string at = "sphere " + std::to_string(i) + ": ";
     if (!(s.radius > 0.0) || !std::isfinite(s.radius)) return at + "radius must be finite and > 0";
     if (!(s.mass > 0.0) || !std::isfinite(s.mass)) return at + "mass must be finite and > 0";
     if (!is_finite(s.pos) || !is_finite(s.vel) || !std::isfinite(s.charge)) return at + "pos, vel and charge must be finite";
+    if (!(s.restitution >= 0.0 && s.restitution <= 1.0))
+      return at + "restitution must be in [0, 1]; 1 is elastic, 0 perfectly inelastic";
     for (int a = 0; a < 3; ++a)
       if (s.pos[a] < 0.0 || s.pos[a] >= def.size[a]) return at + "pos must lie in the arena [0, size)";
     if (def.boundary == Boundary3::walls)
@@ -136,6 +143,8 @@ std::string check_world3(const World3Def& def) {
     const auto& c = def.walls[w].corners;
     const std::string at = "wall " + std::to_string(w) + ": ";
     if (c.size() < 3) return at + "needs 3 or more corners";
+    if (!(def.walls[w].restitution >= 0.0 && def.walls[w].restitution <= 1.0))
+      return at + "restitution must be in [0, 1]; 1 is elastic, 0 perfectly inelastic";
     for (const Vec3& p : c) {
       if (!is_finite(p)) return at + "corners must be finite";
       for (int a = 0; a < 3; ++a)
@@ -181,6 +190,11 @@ struct World3::Impl {
   double contact_error = 0.0;
   double virial = 0.0;
   std::vector<Event3>* log = nullptr;
+  // Restitution (docs/physics.md, "3-D: restitution"): kept beside the records, and only when
+  // some e < 1, so that an elastic gas's record and loop are unchanged.
+  bool inelastic = false;
+  double tc = 0.0;
+  std::vector<double> e_sphere, e_wall, last_change;
 
   std::uint32_t cell_index(int cx, int cy, int cz) const {
     return static_cast<std::uint32_t>((cz * n[1] + cy) * n[0] + cx);
@@ -222,6 +236,15 @@ struct World3::Impl {
       w[a] = size[a] / n[a];
     }
     for (const auto& wd : def.walls) walls.emplace_back(wd.corners);
+    for (const auto& s : def.spheres) inelastic = inelastic || s.restitution < 1.0;
+    for (const auto& wd : def.walls) inelastic = inelastic || wd.restitution < 1.0;
+    if (inelastic) {
+      tc = def.tc;
+      for (const auto& s : def.spheres) e_sphere.push_back(s.restitution);
+      for (const auto& wd : def.walls) e_wall.push_back(wd.restitution);
+      e_wall.resize(def.walls.size() + (boundary == Boundary3::walls ? 6 : 0), 1.0);  // the arena's: elastic
+      last_change.assign(def.spheres.size(), -kNever);
+    }
     if (boundary == Boundary3::walls) {
       const double X = size.x, Y = size.y, Z = size.z;
       walls.emplace_back(std::vector<Vec3>{{0, 0, 0}, {0, Y, 0}, {0, Y, Z}, {0, 0, Z}});
@@ -431,6 +454,44 @@ struct World3::Impl {
     ++collisions;
   }
 
+  // The TC rule (2-D's Restitution::for_ball): a sphere that changed course less than tc ago
+  // collides elastically.
+  double e_now(std::uint32_t i) const { return now - last_change[i] < tc ? 1.0 : e_sphere[i]; }
+
+  // The impulse on sphere i along the line of centres n (from i to j) with restitution: the
+  // pair's e is the larger of the two spheres' (after the TC rule), the relative normal speed
+  // s = -vn leaves as e s, and never slower than kDepartFloor of the relative speed (a sphere
+  // pair at e = 0 would otherwise be left touching and "approaching" by round-off).
+  double inelastic_pair_impulse(std::uint32_t i, std::uint32_t j, Vec3 w, double vn, double mu) {
+    const double e = std::max(e_now(i), e_now(j));
+    last_change[i] = last_change[j] = now;
+    if (e == 1.0) return 2.0 * mu * vn;
+    const double out = std::max(e * -vn, kDepartFloor * norm(w));
+    return -mu * (-vn + out);
+  }
+
+  // A wall feature's bounce with restitution e_sphere * e_wall: the normal speed w leaves as
+  // e w, at least kDepartFloor of the speed, and, where the sphere's acceleration presses it onto
+  // the feature (a_n < 0), at least |a_n| tc / 2 (the rest threshold: it stays away for tc at
+  // least, so a sphere coming to rest on a floor bounces every tc instead of infinitely often).
+  // At e = 1 the plain reflection.
+  void bounce_inelastic(std::uint32_t i, Record& b, Vec3 normal, std::uint32_t wall) {
+    const double e = e_sphere[i] * e_wall[wall];
+    last_change[i] = now;
+    if (e == 1.0) {
+      reflect(b, normal);
+      return;
+    }
+    const Vec3 nn = (1.0 / norm(normal)) * normal;
+    const double w = -dot(b.v, nn);
+    double out = std::max(e * w, kDepartFloor * norm(b.v));
+    const double a_n = dot(b.a, nn);
+    if (a_n < 0.0) out = std::max(out, -a_n * tc / 2.0);
+    b.v += (w + out) * nn;
+    ++b.count;
+    ++collisions;
+  }
+
   void serve(std::uint32_t i) {
     Record& b = rec[i];
     ++events;
@@ -456,7 +517,8 @@ struct World3::Impl {
         const Vec3 nn = (1.0 / dist) * d;
         const double vn = dot(o.v - b.v, nn);
         const double mu = b.m * o.m / (b.m + o.m);
-        const double jn = 2.0 * mu * vn;  // impulse on b along nn
+        double jn = 2.0 * mu * vn;  // impulse on b along nn
+        if (inelastic) jn = inelastic_pair_impulse(i, b.partner, o.v - b.v, vn, mu);
         b.v += (jn / b.m) * nn;
         o.v -= (jn / o.m) * nn;
         virial += -jn * dist;  // m1 m2 / M (Δv12 . r12) with r12 = -d, Δv12 = jn / m nn
@@ -476,7 +538,7 @@ struct World3::Impl {
         Event3Kind kind;
         const Vec3 d = b.x - p.corners[b.partner_count];
         if (b.kind == Pending::face) {
-          normal = p.normal;
+          normal = dot(b.x - p.corners[0], p.normal) >= 0.0 ? p.normal : -p.normal;  // towards the sphere
           kind = Event3Kind::ball_wall;
           contact_error = std::max(contact_error, std::abs(std::abs(dot(b.x - p.corners[0], normal)) - b.r) / b.r);
         } else if (b.kind == Pending::edge) {
@@ -489,7 +551,8 @@ struct World3::Impl {
           kind = Event3Kind::ball_wall_corner;
           contact_error = std::max(contact_error, std::abs(norm(normal) - b.r) / b.r);
         }
-        reflect(b, normal);
+        if (inelastic) bounce_inelastic(i, b, normal, b.partner);
+        else reflect(b, normal);
         note(kind, i, b.partner, b.partner_count);
         predict(i);
         return;

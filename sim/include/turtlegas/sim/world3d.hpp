@@ -23,11 +23,16 @@ struct Sphere3Def {
   double radius = 1.0;  ///< world units, > 0
   double mass = 1.0;    ///< > 0
   double charge = 0.0;  ///< scales the electric field's acceleration by charge / mass
+  /// e in [0, 1], the memo's "2 replaced by 1 + e". A pair takes the larger of its two spheres'
+  /// (2-D's rule, which equal e reduces to: the TC rule makes it 1 for a sphere that changed
+  /// course less than World3Def::tc ago); a wall contact takes the sphere's e times the wall's.
+  double restitution = 1.0;
 };
 
 /// A convex planar polygon, corners in order (3 or more, not collinear).
 struct Wall3Def {
   std::vector<Vec3> corners;
+  double restitution = 1.0;  ///< in [0, 1]; a contact takes this times the sphere's e
 };
 
 struct World3Def {
@@ -36,6 +41,11 @@ struct World3Def {
   Vec3 gravity;   ///< units / s^2, on every sphere
   Vec3 electric;  ///< acceleration charge / mass * electric on each sphere
   double cell = 0.0;  ///< the grid's smallest cell side; 0: the largest diameter (times 1 + 2^-20)
+  /// Inelastic-collapse threshold t_c in seconds (2-D's effects.tc, docs/physics.md "3-D:
+  /// restitution"): used only when some e < 1. A pair one of whose spheres changed course less
+  /// than t_c ago collides elastically (the TC rule); a sphere pressed onto a wall feature by its
+  /// acceleration leaves an inelastic bounce at least at |a_n| t_c / 2 (the rest threshold).
+  double tc = 1e-4;
   std::vector<Sphere3Def> spheres;
   std::vector<Wall3Def> walls;  ///< with boundary walls, six more follow these (x0 x1 y0 y1 z0 z1)
 };
