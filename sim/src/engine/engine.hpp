@@ -149,7 +149,14 @@ class Engine final : public EngineBase {
   std::size_t turtle_count() const override { return turtles_.size(); }
   TurtleState turtle(std::size_t k) const override {
     const std::size_t id = bodies_.balls() + k;
-    return turtles_.state(k, bodies_.body[id], bodies_.end[id], now_);
+    TurtleState s = turtles_.state(k, bodies_.body[id], bodies_.end[id], now_);
+    if (motion_.any_arcs()) [[unlikely]] {
+      const Body& b = bodies_.body[id];
+      const FieldState f = motion_.state(b, static_cast<std::uint32_t>(id), now_ - b.t);
+      s.pos = f.x;
+      s.vel = f.v;
+    }
+    return s;
   }
   double turtle_radius(std::size_t k) const override { return bodies_.body[bodies_.balls() + k].r; }
   void idle_turtles(std::vector<std::uint32_t>& out) const override { turtles_.idle(out); }
@@ -538,14 +545,27 @@ void Engine<F, kBallBall, kStep, kExtras>::retire(std::uint32_t i) {
   ++b.count;  // predictions made against it are now stale
   heap_.remove(i);
   if constexpr (kSlides) motion_.flight().end_slide(i);
-  if (is_turtle(i)) turtles_.exit(i - bodies_.balls(), b, bodies_.end[i]);
+  if (is_turtle(i)) {
+    turtles_.exit(i - bodies_.balls(), b, bodies_.end[i]);
+    motion_.set_arc(i - bodies_.balls(), 0.0);
+  }
 }
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
 void Engine<F, kBallBall, kStep, kExtras>::end_command(std::uint32_t i) {
   // A turtle's command (or its coasting after a bounce) has run its course.
   sync(i);
-  if (!turtles_.finish(i - bodies_.balls(), bodies_.body[i], bodies_.end[i])) {
+  const std::size_t k = i - bodies_.balls();
+  if (Vec2 end; turtles_.arc_end(k, end)) [[unlikely]] {
+    // An arc run to its end ends at its closed form (Turtles::arc_end), not at the sum of the
+    // round-offs of the events it passed: the two differ by round-off only (a lap ends where it
+    // began, exactly). In a periodic arena the body may be an image away.
+    Body& b = bodies_.body[i];
+    const Vec2 d = arena_.min_image(end - b.x);
+    if (norm(d) <= 1e-9 * (b.r + norm(turtles_.run(k).v0) * dt_)) b.x = b.x + d;
+  }
+  motion_.set_arc(k, 0.0);
+  if (!turtles_.finish(k, bodies_.body[i], bodies_.end[i])) {
     // The disc stood still and stays still: only its key loses the command's end.
     schedule(i);
     return;
@@ -560,8 +580,18 @@ void Engine<F, kBallBall, kStep, kExtras>::command_turtle(std::size_t k, const T
   if (k >= turtles_.size()) throw std::out_of_range("command_turtle: no turtle " + std::to_string(k));
   const auto id = static_cast<std::uint32_t>(bodies_.balls() + k);
   if (bodies_.body[id].cell == kNone) return;  // it has left the arena
+  if (c.kind == TurtleCommand::Kind::arc && c.rate != 0.0) {
+    // There is no exact solver for a circle against a turning or stretching wall (ChargedFlight's
+    // circles are refused there too, validate.cpp).
+    for (const Mover& m : schedule_.movers)
+      if (!m.rigid())
+        throw std::invalid_argument("turtle #" + std::to_string(k) +
+                                    ": arcs are not simulated while a wall turns or stretches (no exact solver); "
+                                    "drive straight strokes and turns in this world");
+  }
   sync(id);
   const bool moved = turtles_.command(k, c, bodies_.body[id], bodies_.end[id], now_);
+  motion_.set_arc(k, turtles_.busy(k) && c.kind == TurtleCommand::Kind::arc ? c.rate : 0.0);
   if constexpr (kExtras) {
     // A command lasting a whole number of control steps ends on that boundary, exactly.
     if (const std::uint64_t j = turtles_.snap_end(k, bodies_.end[id], t_base_, dt_); j != kNoStep)

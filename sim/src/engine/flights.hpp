@@ -364,6 +364,15 @@ FieldState flight_state(const F& f, std::uint32_t ball, Vec2 x, Vec2 v, double d
   else return {f.pos(ball, x, v, dt), f.vel(ball, v, dt)};
 }
 
+/// The field flight of ball `ball` under flight f with velocity v now (FieldFlight's a and w): for
+/// the pair searches of a ball against a turtle on an arc.
+template <class F>
+FieldFlight field_flight_of(const F& f, std::uint32_t ball, Vec2 v) {
+  if constexpr (requires { f.flight(ball, v); }) return f.flight(ball, v);
+  else if constexpr (requires { f.accel(ball); }) return {v, f.accel(ball), 0.0};
+  else return {v, Vec2{}, 0.0};
+}
+
 template <Flight F, bool kExtras>
 class Motion {
  public:
@@ -376,28 +385,91 @@ class Motion {
   /// A ball spawned at run time takes id balls_ (world_changes.hpp; flights with per-ball data refuse).
   void add_ball() { ++balls_; }
   /// Whether body id's motion relative to something that flies straight is a straight line.
-  bool straight(std::uint32_t id) const { return is_turtle(id) || flight_.straight(id); }
+  bool straight(std::uint32_t id) const { return is_turtle(id) ? !arcs(id) : flight_.straight(id); }
+
+  // Turtles on arcs (TurtleCommand::Kind::arc): a turtle driving at v while its heading turns at
+  // w rad/s (positive clockwise) flies the drift-free circle of a charged disc in a magnetic field
+  // with W = w (field_flight.hpp: there too w > 0 turns clockwise), so its positions and its times
+  // of impact are that flight's (circle_advance, field_toi.hpp). No turtle on an arc: one compare.
+
+  /// Turtle k (its index among turtles) turns at w rad/s from now (0: it flies straight).
+  void set_arc(std::size_t k, double w) {
+    if constexpr (kExtras) {
+      if (arc_.size() <= k) {
+        if (w == 0.0) return;
+        arc_.resize(k + 1, 0.0);
+      }
+      arcing_ += (w != 0.0 ? 1 : 0) - (arc_[k] != 0.0 ? 1 : 0);
+      arc_[k] = w;
+    }
+  }
+  /// Body id's turn rate (rad/s): a turtle's on an arc, else 0.
+  double arc(std::uint32_t id) const {
+    if (arcing_ == 0 || !is_turtle(id)) [[likely]] return 0.0;
+    const std::size_t k = id - balls_;
+    return k < arc_.size() ? arc_[k] : 0.0;
+  }
+  bool arcs(std::uint32_t id) const { return arc(id) != 0.0; }
+  bool any_arcs() const { return arcing_ != 0; }
+  /// Body id's flight as field_toi.hpp takes it, with velocity v now.
+  FieldFlight field_flight(std::uint32_t id, Vec2 v) const {
+    return is_turtle(id) ? FieldFlight{v, Vec2{}, arc(id)} : field_flight_of(flight_, id, v);
+  }
+  /// The first contact of bodies i and j (one of them a turtle on an arc), r = x_j - x_i, both
+  /// brought to now with velocities vi and vj; horizon finite (an arc's end bounds it).
+  double toi_arc_pair(std::uint32_t i, Vec2 vi, std::uint32_t j, Vec2 r, Vec2 vj, double sigma, double horizon) const {
+    return toi_field_disc_disc(r, field_flight(i, vi), field_flight(j, vj), sigma, horizon);
+  }
 
   Vec2 pos(const Body& b, std::uint32_t id, double dt) const {
-    return is_turtle(id) ? b.x + dt * b.v : flight_.pos(id, b.x, b.v, dt);
+    if (is_turtle(id)) {
+      if (const double w = arc(id); w != 0.0) [[unlikely]] return circle_advance(b.x, b.v, w, dt).x;
+      return b.x + dt * b.v;
+    }
+    return flight_.pos(id, b.x, b.v, dt);
   }
-  Vec2 vel(const Body& b, std::uint32_t id, double dt) const { return is_turtle(id) ? b.v : flight_.vel(id, b.v, dt); }
+  Vec2 vel(const Body& b, std::uint32_t id, double dt) const {
+    if (is_turtle(id)) {
+      if (const double w = arc(id); w != 0.0) [[unlikely]] return circle_advance(Vec2{}, b.v, w, dt).v;
+      return b.v;
+    }
+    return flight_.vel(id, b.v, dt);
+  }
   /// pos and vel at once (a flight with state() computes them together).
   FieldState state(const Body& b, std::uint32_t id, double dt) const {
-    if (is_turtle(id)) return {b.x + dt * b.v, b.v};
+    if (is_turtle(id)) {
+      if (const double w = arc(id); w != 0.0) [[unlikely]] return circle_advance(b.x, b.v, w, dt);
+      return {b.x + dt * b.v, b.v};
+    }
     return flight_state(flight_, id, b.x, b.v, dt);
   }
   CellExit cell_exit(std::uint32_t id, Vec2 x, Vec2 v, const CellBox& b) const {
-    if (is_turtle(id))
+    if (is_turtle(id)) {
+      if (const double w = arc(id); w != 0.0) [[unlikely]] {
+        // ChargedFlight's drift-free circle: the earlier of the two axes' closed forms.
+        const BoxExit bx = field_box_exit_drift_free(x, FieldFlight{v, Vec2{}, w}, {b.x_lo, b.y_lo}, {b.x_hi, b.y_hi});
+        if (bx.t == kNever) return {};
+        return {bx.t, static_cast<std::uint8_t>(bx.axis == 0 ? (bx.upper ? 1 : 0) : (bx.upper ? 3 : 2))};
+      }
       return earlier_exit(straight_exit(x.x, v.x, b.x_lo, b.x_hi), straight_exit(x.y, v.y, b.y_lo, b.y_hi));
+    }
     return flight_.cell_exit(id, x, v, b);
   }
-  /// Body id (a ball or a turtle) at rel from a point that flies straight, v relative to it.
+  /// Body id (a ball or a turtle) at rel from a point that flies straight at u, v relative to it.
+  /// A turtle on an arc seen from a point moving at u turns v + u: relative to the point its
+  /// flight has the acceleration w J(u) (in_moving_frame).
   double toi_point(std::uint32_t id, Vec2 rel, Vec2 v, Vec2 u, double sigma, double t_max) const {
-    return is_turtle(id) ? toi_disc_point(rel, v, sigma) : flight_.toi_point(id, rel, v, u, sigma, t_max);
+    if (is_turtle(id)) {
+      if (const double w = arc(id); w != 0.0) [[unlikely]]
+        return toi_field_disc_point(rel, FieldFlight{v, w * turn_cw(u), w}, sigma, t_max);
+      return toi_disc_point(rel, v, sigma);
+    }
+    return flight_.toi_point(id, rel, v, u, sigma, t_max);
   }
   double toi_segment(std::uint32_t id, Vec2 rel, Vec2 v, Vec2 u, const Segment& s, double radius, double t_max) const {
     if (!is_turtle(id)) return flight_.toi_segment(id, rel, v, u, s, radius, t_max);
+    if (const double w = arc(id); w != 0.0) [[unlikely]]
+      return toi_field_disc_segment(rel, FieldFlight{v, w * turn_cw(u), w}, s, radius, t_max);
     // A turtle that has turned to drive along a wall it touches moves along it up to the
     // round-off of its heading's sine and cosine against the wall's normal: a graze, not an
     // approach (it would stop the turtle at once; contacts.hpp, kGrazeRate). Moving along the
@@ -405,6 +477,8 @@ class Motion {
     if (grazes_line(v, s.n)) return kNever;
     return toi_disc_segment(rel, v, Vec2{}, s, radius);
   }
+  /// (A turtle on an arc never meets a turning or stretching wall: the engine refuses arcs in a
+  /// scene with one, as ChargedFlight's circles are refused there; there is no solver.)
   double toi_deforming_segment(std::uint32_t id, Vec2 rel, Vec2 v, Vec2 d0, Vec2 w, double radius, double t_max) const {
     return is_turtle(id) ? toi_disc_deforming_segment(rel, v, Vec2{}, d0, w, radius, t_max)
                          : flight_.toi_deforming_segment(id, rel, v, d0, w, radius, t_max);
@@ -413,6 +487,8 @@ class Motion {
  private:
   F flight_;
   std::uint32_t balls_ = 0;
+  std::vector<double> arc_;  ///< per turtle: its turn rate on an arc (rad/s), grown at the first arc
+  std::uint32_t arcing_ = 0;  ///< how many turtles are on an arc now
 };
 
 }  // namespace turtlegas::sim::detail

@@ -95,11 +95,27 @@ Changed apply_ball_ball(const Parts<Fl, kStep, kExtras>& w, std::uint32_t i, std
 // ---------------------------------------------------------------------------------------------
 // Turtle-body: a turtle (a disc of infinite mass that flies straight) with a ball or a turtle
 
+/// A pair one of whose bodies is a turtle on an arc: the field searches of two flights (field_toi.hpp),
+/// up to the end of the arcs (the pair's relative motion is not straight: no pair is skipped for
+/// having just met).
+template <Flight F, bool kExtras>
+[[gnu::noinline]] void predict_arc_pair(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift,
+                                        Pending& p) {
+  const Body& bj = l.bodies.body[j];
+  const FieldState sj = l.motion.state(bj, j, l.now - bj.t);
+  const double horizon = l.horizon(j, l.horizon(i, p.t_coll)) - l.now;
+  if (!(horizon > 0.0)) return;
+  const double t = l.now + l.motion.toi_arc_pair(i, bi.v, j, sj.x + shift - bi.x, sj.v, bi.r + bj.r, horizon);
+  if (t < p.t_coll) p.take(t, Partner::body, j, bj.count);
+}
+
 /// Turtle j, seen from body i (a ball or a turtle).
 template <Flight F, bool kExtras>
 [[gnu::always_inline]] inline void predict_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j, Vec2 shift,
                     Pending& p) {
   if (j == i || !l.meets(i, j)) return;
+  if (l.motion.any_arcs() && (l.motion.arcs(i) || l.motion.arcs(j))) [[unlikely]]
+    return predict_arc_pair(l, i, bi, j, shift, p);
   const Body& bj = l.bodies.body[j];
   const Vec2 rel = bi.x - (bj.x + (l.now - bj.t) * bj.v + shift);
   const Vec2 v = bi.v - bj.v;
@@ -113,6 +129,8 @@ template <Flight F, bool kExtras>
 [[gnu::always_inline]] inline void predict_ball_from_turtle(const Look<F, kExtras>& l, std::uint32_t i, const Body& bi, std::uint32_t j,
                               Vec2 shift, Pending& p) {
   if (!l.meets(i, j)) return;
+  if (l.motion.any_arcs() && l.motion.arcs(i)) [[unlikely]]
+    return predict_arc_pair(l, i, bi, j, shift, p);
   const Body& bj = l.bodies.body[j];
   const double dtj = l.now - bj.t;
   const F& f = l.motion.flight();
@@ -181,7 +199,7 @@ template <Flight F, bool kExtras>
   if (slides_on(l.motion.flight(), i, w)) [[unlikely]] return;
   const Segment& s = l.walls.segments[w];
   // Relative to the wall's first end, so walls far from the origin lose nothing.
-  const double t = l.now + l.motion.toi_segment(i, bi.x - (s.p1 + shift), bi.v, Vec2{}, s, bi.r, p.t_coll - l.now);
+  const double t = l.now + l.motion.toi_segment(i, bi.x - (s.p1 + shift), bi.v, Vec2{}, s, bi.r, l.horizon(i, p.t_coll) - l.now);
   if (t < p.t_coll && !(l.bodies.held_against(i, LastPartner::of(Partner::wall, w), t)))
     p.take(t, Partner::wall, w);
 }
@@ -263,7 +281,7 @@ template <Flight F, bool kExtras>
   // skip() in two halves (contacts.hpp): the end just met is left out before the search.
   if (!l.meets_end(i, e) || just_met(l.bodies, l.motion.straight(i), i, LastPartner::of(Partner::end, e))) return;
   const Vec2 rel = bi.x - (l.walls.ends[e].p + shift);
-  const double t = l.now + l.motion.toi_point(i, rel, bi.v, Vec2{}, bi.r, p.t_coll - l.now);
+  const double t = l.now + l.motion.toi_point(i, rel, bi.v, Vec2{}, bi.r, l.horizon(i, p.t_coll) - l.now);
   if (t < p.t_coll && !(l.bodies.held_against(i, LastPartner::of(Partner::end, e), t))) {
     // A ball sliding along a wall passes its ends at the contact distance only when the slide
     // ends there (the sliding flight's own event): until then it cannot meet them.
@@ -310,7 +328,7 @@ template <Flight F, bool kExtras>
   const Segment& s = l.walls.segments[w];
   const Vec2 p1 = m.p1_at(l.now);
   const Vec2 v = bi.v - m.u;
-  const double horizon = std::min(p.t_coll, l.schedule.next_key);
+  const double horizon = std::min(l.horizon(i, p.t_coll), l.schedule.next_key);
   const bool straight = l.motion.straight(i);
   // Relative to a turning or stretching wall no motion is straight: no straight-line argument
   // rules out meeting the same wall again.

@@ -72,6 +72,13 @@ struct Look {
   double now;
 
   bool is_turtle(std::uint32_t id) const { return motion.is_turtle(id); }
+  /// How far body i's searches look (internal time): t_coll, but no further than the end of its
+  /// arc if it is a turtle on one (the searches on a circle need a finite horizon, and the arc's
+  /// end predicts afresh).
+  double horizon(std::uint32_t i, double t_coll) const {
+    if (motion.any_arcs() && motion.arcs(i)) [[unlikely]] return std::min(t_coll, bodies.end[i]);
+    return t_coll;
+  }
   /// Collision layers: whether two bodies, or a body and a wall or wall end, can touch at all.
   bool meets(std::uint32_t i, std::uint32_t j) const {
     // Bodies' layers are fixed at construction; when all are the defaults (which meet), the pair
@@ -105,7 +112,7 @@ void sync_body(BodyStore& bodies, const Motion<F, kExtras>& motion, StepState& s
 template <Flight F, bool kStep, bool kExtras>
 struct Parts {
   BodyStore& bodies;
-  const Motion<F, kExtras>& motion;
+  Motion<F, kExtras>& motion;
   Walls& walls;
   WallSchedule& schedule;
   Turtles& turtles;
@@ -143,6 +150,7 @@ struct Parts {
   void touch(std::uint32_t id, EventKind kind, std::uint32_t other, Vec2 normal) const {
     const std::size_t k = id - bodies.balls();
     turtles.touch(k, bodies.body[id], bodies.end[id], now, t_base, dt, kind, other, normal);
+    motion.set_arc(k, 0.0);  // stopped dead, or coasting straight after a bounce
     if (const std::uint64_t j = turtles.end_step[k]; j != kNoStep)
       bodies.end[id] = internal_boundary(j, t_base, dt, kStep, step.index);
   }

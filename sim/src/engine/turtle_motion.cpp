@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "turtlegas/sim/control_steps.hpp"
+#include "turtlegas/sim/field_flight.hpp"
 
 namespace turtlegas::sim::detail {
 
@@ -47,6 +48,7 @@ TurtleState Turtles::state(std::size_t k, const Body& b, double end, double now)
     const double el = now - r.t_start;
     s.done = r.kind == TurtleCommand::Kind::move ? r.speed * el
              : r.kind == TurtleCommand::Kind::turn ? r.turn_rate * el
+             : r.kind == TurtleCommand::Kind::arc  ? norm(r.v0) * el
                                                    : el;
   } else {
     s.done = std::abs(r.amount);
@@ -85,6 +87,18 @@ bool Turtles::command(std::size_t k, const TurtleCommand& c, Body& b, double& en
       end = busy ? now + std::abs(c.amount) / r.turn_rate : kNever;
       r.amount = c.amount;
       break;
+    case TurtleCommand::Kind::arc: {
+      // The odometer counts the distance along the arc, |speed| * time (amount: it, at the end).
+      busy = c.amount > 0.0 && (c.speed != 0.0 || c.rate != 0.0);
+      end = busy ? now + c.amount : kNever;
+      r.omega = busy ? c.rate : 0.0;
+      r.angle = std::isnan(c.angle) ? c.rate * c.amount : c.angle;
+      if (busy) b.v = c.speed * heading_vector(r.heading0);
+      r.x0 = b.x;
+      r.v0 = b.v;
+      r.amount = std::abs(c.speed) * c.amount;
+      break;
+    }
     case TurtleCommand::Kind::wait:
       busy = c.amount > 0.0;
       end = busy ? now + c.amount : kNever;
@@ -115,6 +129,9 @@ bool Turtles::finish(std::size_t k, Body& b, double& end) {
   // A completed turn ends exactly where it was told to, not where omega * time rounds to.
   if (busy_[k] != 0) {
     if (r.kind == TurtleCommand::Kind::turn) r.heading0 += r.amount;
+    // An arc's heading is kept in (-pi, pi]: a turtle circling for ever would otherwise carry a
+    // heading whose ulp grows with the laps (7e-12 rad after 10^4), and every lap would round it.
+    if (r.kind == TurtleCommand::Kind::arc) r.heading0 = std::remainder(r.heading0 + r.angle, 2.0 * 3.141592653589793);
     r.amount = std::abs(r.amount);
   }
   busy_[k] = 0;
@@ -128,15 +145,33 @@ bool Turtles::finish(std::size_t k, Body& b, double& end) {
   return true;
 }
 
+bool Turtles::arc_end(std::size_t k, Vec2& pos) const {
+  const TurtleRun& r = run_[k];
+  if (busy_[k] == 0 || r.kind != TurtleCommand::Kind::arc || r.coasting) return false;
+  if (r.omega == 0.0) return false;  // a straight stroke: its end is where it stopped
+  // The chord of the exact turn: x(T) - x0 = sin(phi)/w v0 + (1 - cos(phi))/w J(v0), phi = w T
+  // (field_flight.hpp's coefficients), with phi reduced to (-pi, pi] first so that a whole number
+  // of turns gives exactly no chord (and a lap ends where it began).
+  const double two_pi = 2.0 * 3.141592653589793;
+  const double phi = std::remainder(r.angle, two_pi);
+  const double h = 0.5 * phi;
+  const double sh = std::sin(h);
+  const double s = std::sin(phi) / r.omega;
+  const double c = (2.0 * sh * sh) / r.omega;
+  pos = r.x0 + (s * r.v0 + c * turn_cw(r.v0));
+  return true;
+}
+
 void Turtles::touch(std::size_t k, Body& b, double& end, double now, double t_base, double dt, EventKind kind,
                     std::uint32_t other, Vec2 normal) {
   TurtleRun& r = run_[k];
   if (busy_[k] != 0) {
     busy_[k] = 0;
     r.touched = true;
-    if (r.kind == TurtleCommand::Kind::turn) r.heading0 = heading_at(k, now, end);
+    if (r.kind == TurtleCommand::Kind::turn || r.kind == TurtleCommand::Kind::arc) r.heading0 = heading_at(k, now, end);
     r.amount = r.kind == TurtleCommand::Kind::move ? r.speed * (now - r.t_start)
                : r.kind == TurtleCommand::Kind::turn ? std::abs(r.omega) * (now - r.t_start)
+               : r.kind == TurtleCommand::Kind::arc  ? norm(r.v0) * (now - r.t_start)
                                                      : now - r.t_start;
     r.omega = 0.0;
     end = kNever;
@@ -155,6 +190,7 @@ void Turtles::touch(std::size_t k, Body& b, double& end, double now, double t_ba
     end = kNever;
     end_step[k] = kNoStep;
   }
+  r.omega = 0.0;  // (a coast after a bounce flies straight)
   contacts_.push_back({t_base + now, static_cast<std::uint32_t>(k), kind, other, normal});
 }
 
@@ -177,6 +213,7 @@ void Turtles::place(std::size_t k, double heading, Body& b, double& end, double 
     const double el = now - r.t_start;
     r.amount = r.kind == TurtleCommand::Kind::move ? r.speed * el
                : r.kind == TurtleCommand::Kind::turn ? r.turn_rate * el
+               : r.kind == TurtleCommand::Kind::arc  ? norm(r.v0) * el
                                                      : el;
   }
   busy_[k] = 0;

@@ -29,6 +29,11 @@ struct TurtleRun {
   double speed = 0.0;
   double turn_rate = 0.0;
   double bounce = -1.0;
+  /// An arc's start (Kind::arc): where it began and with what velocity, so that its end is the
+  /// closed form from there rather than the sum of the round-offs of every event it passed.
+  Vec2 x0;
+  Vec2 v0;
+  double angle = 0.0;  ///< an arc's exact turn, radians
 };
 
 /// No control boundary: a command whose end is not on one.
@@ -91,6 +96,10 @@ class Turtles {
   /// Turtle k's command (or its coasting after a bounce) has run its course at `now`. Returns
   /// whether the body was moving (it now stands still: its course changed).
   bool finish(std::size_t k, Body& b, double& end);
+  /// Where turtle k's arc, just run to its end, ends in closed form (its start plus the circle's
+  /// chord for its exact turn); its heading is set to the start's plus that turn. Call before
+  /// finish(), with the body brought to the end; returns false for any other command.
+  bool arc_end(std::size_t k, Vec2& pos) const;
   /// Turtle k touched something at internal time `now` (t_base: the external time of internal
   /// zero; dt: the control step): its command ends there (a dead stop, or a bounce that coasts
   /// until the next control step), and the contact waits for its touch sensors.

@@ -215,6 +215,7 @@ void Engine<F, kBallBall, kStep, kExtras>::teleport_turtle(std::size_t k, Vec2 p
     sync(i);
     unlink(i);
     turtles_.place(k, heading, bodies_.body[i], bodies_.end[i], now_);
+    motion_.set_arc(k, 0.0);
     place(i, pos);
   }
 }

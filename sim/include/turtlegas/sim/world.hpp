@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <functional>
 #include <memory>
 #include <stdexcept>
@@ -85,9 +86,19 @@ struct TurtleCommand {
     move,  ///< drive `amount` world units along the heading (negative: backwards)
     turn,  ///< turn in place by `amount` radians (positive: clockwise, "right"); never collides
     wait,  ///< stand still for `amount` seconds
+    /// drive along a circle for `amount` seconds (>= 0) at `speed` units/s along the heading
+    /// (negative: backwards) while the heading turns at `rate` rad/s (positive: clockwise, as
+    /// `turn`); `rate` 0 is a straight stroke, `speed` 0 a turn on the spot. The disc's path is the
+    /// flight of a charged disc in a magnetic field (field_flight.hpp, w = rate), and its contacts
+    /// are that flight's exact times of impact. `angle`, when finite, is the exact turn the
+    /// command makes (rate * amount up to round-off): the end pose is its closed form.
+    arc,
   };
   Kind kind = Kind::stop;
   double amount = 0.0;
+  double speed = 0.0;  ///< arc: units/s
+  double rate = 0.0;   ///< arc: rad/s, positive clockwise
+  double angle = std::numeric_limits<double>::quiet_NaN();  ///< arc: radians, its exact turn (NaN: rate * amount)
 };
 
 /// A turtle's state at the world's current time.
