@@ -136,4 +136,19 @@ std::string controller_summary(const world::Scene& scene) {
   return s;
 }
 
+bool is_recording(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(256, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  std::size_t at = 0;
+  auto token = [&](std::string_view t) {
+    while (at < head.size() && (head[at] == ' ' || head[at] == '\t' || head[at] == '\r' || head[at] == '\n')) ++at;
+    if (head.compare(at, t.size(), t) != 0) return false;
+    at += t.size();
+    return true;
+  };
+  return token("{") && token("\"format\"") && token(":") && token("\"turtlegas-recording/");
+}
+
 }  // namespace turtlegas::apps

@@ -79,4 +79,8 @@ std::string fmt(double v);
 /// "wander x3, script": each controller the scene uses and how many turtles run it, in file order.
 std::string controller_summary(const world::Scene& scene);
 
+/// Whether the file opens as a recording's header does: {"format": "turtlegas-recording/...,
+/// with any JSON whitespace between the tokens. Reads at most 256 bytes.
+bool is_recording(const std::string& path);
+
 }  // namespace turtlegas::apps

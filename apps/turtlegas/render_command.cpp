@@ -50,24 +50,6 @@ struct Source {
   std::vector<formats::Keyframe> keyframes;  ///< a recording: its keyframes, checked as the run passes them
 };
 
-/// Whether the file opens as a recording's header does: {"format": "turtlegas-recording/...,
-/// with any JSON whitespace between the tokens (a header edited by hand and re-indented was read
-/// as a world file, and refused as one).
-bool is_recording(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string head(256, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  std::size_t at = 0;
-  auto token = [&](std::string_view t) {
-    while (at < head.size() && (head[at] == ' ' || head[at] == '\t' || head[at] == '\r' || head[at] == '\n')) ++at;
-    if (head.compare(at, t.size(), t) != 0) return false;
-    at += t.size();
-    return true;
-  };
-  return token("{") && token("\"format\"") && token(":") && token("\"turtlegas-recording/");
-}
-
 Source load_source(const std::string& path, const turtle::Registry& registry) {
   Source s;
   if (!is_recording(path)) {

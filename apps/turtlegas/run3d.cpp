@@ -37,6 +37,9 @@ nlohmann::json vec(sim::Vec3 v) { return nlohmann::json::array({v.x, v.y, v.z});
 }  // namespace
 
 std::optional<world::World3File> load_world3_if_3d(const std::string& file) {
+  // A recording is 2-D and may be huge (a crash can leave a zero-filled tail): its own reader
+  // takes it a line at a time; reading it whole here took all memory.
+  if (is_recording(file)) return std::nullopt;
   std::ifstream in(file, std::ios::binary);
   if (!in) return std::nullopt;
   std::ostringstream text;
