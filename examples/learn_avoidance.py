@@ -32,15 +32,6 @@ def features(obs, layout):
     return np.concatenate([near, np.ones(near.shape[:2] + (1,), dtype=np.float32)], axis=2)
 
 
-def reward(vec, obs, actions):
-    """Forward stroke as a fraction of the longest (speed x dt / 2), minus 1 for a touch."""
-    lay = vec.layout
-    full = 60.0 * vec.dt * 0.5
-    moved = obs[:, :, lay["odometry"]][:, :, 0] / full
-    touched = obs[:, :, lay["touch"]].max(axis=2)
-    return moved - touched
-
-
 def evaluate(vec, weights, copies_each, steps, seed):
     """Mean reward a step and a turtle of each policy in weights (P, 2, 9), on copies_each copies each."""
     import turtlegas  # noqa: F401  (vec is one)
@@ -70,7 +61,9 @@ def cem(generations=20, population=32, copies_each=4, steps=100, elite_frac=0.2,
     dim = (2, 9)
     mu, sigma = np.zeros(dim), np.ones(dim)
     # One VecWorld for the population and the mean policy: (population + 1) x copies_each copies.
-    vec = turtlegas.VecWorld(WORLD, (population + 1) * copies_each, seed, threads=threads, reward=reward)
+    # The reward is the world file's: {"learn": {"reward": "distance / stroke - touch"}}, the forward
+    # stroke as a fraction of the longest, minus 1 for a step with a touch.
+    vec = turtlegas.VecWorld(WORLD, (population + 1) * copies_each, seed, threads=threads)
     n_elite = max(2, int(round(elite_frac * population)))
     history = []
     for g in range(generations):

@@ -376,6 +376,11 @@ std::size_t VecWorld::action_size() const { return impl_->action_size(); }
 const VecWorldOptions& VecWorld::options() const { return impl_->options; }
 const std::vector<std::string>& VecWorld::turtle_ids() const { return impl_->ids; }
 double VecWorld::dt() const { return impl_->def.dt; }
+std::vector<double> VecWorld::turtle_speeds() const {
+  std::vector<double> out;
+  for (const sim::TurtleDef& t : impl_->def.turtles) out.push_back(t.speed);
+  return out;
+}
 
 void VecWorld::reset(std::uint64_t seed, std::span<float> obs) {
   Impl& m = *impl_;

@@ -66,6 +66,7 @@ void bind_vec_world(py::module_& m) {
       .def_property_readonly("action_size", &VecWorld::action_size)
       .def_property_readonly("turtle_ids", &VecWorld::turtle_ids)
       .def_property_readonly("dt", &VecWorld::dt)
+      .def_property_readonly("turtle_speeds", &VecWorld::turtle_speeds)
       .def_property_readonly("layout", [](const VecWorld& v) {
         const learn::ObsLayout& l = v.layout();
         py::dict d;

@@ -17,6 +17,7 @@ import os
 import numpy as np
 
 from . import _turtlegas as _core
+from .reward import RewardExpression
 
 ACTION_KINDS = ("velocity", "wheels", "logo")
 LOGO_ACTIONS = ("wait", "forward", "back", "left", "right")
@@ -32,8 +33,10 @@ class VecWorld:
         speed and turn rate; a turn then a stroke each control step), "wheels" ((left, right) in
         [-1, 1], the differential drive v = (l + r) / 2, omega = (l - r) / 2) or "logo" (one integer
         per turtle: 0 wait, 1 forward, 2 back, 3 left, 4 right, for a whole control step).
-    reward: None (rewards are 0) or a callable reward(vec, obs, actions) -> array (n, turtles),
-        called after each step; vec.positions() and the rest give it the ground truth.
+    reward: a callable reward(vec, obs, actions) -> array (n, turtles), called after each step
+        (vec.positions() and the rest give it the ground truth); or an expression as a string
+        ("distance / stroke - touch": turtlegas.reward.NAMES lists the figures); None: the world
+        file's {"learn": {"reward": ...}} when it has one, else rewards are 0.
     random_start: each reset scatters the turtles at random free poses (False: the file's poses).
     max_steps: control steps after which a copy is truncated (0: never).
     mode: "exact" or "step", the engine's mode.
@@ -50,8 +53,15 @@ class VecWorld:
             name = path
         if actions not in ACTION_KINDS:
             raise ValueError(f"actions must be one of {ACTION_KINDS}, not {actions!r}")
-        if reward is not None and not callable(reward):
-            raise TypeError("reward must be a callable reward(vec, obs, actions) -> (n, turtles) array, or None")
+        if reward is None:
+            learn = json.loads(text).get("learn") if text.lstrip().startswith("{") else None
+            if isinstance(learn, dict) and "reward" in learn:
+                reward = RewardExpression(learn["reward"], f"{name}: /learn/reward")
+        elif isinstance(reward, str):
+            reward = RewardExpression(reward, "reward=")
+        elif not callable(reward):
+            raise TypeError("reward must be a callable reward(vec, obs, actions) -> (n, turtles) array, "
+                            "an expression (a string), or None")
         self._vec = _core._VecWorld(text, name, int(n), threads=int(threads), actions=actions,
                                     random_start=bool(random_start), max_steps=int(max_steps), mode=mode)
         self.actions = actions
@@ -139,6 +149,8 @@ class VecWorld:
         truncated = np.repeat(trunc[:, None], t, axis=1)
         if self.reward_fn is None:
             reward = np.zeros((self._vec.size, t), dtype=np.float32)
+        elif isinstance(self.reward_fn, RewardExpression):
+            reward = self._expression_reward(obs, a)
         else:
             reward = np.asarray(self.reward_fn(self, obs, a), dtype=np.float32)
             if reward.shape != (self._vec.size, t):
@@ -157,6 +169,49 @@ class VecWorld:
     def headings(self):
         """(n, turtles) degrees, Logo convention (0 is +y, clockwise)."""
         return self._vec.headings()
+
+    def _expression_reward(self, obs, a):
+        """The world file's (or reward=) expression over this step's figures, (n, turtles) float32."""
+        expr, lay, shape = self.reward_fn, self.layout, (self._vec.size, self._vec.turtle_count)
+        figures = {}
+        for name in expr.names:
+            if name in ("distance", "turned"):
+                figures[name] = obs[:, :, lay["odometry"].start + int(name == "turned")].astype(np.float64)
+            elif name in ("touch", "touches"):
+                arcs = obs[:, :, lay["touch"]].astype(np.float64)
+                if arcs.shape[2] == 0:
+                    figures[name] = np.zeros(shape)
+                else:
+                    figures[name] = arcs.max(axis=2) if name == "touch" else arcs.sum(axis=2)
+            elif name in ("near", "range_min"):
+                rays = obs[:, :, lay["range"]].astype(np.float64)
+                shortest = rays.min(axis=2) if rays.shape[2] else np.ones(shape)
+                figures[name] = 1.0 - shortest if name == "near" else shortest
+            elif name in ("v", "omega"):
+                figures[name] = self._action_parts(a)[int(name == "omega")]
+            elif name in ("speed", "stroke"):
+                speed = np.asarray(self._vec.turtle_speeds, dtype=np.float64)[None, :]
+                figures[name] = speed if name == "speed" else speed * self.dt * (1.0 if self.actions == "logo" else 0.5)
+            elif name in ("x", "y"):
+                figures[name] = self.positions()[:, :, int(name == "y")].astype(np.float64)
+            elif name == "heading":
+                figures[name] = self.headings().astype(np.float64)
+            else:  # contacts, t, steps: one per copy
+                figures[name] = np.asarray(self._info()[name], dtype=np.float64)[:, None]
+        alive = ~np.isnan(self.positions()[:, :, 0])
+        return expr.evaluate(figures, shape, alive)
+
+    def _action_parts(self, a):
+        """(v, omega) of the actions as the turtles took them: clamped to [-1, 1], NaN as 0."""
+        if self.actions == "logo":
+            v = np.where(a == 1, 1.0, np.where(a == 2, -1.0, 0.0))
+            omega = np.where(a == 4, 1.0, np.where(a == 3, -1.0, 0.0))
+            return v, omega
+        x = np.clip(np.nan_to_num(a[:, :, 0].astype(np.float64), nan=0.0), -1.0, 1.0)
+        y = np.clip(np.nan_to_num(a[:, :, 1].astype(np.float64), nan=0.0), -1.0, 1.0)
+        if self.actions == "wheels":
+            return 0.5 * (x + y), 0.5 * (x - y)
+        return x, y
 
     def _info(self):
         return {"contacts": self._vec.contacts(), "steps": self._vec.steps(), "t": self._vec.times()}

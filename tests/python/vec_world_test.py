@@ -128,6 +128,77 @@ class VecWorldTest(unittest.TestCase):
         with self.assertRaises(ValueError):
             bad.step(ahead)
 
+    def test_reward_expression_from_the_world_file(self):
+        import json
+        import turtlegas
+        with open(swarm(), encoding="utf-8") as f:
+            world = json.load(f)
+        world["learn"] = {"reward": "distance / stroke - 2 * touch + 0 * (x + y + heading + t + steps + contacts)"}
+
+        def by_hand(vec, obs, actions):
+            lay = vec.layout
+            moved = obs[:, :, lay["odometry"]][:, :, 0] / (100.0 * vec.dt * 0.5)
+            return moved - 2.0 * obs[:, :, lay["touch"]].max(axis=2)
+
+        a = turtlegas.VecWorld(world, 4, seed=2)
+        b = turtlegas.VecWorld(world, 4, seed=2, reward=by_hand)
+        a.reset(), b.reset()
+        touched = 0
+        for _ in range(40):
+            actions = a.sample_actions()
+            actions[:, :, 0] = np.abs(actions[:, :, 0])  # ahead: they meet walls and each other
+            oa, ra, *_ = a.step(actions)
+            ob, rb, *_ = b.step(actions)
+            self.assertTrue(np.array_equal(oa, ob))
+            self.assertTrue(np.allclose(ra, rb, rtol=0, atol=1e-6), (ra - rb).max())
+            touched += int((oa[:, :, a.layout["touch"]].max(axis=2) > 0).sum())
+        self.assertGreater(touched, 0)  # the touch term was exercised
+        # A string given to reward= overrides the file's; "v" is the clamped action's linear part.
+        c = turtlegas.VecWorld(world, 2, seed=2, reward="where(v > 0.5, 1, -1) + (omega if omega > 0 else 0)")
+        c.reset()
+        actions = np.zeros((2, 16, 2), dtype=np.float32)
+        actions[0, :, 0], actions[1, :, 0], actions[:, :, 1] = 0.9, 7.0, -0.3  # 7 clamps to 1
+        actions[0, 0, 1] = float("nan")  # NaN reads as 0
+        _, r, *_ = c.step(actions)
+        self.assertTrue(np.all(r == 1.0), r)
+        w = turtlegas.VecWorld(world, 2, seed=2, actions="wheels", reward="omega - v")
+        w.reset()
+        actions[:] = 0
+        actions[:, :, 0], actions[:, :, 1] = 1.0, 0.5  # left 1, right 0.5: v 0.75, omega 0.25
+        self.assertTrue(np.allclose(w.step(actions)[1], -0.5))
+
+    def test_reward_expression_errors(self):
+        import turtlegas
+        cases = {
+            "distance - touhc": "unknown name 'touhc'",
+            "distance +": "not an expression",
+            "__import__('os')": "only the functions",
+            "distance.real": "attribute is not part",
+            "min(distance)": "min takes 2 argument",
+            "'a'": "is not a number",
+            "[distance]": "list is not part",
+            "lambda: 1": "lambda is not part",
+        }
+        for text, says in cases.items():
+            with self.assertRaises(ValueError) as e:
+                turtlegas.VecWorld(swarm(), 1, reward=text)
+            self.assertIn(says, str(e.exception), text)
+            self.assertIn("reward=", str(e.exception))
+        import json
+        with open(swarm(), encoding="utf-8") as f:
+            world = json.load(f)
+        world["learn"] = {"reward": "distance / sqrt(-1 + touch)"}
+        v = turtlegas.VecWorld(world, 2, seed=1)
+        v.reset()
+        with self.assertRaises(FloatingPointError) as e:
+            v.step(v.sample_actions())
+        self.assertIn("/learn/reward", str(e.exception))
+        self.assertIn("copy 0, turtle 0", str(e.exception))
+        with self.assertRaises(turtlegas.WorldError) as e:
+            world["learn"] = {"reward": "touch", "penalty": 1}
+            turtlegas.VecWorld(world, 1)
+        self.assertIn("/learn", str(e.exception))
+
     def test_logo_actions(self):
         import turtlegas
         v = turtlegas.VecWorld(swarm(), 2, actions="logo", random_start=False)

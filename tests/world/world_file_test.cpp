@@ -170,6 +170,17 @@ TEST_CASE("unknown keys are errors with a suggestion") {
   CHECK_ERROR(world(R"(, "a/b~c": 1)"), "/a~1b~0c", "unknown key \"a/b~c\"");
 }
 
+TEST_CASE("learn: a reward expression for VecWorld is checked and does not change the world") {
+  const sim::WorldDef plain = tw::parse_world(world(""), "w.json");
+  const sim::WorldDef with = tw::parse_world(world(R"(, "learn": {"reward": "distance / stroke - touch"})"), "w.json");
+  CHECK(with.balls.size() == plain.balls.size());
+  CHECK(with.dt == plain.dt);
+  CHECK_ERROR(world(R"(, "learn": "touch")"), "/learn", "an object");
+  CHECK_ERROR(world(R"(, "learn": {"reward": ""})"), "/learn/reward", "not an empty string");
+  CHECK_ERROR(world(R"(, "learn": {"reward": 3})"), "/learn/reward", "expected a string");
+  CHECK_ERROR(world(R"(, "learn": {"rewrad": "touch"})"), "/learn/rewrad", "did you mean \"reward\"?");
+}
+
 TEST_CASE("electric and magnetic fields and charges are read") {
   const sim::WorldDef def = tw::parse_world(
       world(R"(, "effects": {"electric": [1, -2], "magnetic": 0.5},

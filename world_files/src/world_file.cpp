@@ -295,7 +295,7 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
                             std::string(key) + "\" to keep it in the file)");
   check_keys(doc, "", "the world",
              {"format", "name", "seed", "dt", "arena", "effects", "walls", "balls", "turtles", "gas", "expect", "game",
-              "draw", "views", "plugins"});
+              "draw", "views", "plugins", "learn"});
 
   Scene scene;
   sim::WorldDef& def = scene.def;
@@ -307,6 +307,14 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
     for (std::size_t k = 0; k < v->size(); ++k)
       if (!(*v)[k].is_string() || (*v)[k].get_ref<const std::string&>().empty())
         fail("/plugins/" + std::to_string(k), "a plugin file's path (a non-empty string), relative to the world file");
+  }
+  if (const json* v = find(doc, "learn")) {
+    // For turtlegas.VecWorld (docs/python.md, "Rewards from the world file"), which parses the
+    // expression and names its errors; a run ignores it.
+    if (!v->is_object()) fail("/learn", "an object, e.g. {\"reward\": \"distance / stroke - touch\"}, got " + json_kind(*v));
+    check_keys(*v, "/learn", "learn", {"reward"});
+    if (const json* r = find(*v, "reward"); r && string(*r, "/learn/reward").empty())
+      fail("/learn/reward", "a reward expression, e.g. \"distance / stroke - touch\", not an empty string");
   }
   if (const json* v = find(doc, "seed")) def.seed = natural(*v, "/seed");
   if (const json* v = find(doc, "dt")) def.dt = positive(*v, "/dt", "dt");

@@ -91,6 +91,8 @@ class VecWorld {
   /// The turtles' ids, in world-file order.
   const std::vector<std::string>& turtle_ids() const;
   double dt() const;  ///< the control step, seconds (the world file's dt)
+  /// Each turtle's top speed, units/s (the world file's "speed"), in turtle_ids() order.
+  std::vector<double> turtle_speeds() const;
 
   /// Rebuilds every copy from the scene: copy i draws its start poses and its action stream from
   /// seed and i alone. Writes the first observations to obs (size() * turtle_count() * obs_size()
