@@ -93,7 +93,7 @@ int run3d(const RunOptions& opt, const world::World3File& w) {
     o.rdf_max = opt.observe_rdf_max;
     if (const std::string bad = formats::check_observe(o, 0.0, opt.until); !bad.empty()) throw BadInput(bad);
     observe_file.emplace(opt.observe, "--observe");
-    observer.emplace(*world, w.def, w.name, o, opt.until);
+    observer.emplace(*world, w.def, w.name, o, opt.until, w.wall_ids);
   }
   if (!opt.events.empty()) events_file.emplace(opt.events, "--events");
   if (!opt.state_out.empty()) state_file.emplace(opt.state_out, "--state-out");

@@ -73,7 +73,7 @@ Observer::Observer(sim::World& world, const sim::WorldDef& def, ObserveOptions o
 }
 
 Observer::Observer(sim::World3& world, const sim::World3Def& def, std::string name, ObserveOptions options,
-                   double until)
+                   double until, std::vector<std::string> wall_ids)
     : world3_(&world),
       dims_(3),
       size_(def.size),
@@ -87,8 +87,22 @@ Observer::Observer(sim::World3& world, const sim::World3Def& def, std::string na
   if (opt_.window <= 0.0) opt_.window = (until - opt_.from) / 10.0;
   last_window_ = static_cast<std::size_t>(std::floor((until - opt_.from) / opt_.window));
   for (const sim::Sphere3Def& s : def.spheres) mass3_.push_back(s.mass), radius3_.push_back(s.radius);
+  for (std::size_t k = 0; k < world.wall_count(); ++k) {
+    wall_length_.push_back(world.wall_area(k));
+    wall_id_.push_back(k < wall_ids.size() ? wall_ids[k] : "wall-" + std::to_string(k));
+  }
   init_species();
+  take_push3(nullptr);
   virial3_ = world.virial_sum();
+}
+
+void Observer::take_push3(Window* into) {
+  push3_.resize(wall_length_.size(), 0.0);
+  for (std::size_t k = 0; k < push3_.size(); ++k) {
+    const double now = world3_->wall_push(k);
+    if (into) into->wall_push[k] += now - push3_[k];
+    push3_[k] = now;
+  }
 }
 
 void Observer::init_species() {
@@ -184,7 +198,7 @@ void Observer::advance_to(double t) {
       if (forward) forward(impulses_);
       impulses_.clear();  // before the observation
       events3_.clear();
-      if (world3_) virial3_ = world3_->virial_sum();
+      if (world3_) virial3_ = world3_->virial_sum(), take_push3(nullptr);
       double v2 = 0.0, n = 0.0;
       for (std::size_t i = 0; i < count(); ++i)
         if (alive(i)) v2 += dot(vel(i), vel(i)), n += 1.0;
@@ -221,6 +235,7 @@ void Observer::take_impulses() {
     events3_.clear();
     current_.virial += world3_->virial_sum() - virial3_;
     virial3_ = world3_->virial_sum();
+    take_push3(&current_);
     return;
   }
   if (forward) forward(impulses_);
@@ -316,7 +331,6 @@ nlohmann::json Observer::result() const {
     nlohmann::json row = {{"t0", w.t0}, {"t1", w.t1}, {"kT", T}, {"mean_speed", v}, {"collision_rate", nu},
                           {"wall_collision_rate", wall_rate.back()}, {"mean_free_path", mfp.back()},
                           {"pressure_walls", p_walls.back()}};
-    if (dims_ == 3) row.erase("pressure_walls");
     if (periodic) {
       // The virial theorem in two dimensions: P A = K + (1/2) <sum r_ij . F_ij>, K the kinetic
       // energy about the centre of mass ((N - 1) kT: a periodic gas's drift exerts no pressure),
@@ -347,7 +361,6 @@ nlohmann::json Observer::result() const {
                             {"mean_free_path", block(mfp)},
                             {"number_density", block(density)},
                             {"pressure_walls", block(p_walls)}};
-  if (dims_ == 3) summary.erase("pressure_walls");  // not reported per wall by the 3-D engine yet
   if (periodic) {
     summary["pressure_virial"] = block(p_virial);
     summary["Z_virial"] = block(z_virial);
@@ -403,7 +416,7 @@ nlohmann::json Observer::result() const {
   }
   nlohmann::json walls = nlohmann::json::array();
   for (std::size_t k = 0; k < wall_length_.size(); ++k)
-    walls.push_back({{"id", wall_id_[k]}, {"length", wall_length_[k]}, {"pressure", block(per_wall[k])}});
+    walls.push_back({{"id", wall_id_[k]}, {dims_ == 3 ? "area" : "length", wall_length_[k]}, {"pressure", block(per_wall[k])}});
   nlohmann::json out = {{"format", "turtlegas-observables/1"},
           {"name", name_},
           {"boundary", std::string(sim::to_string(boundary_))},

@@ -184,7 +184,13 @@ TEST_CASE("run --observe of a 3-D world: the observables in three dimensions") {
   CHECK(o["summary"]["number_density"]["mean"].get<double>() == Approx(601.0 / 216000.0));
   CHECK(o["summary"]["collision_rate"]["mean"].get<double>() > 0.0);
   CHECK(o["speed_histogram"].contains("maxwell"));
-  CHECK(!o["summary"].contains("pressure_walls"));  // not reported per wall in 3-D yet
+  // The walls' pressure, per face of the box, under the world file's ids (before: not reported).
+  CHECK(o["summary"]["pressure_walls"]["mean"].get<double>() > 0.0);
+  REQUIRE(o["walls"].size() == 8);  // the file's triangle and shelf, then the box's six faces
+  CHECK(o["walls"][0]["id"] == "triangle");
+  CHECK(o["walls"][2]["id"] == "arena-x0");
+  CHECK(o["walls"][7]["id"] == "arena-z1");
+  CHECK(o["walls"][2]["area"].get<double>() == Approx(3600.0));
   r = run(dir, {"run", "worlds/gas3d_box.json", "--until", "3", "--observe", out.string(), "--events",
                 (dir.path / "e.jsonl").string()});
   CHECK(r.code == 2);

@@ -59,7 +59,7 @@ json run_one_3d(const Spec& spec, const json& w, json line, const std::string& l
   }
   const double e0 = world->energy();
   if (spec.observe) {
-    formats::Observer observer(*world, f.def, f.name, *spec.observe, spec.until);
+    formats::Observer observer(*world, f.def, f.name, *spec.observe, spec.until, f.wall_ids);
     observer.advance_to(spec.until);
     observer.detach();
     line["observables"] = observables_of(observer.result(), spec.observe_full);

@@ -189,6 +189,7 @@ struct World3::Impl {
   std::uint64_t collisions = 0, events = 0;
   double contact_error = 0.0;
   double virial = 0.0;
+  std::vector<double> wall_push;  // per wall: sum of m Δv . n over its contacts (World3::wall_push)
   std::vector<Event3>* log = nullptr;
   // Restitution (docs/physics.md, "3-D: restitution"): kept beside the records, and only when
   // some e < 1, so that an elastic gas's record and loop are unchanged.
@@ -254,6 +255,7 @@ struct World3::Impl {
       walls.emplace_back(std::vector<Vec3>{{0, 0, 0}, {X, 0, 0}, {X, Y, 0}, {0, Y, 0}});
       walls.emplace_back(std::vector<Vec3>{{0, 0, Z}, {0, Y, Z}, {X, Y, Z}, {X, 0, Z}});
     }
+    wall_push.assign(walls.size(), 0.0);
     const std::size_t cells = static_cast<std::size_t>(n[0]) * n[1] * n[2];
     head.assign(cells, kNone);
     cell_walls.assign(cells, {});
@@ -551,8 +553,10 @@ struct World3::Impl {
           kind = Event3Kind::ball_wall_corner;
           contact_error = std::max(contact_error, std::abs(norm(normal) - b.r) / b.r);
         }
+        const Vec3 v_before = b.v;
         if (inelastic) bounce_inelastic(i, b, normal, b.partner);
         else reflect(b, normal);
+        wall_push[b.partner] += b.m * dot(b.v - v_before, normal) / norm(normal);
         note(kind, i, b.partner, b.partner_count);
         predict(i);
         return;
@@ -643,6 +647,13 @@ std::uint64_t World3::collisions() const { return impl_->collisions; }
 std::uint64_t World3::events() const { return impl_->events; }
 double World3::max_contact_error() const { return impl_->contact_error; }
 double World3::virial_sum() const { return impl_->virial; }
+double World3::wall_push(std::size_t w) const { return impl_->wall_push.at(w); }
+double World3::wall_area(std::size_t w) const {
+  const std::vector<Vec3>& c = impl_->walls.at(w).corners;
+  Vec3 twice;  // Newell's: twice the area along the normal, for any planar polygon
+  for (std::size_t k = 0; k < c.size(); ++k) twice += cross(c[k], c[(k + 1) % c.size()]);
+  return 0.5 * norm(twice);
+}
 
 double World3::max_overlap_now() const {
   const Impl& m = *impl_;

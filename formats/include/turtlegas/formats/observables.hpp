@@ -47,9 +47,11 @@ class Observer {
   /// (World::set_impulse_log); the world must outlive the observer or be detached first.
   Observer(sim::World& world, const sim::WorldDef& def, ObserveOptions options, double until);
   /// For a run of the 3-D gas `world` (built from `def`, named `name`) to `until`: the same
-  /// measurements in three dimensions (docs/observables.md, "3-D"), except the walls' pressure,
-  /// which the 3-D engine does not report per wall yet. The world must outlive the observer.
-  Observer(sim::World3& world, const sim::World3Def& def, std::string name, ObserveOptions options, double until);
+  /// measurements in three dimensions (docs/observables.md, "3-D"), the walls' pressure per unit
+  /// area. wall_ids name the world's walls (World3::wall_count() of them; empty: "wall-k"). The
+  /// world must outlive the observer.
+  Observer(sim::World3& world, const sim::World3Def& def, std::string name, ObserveOptions options, double until,
+           std::vector<std::string> wall_ids = {});
   Observer(const Observer&) = delete;
   Observer& operator=(const Observer&) = delete;
   ~Observer();
@@ -108,6 +110,8 @@ class Observer {
   void step_to(double t);
   double volume() const { return dims_ == 3 ? size_.x * size_.y * size_.z : size_.x * size_.y; }
   void init_species();
+  /// Adds the 3-D walls' push since the last take to `into` (if given) and remembers it.
+  void take_push3(Window* into);
   void sample();
   Window fresh(double t0) const;
 
@@ -116,6 +120,7 @@ class Observer {
   int dims_ = 2;
   sim::Vec3 size_;                   ///< width, height and (3-D) depth
   double virial3_ = 0.0;             ///< the 3-D world's virial_sum at the last take
+  std::vector<double> push3_;        ///< the 3-D world's wall_push per wall at the last take
   std::vector<sim::Event3> events3_;  ///< the 3-D world's events since the last take
   std::vector<double> mass3_, radius3_;  ///< per 3-D sphere, from its def
   ObserveOptions opt_;
@@ -124,7 +129,7 @@ class Observer {
   double width_ = 0.0, height_ = 0.0;
   double speed_max_ = 0.0;
   bool started_ = false;
-  std::vector<double> wall_length_;
+  std::vector<double> wall_length_;  ///< per wall: its length (2-D) or area (3-D)
   std::vector<std::string> wall_id_;
   std::map<double, std::size_t> masses_;  ///< the balls' masses and how many have each
   std::vector<Species> species_;

@@ -105,6 +105,11 @@ class World3 {
   /// Sum over served sphere-sphere collisions of m1 m2 / (m1 + m2) * (Δv . d): the collision
   /// virial's numerator, for the pressure of a periodic gas (docs/physics.md).
   double virial_sum() const;
+  /// The momentum the spheres have pushed into wall w (wall_count() order) since the start:
+  /// the sum over its contacts of m Δv . n, n the contact normal towards the sphere. Its rate
+  /// over wall_area(w) is the pressure on the wall (docs/observables.md).
+  double wall_push(std::size_t w) const;
+  double wall_area(std::size_t w) const;  ///< the polygon's area
 
  private:
   struct Impl;
