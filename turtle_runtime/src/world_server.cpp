@@ -124,9 +124,14 @@ void WorldServer::Impl::finish_command(Agent& a) {
     return;
   }
   const sim::TurtleState s = world.turtle(a.index);
-  if (a.waiting_on == sim::TurtleCommand::Kind::move) a.odometer += s.done;
-  if (a.pen_down) a.trail.push_back(s.pos);
-  if (a.lays_wall && s.pos != a.stroke_start) lay_wall(a, a.stroke_start, s.pos);
+  const bool arc = a.waiting_on == sim::TurtleCommand::Kind::arc;
+  if (a.waiting_on == sim::TurtleCommand::Kind::move || arc) a.odometer += s.done;  // an arc's: along it
+  if (arc && (a.pen_down || a.lays_wall) && s.pos != a.stroke_start) [[unlikely]] {
+    pen_arc(a, s);
+  } else {
+    if (a.pen_down) a.trail.push_back(s.pos);
+    if (a.lays_wall && s.pos != a.stroke_start) lay_wall(a, a.stroke_start, s.pos);
+  }
   const double done = a.waiting_on == sim::TurtleCommand::Kind::turn ? sim::to_degrees(s.done) : s.done;
   // A touch that cut the command short is the first of those delivered on resuming.
   a.answer = s.touched && !a.inbox.empty() ? Result(done, a.inbox.front()) : Result(done, std::nullopt);
@@ -233,7 +238,11 @@ bool WorldServer::Impl::resume(Agent& a) {
     case detail::Fiber::Outcome::suspended:
       if (a.command) {
         world.command_turtle(a.index, *a.command);
-        if (a.command->kind == sim::TurtleCommand::Kind::move && a.command->amount != 0.0) a.in_contact.clear();
+        // A turtle that drives away leaves its contacts (one turning on the spot keeps them).
+        const sim::TurtleCommand& c = *a.command;
+        if ((c.kind == sim::TurtleCommand::Kind::move && c.amount != 0.0) ||
+            (c.kind == sim::TurtleCommand::Kind::arc && c.amount > 0.0 && c.speed != 0.0))
+          a.in_contact.clear();
         a.command.reset();
         return false;
       }
