@@ -12,6 +12,7 @@
 
 #include "fixtures.hpp"
 #include "turtlegas/turtle/registry.hpp"
+#include "turtlegas/turtle/remote.hpp"
 #include "turtlegas/turtle/turtle.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
@@ -412,4 +413,49 @@ TEST_CASE("the script controller drives arcs, drive and wheels", "[runtime][arc]
     b.run_until(1);
     CHECK(b.turtle(0).fault == std::string("its program threw: ") + fault);
   }
+}
+
+TEST_CASE("a remote turtle's arc, drive and wheels run as the C++ program's", "[runtime][arc][remote]") {
+  using K = RemoteCommand::Kind;
+  std::vector<RemoteCommand> commands(3);
+  commands[0].kind = K::arc;
+  commands[0].steer = {70, -120, 0};
+  commands[1].kind = K::drive;
+  commands[1].steer = {-25, 60, 1.5};
+  commands[2].kind = K::wheels;
+  commands[2].steer = {12, 30, 2};
+  struct Source : InputSource {
+    std::vector<RemoteCommand> commands;
+    std::size_t next_one = 0;
+    std::optional<RemoteCommand> next(std::uint64_t, std::size_t) override {
+      if (next_one == commands.size()) return std::nullopt;
+      return commands[next_one++];
+    }
+  };
+  auto source = std::make_shared<Source>();
+  source->commands = commands;
+  std::vector<double> done;
+  ServerOptions o;
+  o.input = source;
+  o.remote_reports = [&](const RemoteReport& r) {
+    if (r.kind == RemoteReport::Kind::result) done.push_back(r.result.done());
+  };
+  sim::WorldDef d = wide();
+  d.turtles.push_back(body("t", {200, 200}, 0));
+  TurtleProgram remote;
+  remote.controller = "remote";
+  WorldServer s(d, {remote}, base_registry(), o);
+  s.run_until(20);
+  static std::vector<double> cpp_done;
+  cpp_done.clear();
+  OneTurtle c([](Turtle& t) {
+    cpp_done.push_back(t.arc(70, -120).done());
+    cpp_done.push_back(t.drive(-25, 60, 1.5).done());
+    cpp_done.push_back(t.wheels(12, 30, 2).done());
+  });
+  c->run_until(20);
+  CHECK(done == cpp_done);
+  CHECK(done.size() == 3);
+  CHECK(s.turtle(0).state.pos == c->turtle(0).state.pos);
+  CHECK(s.turtle(0).state.heading == c->turtle(0).state.heading);
 }
