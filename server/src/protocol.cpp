@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "turtlegas/server/protocol.hpp"
 
-#include <algorithm>
 #include <array>
+#include <utility>
 #include <cmath>
 
 #include "turtlegas/formats/json_text.hpp"
@@ -223,8 +223,8 @@ std::string report_text(const turtle::RemoteReport& r, std::string_view turtle_i
       if (const auto keys = turtle::steer_keys(r.command.kind); !keys.empty()) {
         // arc, drive, wheels: the command's numbers, by name (sorted, as dump() writes them).
         std::array<std::size_t, 3> order{0, 1, 2};
-        std::sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(keys.size()),
-                  [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
+        for (std::size_t i = 1; i < keys.size(); ++i)  // (an insertion sort of at most three)
+          for (std::size_t j = i; j > 0 && keys[order[j]] < keys[order[j - 1]]; --j) std::swap(order[j], order[j - 1]);
         append_key(out, "args");
         out += '{';
         for (std::size_t k = 0; k < keys.size(); ++k) {

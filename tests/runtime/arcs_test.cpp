@@ -459,3 +459,23 @@ TEST_CASE("a remote turtle's arc, drive and wheels run as the C++ program's", "[
   CHECK(s.turtle(0).state.pos == c->turtle(0).state.pos);
   CHECK(s.turtle(0).state.heading == c->turtle(0).state.heading);
 }
+
+TEST_CASE("an arc where a wall turns is a fault of that turtle, and the world runs on", "[runtime][arc][isolation]") {
+  sim::WorldDef d = wide();
+  sim::WallDef arm{"arm", {600, 300}, {700, 300}};
+  arm.keys.push_back({10.0, {600, 300}, {600, 380}});  // turns about its first end
+  d.walls.push_back(arm);
+  d.turtles.push_back(body("t", {200, 200}, 0));
+  d.turtles.push_back(body("u", {100, 100}, 90));
+  TurtleProgram arcs, straight;
+  arcs.params = nlohmann::json::parse(R"({"commands": [["forward", 10], ["arc", 50, 90], ["forward", 10]]})");
+  straight.params = nlohmann::json::parse(R"({"commands": [["forward", 100]]})");
+  WorldServer s(d, {arcs, straight}, base_registry());
+  s.run_until(5);
+  CHECK(s.turtle(0).finished);
+  CHECK(s.turtle(0).fault.find("its arc was refused: ") == 0);
+  CHECK(s.turtle(0).fault.find("arcs are not simulated while a wall turns or stretches") != std::string::npos);
+  CHECK(s.turtle(0).state.pos == sim::Vec2{200, 210});  // it stopped where the refused arc began
+  CHECK(s.turtle(1).fault.empty());
+  CHECK(std::abs(s.turtle(1).state.pos.x - 200) <= 1e-9);
+}

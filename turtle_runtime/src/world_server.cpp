@@ -237,7 +237,20 @@ bool WorldServer::Impl::resume(Agent& a) {
   switch (outcome) {
     case detail::Fiber::Outcome::suspended:
       if (a.command) {
-        world.command_turtle(a.index, *a.command);
+        if (a.command->kind == sim::TurtleCommand::Kind::arc) [[unlikely]] {
+          // The engine refuses an arc where a wall turns or stretches (no exact solver): a fault
+          // of this turtle's program, as if its call had thrown, not the end of the run.
+          try {
+            world.command_turtle(a.index, *a.command);
+          } catch (const std::invalid_argument& e) {
+            a.command.reset();
+            a.waiting = false;
+            park(std::string("its arc was refused: ") + e.what());
+            return false;
+          }
+        } else {
+          world.command_turtle(a.index, *a.command);
+        }
         // A turtle that drives away leaves its contacts (one turning on the spot keeps them).
         const sim::TurtleCommand& c = *a.command;
         if ((c.kind == sim::TurtleCommand::Kind::move && c.amount != 0.0) ||
