@@ -204,6 +204,7 @@ void bind_programs(py::module_& m) {
       .def_property_readonly("radius", [](const TurtleHandle& h) { return h.get().radius(); })
       .def_property_readonly("speed", [](const TurtleHandle& h) { return h.get().speed(); })
       .def_property_readonly("turn_rate", [](const TurtleHandle& h) { return h.get().turn_rate(); })
+      .def_property_readonly("axle", [](const TurtleHandle& h) { return h.get().axle(); })
       .def_property_readonly("dt", [](const TurtleHandle& h) { return h.get().dt(); })
       .def_property_readonly("pen_is_down", [](const TurtleHandle& h) { return h.get().pen_is_down(); })
       .def_property_readonly("pen_mode", [](const TurtleHandle& h) {

@@ -188,6 +188,7 @@ class Turtle:
     radius = property(lambda self: self._handle.radius)
     speed = property(lambda self: self._handle.speed, doc="units per second")
     turn_rate = property(lambda self: self._handle.turn_rate, doc="degrees per second")
+    axle = property(lambda self: self._handle.axle, doc='units between the wheels of wheels() ("axle"; twice the radius)')
     dt = property(lambda self: self._handle.dt, doc="the world's control step, seconds")
     pen_is_down = property(lambda self: self._handle.pen_is_down)
     pen_mode = property(lambda self: self._handle.pen_mode)

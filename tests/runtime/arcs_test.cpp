@@ -251,6 +251,17 @@ TEST_CASE("drive: v and omega, scaled down together past the turtle's speed or t
   const sim::Vec2 x = arc_pos({200, 200}, 0, 50, M_PI / 4, 2.0);
   CHECK(std::abs(g->turtle(0).state.pos.x - x.x) <= 1e-9);
   CHECK(std::abs(g->turtle(0).state.pos.y - x.y) <= 1e-9);
+  // No speed and no turn: it stands still for its time, driving nothing.
+  static double t_end;
+  static Result still;
+  OneTurtle z([](Turtle& t) {
+    still = t.drive(0, 0, 2);
+    t_end = t.time();
+  });
+  z->run_until(5);
+  CHECK(t_end == Approx(2.0));
+  CHECK(still.done() == 0.0);
+  CHECK(z->turtle(0).state.pos == sim::Vec2{200, 200});
   // 10 units/s and 360 degrees/s on a turn rate of 180: both halve. Backwards and to the left.
   OneTurtle h([](Turtle& t) { t.drive(-10, -360, 1); });
   h->run_until(2);
