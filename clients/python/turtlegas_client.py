@@ -655,6 +655,20 @@ class RemoteTurtle:
     def wait(self, seconds):
         return self._command({"type": "wait", "amount": seconds})
 
+    def arc(self, radius, degrees):
+        """Drives along a circle of `radius` units through `degrees` of turn (positive right,
+        clockwise; negative left). The result's done is the distance along the arc."""
+        return self._command({"type": "arc", "radius": radius, "degrees": degrees})
+
+    def drive(self, v, omega, seconds):
+        """Drives for `seconds` at `v` units/s while turning at `omega` degrees/s (positive right)."""
+        return self._command({"type": "drive", "v": v, "omega": omega, "seconds": seconds})
+
+    def wheels(self, left, right, seconds):
+        """Differential drive: the wheels at `left` and `right` units/s for `seconds`, the
+        world file's "axle" apart."""
+        return self._command({"type": "wheels", "left": left, "right": right, "seconds": seconds})
+
     def yield_(self):
         return self._command({"type": "yield"})
 

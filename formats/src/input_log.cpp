@@ -73,6 +73,13 @@ std::string input_command_line(std::uint64_t step, std::string_view turtle, cons
     members += ", \"amount\": ";
     append_number(members, c.amount);
   }
+  const auto keys = turtle::steer_keys(c.kind);  // arc, drive, wheels
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    members += ", \"";
+    members += keys[k];
+    members += "\": ";
+    append_number(members, c.steer[k]);
+  }
   if (c.kind == turtle::RemoteCommand::Kind::pen_down)
     members += c.pen == turtle::PenMode::wall ? ", \"mode\": \"wall\"" : ", \"mode\": \"line\"";
   if (c.kind == turtle::RemoteCommand::Kind::sense) {
@@ -201,12 +208,17 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
       if (j.contains("turtle")) {
         const std::size_t i = index_of(j.at("turtle").get<std::string>(), line, "turtle");
         const auto kind = turtle::remote_command_kind(j.at("command").get<std::string>());
-        if (!kind) fail("/command: not a command (forward, back, left, right, wait, yield, pen_up, pen_down, sense)");
+        if (!kind) fail("/command: not a command (forward, back, left, right, wait, yield, pen_up, pen_down, sense, arc, drive, wheels)");
         turtle::RemoteCommand c;
         c.kind = *kind;
         if (turtle::takes_amount(c.kind)) {
           c.amount = j.at("amount").get<double>();
           if (!std::isfinite(c.amount) || c.amount < 0.0) fail("/amount: must be finite and >= 0");
+        }
+        const auto keys = turtle::steer_keys(c.kind);
+        for (std::size_t k = 0; k < keys.size(); ++k) {
+          c.steer[k] = j.at(std::string(keys[k])).get<double>();
+          if (!std::isfinite(c.steer[k])) fail("/" + std::string(keys[k]) + ": must be finite");
         }
         if (c.kind == turtle::RemoteCommand::Kind::pen_down)
           c.pen = j.value("mode", std::string("line")) == "wall" ? turtle::PenMode::wall : turtle::PenMode::line;

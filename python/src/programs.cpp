@@ -4,6 +4,7 @@
 #include <exception>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 #include <pybind11/stl.h>
 
@@ -67,6 +68,7 @@ struct Command {
   turtle::PenMode pen = turtle::PenMode::line;
   std::string sensor;
   bool first = false;
+  std::vector<double> steer;  // arc, drive, wheels
 };
 
 /// The program's exception, kept for World.run (the first one), and the fault the runtime logs.
@@ -142,6 +144,7 @@ void run(Programs& programs, turtle::Turtle& t, const turtle::Params& p) {
         c.pen = yielded.attr("pen").cast<std::string>() == "wall" ? turtle::PenMode::wall : turtle::PenMode::line;
         c.sensor = yielded.attr("sensor").cast<std::string>();
         c.first = yielded.attr("first").cast<bool>();
+        c.steer = yielded.attr("steer").cast<std::vector<double>>();
       } catch (py::error_already_set& e) {
         program_failed(programs, e);
       } catch (const py::builtin_exception& e) {
@@ -158,6 +161,9 @@ void run(Programs& programs, turtle::Turtle& t, const turtle::Params& p) {
     else if (c.kind == "left") result = t.left(c.amount);
     else if (c.kind == "right") result = t.right(c.amount);
     else if (c.kind == "wait") result = t.wait(c.amount);
+    else if (c.kind == "arc" && c.steer.size() == 2) result = t.arc(c.steer[0], c.steer[1]);
+    else if (c.kind == "drive" && c.steer.size() == 3) result = t.drive(c.steer[0], c.steer[1], c.steer[2]);
+    else if (c.kind == "wheels" && c.steer.size() == 3) result = t.wheels(c.steer[0], c.steer[1], c.steer[2]);
     else if (c.kind == "yield") t.yield();
     else if (c.kind == "pen_up") t.pen_up();
     else if (c.kind == "pen_down") t.pen_down(c.pen);
@@ -198,6 +204,7 @@ void bind_programs(py::module_& m) {
       .def_property_readonly("radius", [](const TurtleHandle& h) { return h.get().radius(); })
       .def_property_readonly("speed", [](const TurtleHandle& h) { return h.get().speed(); })
       .def_property_readonly("turn_rate", [](const TurtleHandle& h) { return h.get().turn_rate(); })
+      .def_property_readonly("axle", [](const TurtleHandle& h) { return h.get().axle(); })
       .def_property_readonly("dt", [](const TurtleHandle& h) { return h.get().dt(); })
       .def_property_readonly("pen_is_down", [](const TurtleHandle& h) { return h.get().pen_is_down(); })
       .def_property_readonly("pen_mode", [](const TurtleHandle& h) {

@@ -75,18 +75,21 @@ class Result(collections.namedtuple("Result", "done touch")):
 class Command:
     """A command, made by a Turtle method, for the program to yield."""
 
-    __slots__ = ("kind", "amount", "pen", "sensor", "first")
+    __slots__ = ("kind", "amount", "pen", "sensor", "first", "steer")
 
-    def __init__(self, kind, amount=0.0, pen="line", sensor="", first=False):
+    def __init__(self, kind, amount=0.0, pen="line", sensor="", first=False, steer=()):
         self.kind = kind
         self.amount = float(amount)
         self.pen = pen
         self.sensor = sensor
         self.first = first  # range(): the first ray alone
+        self.steer = tuple(float(x) for x in steer)  # arc, drive, wheels: their numbers
 
     def __repr__(self):
         if self.kind == "sense":
             return "Command(sense %r)" % self.sensor
+        if self.steer:
+            return "Command(%s %s)" % (self.kind, ", ".join(repr(x) for x in self.steer))
         return "Command(%s %r)" % (self.kind, self.amount)
 
 
@@ -101,7 +104,8 @@ class Turtle:
         self._on_touch = None
         self._on_message = None
 
-    # Commands: yield them. The yield's value is a Result for forward, back, left, right and wait;
+    # Commands: yield them. The yield's value is a Result for forward, back, left, right, wait, arc,
+    # drive and wheels;
     # a list of Readings for scan; one Reading for range; None for yield_, pen_up and pen_down.
     def forward(self, distance):
         return Command("forward", distance)
@@ -117,6 +121,19 @@ class Turtle:
 
     def wait(self, seconds):
         return Command("wait", seconds)
+
+    def arc(self, radius, degrees):
+        """Drives along a circle of `radius` units through `degrees` of turn (positive right,
+        clockwise; negative left), as Turtle::arc. The Result's done is the distance along it."""
+        return Command("arc", steer=(radius, degrees))
+
+    def drive(self, v, omega, seconds):
+        """Drives for `seconds` at `v` units/s turning at `omega` degrees/s (positive clockwise)."""
+        return Command("drive", steer=(v, omega, seconds))
+
+    def wheels(self, left, right, seconds):
+        """Differential drive: wheel speeds in units/s, the world file's "axle" apart."""
+        return Command("wheels", steer=(left, right, seconds))
 
     def yield_(self):
         """Gives up the rest of this control step without a command."""
@@ -171,6 +188,7 @@ class Turtle:
     radius = property(lambda self: self._handle.radius)
     speed = property(lambda self: self._handle.speed, doc="units per second")
     turn_rate = property(lambda self: self._handle.turn_rate, doc="degrees per second")
+    axle = property(lambda self: self._handle.axle, doc='units between the wheels of wheels() ("axle"; twice the radius)')
     dt = property(lambda self: self._handle.dt, doc="the world's control step, seconds")
     pen_is_down = property(lambda self: self._handle.pen_is_down)
     pen_mode = property(lambda self: self._handle.pen_mode)

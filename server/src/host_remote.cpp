@@ -110,7 +110,10 @@ void WorldHost::on_release(ClientState& c, const json& m, const std::string& /*t
 void WorldHost::on_command(ClientState& c, const json& m, const std::string& type) {
   const json id = message_id(m);
   require_live();
-  const std::string ex = "{\"type\": \"" + type + "\", \"turtle\": \"t1\"" + (type == "pen" ? ", \"down\": true}" : type == "yield" ? "}" : type == "sense" ? ", \"sensor\": \"ir\"}" : ", \"amount\": 100}");
+  const std::string ex = "{\"type\": \"" + type + "\", \"turtle\": \"t1\"" +
+                         (type == "pen" ? ", \"down\": true}" : type == "yield" ? "}" : type == "sense" ? ", \"sensor\": \"ir\"}"
+                          : type == "arc" ? ", \"radius\": 50, \"degrees\": 90}" : type == "drive" ? ", \"v\": 20, \"omega\": 45, \"seconds\": 2}"
+                          : type == "wheels" ? ", \"left\": 20, \"right\": 10, \"seconds\": 2}" : ", \"amount\": 100}");
   const std::size_t i = turtle_index(m, ex.c_str());
   const turtle::RemoteCommand cmd = read_command(m, type);  // the message first, then the turtle's state
   Slot& s = slots_[i];

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "turtlegas/server/protocol.hpp"
 
+#include <array>
+#include <utility>
 #include <cmath>
 
 #include "turtlegas/formats/json_text.hpp"
@@ -120,6 +122,19 @@ turtle::RemoteCommand read_command(const json& m, std::string_view type) {
     return c;
   }
   c.kind = *turtle::remote_command_kind(type);
+  if (const auto keys = turtle::steer_keys(c.kind); !keys.empty()) {
+    // arc, drive, wheels: named numbers, as Turtle::arc, drive and wheels take them.
+    const std::string ex = c.kind == K::arc     ? R"({"type": "arc", "turtle": "t1", "radius": 50, "degrees": 90})"
+                           : c.kind == K::drive ? R"({"type": "drive", "turtle": "t1", "v": 20, "omega": 45, "seconds": 2})"
+                                                : R"({"type": "wheels", "turtle": "t1", "left": 20, "right": 10, "seconds": 2})";
+    for (std::size_t k = 0; k < keys.size(); ++k) c.steer[k] = number_field(m, std::string(keys[k]).c_str(), ex);
+    if (c.kind == K::arc && c.steer[0] < 0.0)
+      throw RequestError("bad_value", "/radius must be >= 0 (got " + json(c.steer[0]).dump() +
+                                          "); negative degrees turn left, and drive with v < 0 goes backwards", "/radius");
+    if (c.kind != K::arc && c.steer[2] < 0.0)
+      throw RequestError("bad_value", "/seconds must be >= 0 (got " + json(c.steer[2]).dump() + ")", "/seconds");
+    return c;
+  }
   if (turtle::takes_amount(c.kind)) {
     const std::string ex = "{\"type\": \"" + std::string(type) + "\", \"turtle\": \"t1\", \"amount\": " +
                            (c.kind == K::wait ? "0.5" : c.kind == K::left || c.kind == K::right ? "90" : "100") + "}";
@@ -204,6 +219,20 @@ std::string report_text(const turtle::RemoteReport& r, std::string_view turtle_i
         append_key(out, "amount");
         append_double(out, r.command.amount);
         out += ',';
+      }
+      if (const auto keys = turtle::steer_keys(r.command.kind); !keys.empty()) {
+        // arc, drive, wheels: the command's numbers, by name (sorted, as dump() writes them).
+        std::array<std::size_t, 3> order{0, 1, 2};
+        for (std::size_t i = 1; i < keys.size(); ++i)  // (an insertion sort of at most three)
+          for (std::size_t j = i; j > 0 && keys[order[j]] < keys[order[j - 1]]; --j) std::swap(order[j], order[j - 1]);
+        append_key(out, "args");
+        out += '{';
+        for (std::size_t k = 0; k < keys.size(); ++k) {
+          if (k > 0) out += ',';
+          append_key(out, keys[order[k]]);
+          append_double(out, r.command.steer[order[k]]);
+        }
+        out += "},";
       }
       append_key(out, "command");
       formats::append_json_string(out, turtle::to_string(r.command.kind));

@@ -25,6 +25,21 @@ TEST_CASE("input log: the header and every kind of line, byte for byte") {
   pen.kind = turtle::RemoteCommand::Kind::pen_down;
   pen.pen = turtle::PenMode::wall;
   CHECK(formats::input_command_line(0, "t2", pen) == "{\"step\": 0, \"turtle\": \"t2\", \"command\": \"pen_down\", \"mode\": \"wall\"}\n");
+  turtle::RemoteCommand arc;
+  arc.kind = turtle::RemoteCommand::Kind::arc;
+  arc.steer = {50, -90, 0};
+  CHECK(formats::input_command_line(4, "t1", arc) ==
+        "{\"step\": 4, \"turtle\": \"t1\", \"command\": \"arc\", \"radius\": 50, \"degrees\": -90}\n");
+  turtle::RemoteCommand wheels;
+  wheels.kind = turtle::RemoteCommand::Kind::wheels;
+  wheels.steer = {20, -10.5, 2};
+  CHECK(formats::input_command_line(5, "t1", wheels) ==
+        "{\"step\": 5, \"turtle\": \"t1\", \"command\": \"wheels\", \"left\": 20, \"right\": -10.5, \"seconds\": 2}\n");
+  turtle::RemoteCommand drive;
+  drive.kind = turtle::RemoteCommand::Kind::drive;
+  drive.steer = {-20, 45, 0.5};
+  CHECK(formats::input_command_line(6, "t1", drive) ==
+        "{\"step\": 6, \"turtle\": \"t1\", \"command\": \"drive\", \"v\": -20, \"omega\": 45, \"seconds\": 0.5}\n");
   turtle::RemoteCommand yield;
   CHECK(formats::input_command_line(3, "t3", yield) == "{\"step\": 3, \"turtle\": \"t3\", \"command\": \"yield\"}\n");
 

@@ -8,6 +8,7 @@ byte-identical to `turtlegas run --events` with the C++ controllers; and the pro
 Run by ctest with the build tree's package on PYTHONPATH and TURTLEGAS set to the program."""
 
 import json
+import math
 import os
 import subprocess
 import tempfile
@@ -153,6 +154,31 @@ class ProtocolTest(unittest.TestCase):
         kinds = [e.kind for e in w.event_tuples()]
         self.assertEqual(kinds.count("touch"), 1)
         self.assertEqual(kinds.count("sense"), 2)
+
+    def test_arcs_drive_and_wheels(self):
+        seen = {}
+
+        def program(t, p):
+            seen["axle"] = t.axle
+            seen["arc"] = yield t.arc(50, -90)  # from (100, 100) heading 90: a left quarter about (100, 150)
+            seen["heading"] = t.heading
+            seen["wheels"] = yield t.wheels(40, 20, 1)  # 30 units/s turning 1 rad/s clockwise
+            seen["drive"] = yield t.drive(50, 0, 10)  # straight on into the north wall
+            seen["odometer"] = t.odometer
+
+        w = turtlegas.World.load(self.ROOM, programs={"t": program})
+        w.run(30)
+        self.assertEqual(seen["axle"], 20.0)  # twice the default radius
+        self.assertAlmostEqual(seen["arc"].done, 25 * math.pi, delta=1e-9)
+        self.assertAlmostEqual(seen["heading"], 0.0, delta=1e-9)
+        self.assertAlmostEqual(seen["wheels"].done, 30, delta=1e-9)
+        self.assertTrue(seen["drive"].touched)
+        self.assertEqual(seen["drive"].touch.what, "arena-top")
+        self.assertAlmostEqual(seen["odometer"], 25 * math.pi + 30 + seen["drive"].done, delta=1e-9)
+        # After the wheels: heading 1 rad, 30 units from the circle's centre (180, 150) along (-cos 1, sin 1).
+        x = 180 - 30 * math.cos(1) + (190 - (150 + 30 * math.sin(1))) * math.tan(1)
+        self.assertAlmostEqual(w.turtle_positions[0][0], x, delta=1e-9)
+        self.assertAlmostEqual(w.turtle_positions[0][1], 190, delta=1e-9)
 
     def test_a_program_that_raises_stops_its_turtle_not_the_world(self):
         def program(t, p):

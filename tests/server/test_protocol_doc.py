@@ -20,7 +20,8 @@ from turtlegas_client import World, decode_binary_frame
 DOC = os.path.join(ROOT, "docs", "protocol.md")
 REQUESTS = {"hello", "subscribe", "unsubscribe", "snapshot", "pause", "resume", "step", "speed", "run_until",
             "claim", "release", "forward", "back", "left", "right", "wait", "yield", "pen", "add_wall", "save",
-            "load", "view_open", "view_change", "view_close", "ping", "stats", "spawn", "remove", "teleport", "sense"}
+            "load", "view_open", "view_change", "view_close", "ping", "stats", "spawn", "remove", "teleport", "sense",
+            "arc", "drive", "wheels"}
 REPLAY_REQUESTS = {"play", "seek", "reverse"}  # `turtlegas replay` only (test_replay_examples)
 
 
@@ -128,14 +129,19 @@ def session(w, save_dir):
     check(w.request({"type": "speed", "factor": "max"})["status"]["speed"] == "max", "speed max")
     w.resume()
     reply_shape("claimed", ask(w, doc["claim"][0]))
-    for kind in ("forward", "back", "left", "right", "wait", "yield", "pen"):
+    steer = ("arc", "drive", "wheels")
+    for kind in ("forward", "back", "left", "right", "wait", "yield", "pen") + steer:
         r = ask(w, doc[kind][0])
-        # `touch` only when touched; `amount` only for the commands that take one (docs: yield, pen have none).
+        # `touch` only when touched; `amount` only for the commands that take one (docs: yield, pen
+        # and the steering commands have none; these echo their numbers as `args`).
         skip = {"touch"} if not r.get("touched") else set()
-        if kind in ("yield", "pen"):
+        if kind in ("yield", "pen") + steer:
             skip.add("amount")
         same_shape({k: v for k, v in REPLIES_DOC["result"][0].items() if k not in skip}, r, kind)
-        check(("amount" in r) == (kind not in ("yield", "pen")), "amount echoed for %s only if it has one" % kind)
+        check(("amount" in r) == (kind not in ("yield", "pen") + steer), "amount echoed for %s only if it has one" % kind)
+        if kind in steer:
+            sent = {k: float(v) for k, v in doc[kind][0].items() if k not in ("type", "id", "turtle")}
+            check(r.get("args") == sent, "%s echoes its numbers as args: %r" % (kind, r))
         check(r["command"] == (kind if kind != "pen" else "pen_down"), "the result names the command: %r" % r)
     # In lockstep a boundary (where add_wall happens) needs t1's next command: let it go first.
     reply_shape("ok", ask(w, doc["release"][0]))

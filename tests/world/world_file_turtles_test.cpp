@@ -112,7 +112,7 @@ TEST_CASE("a script turtle's commands are checked at load time") {
   CHECK(s.programs[0].params.at("commands").size() == 7);
   const std::string c = "/turtles/0/params/commands";
   CHECK_ERROR(one(R"(, "params": {"commands": [["forward", 10], ["fowrard", 10]]})"), c + "/1/0",
-              "unknown command 'fowrard'; known: forward, back, left, right, wait, pendown, penup, sense");
+              "unknown command 'fowrard'; known: forward, back, left, right, wait, pendown, penup, sense, arc, drive, wheels");
   CHECK_ERROR(one(R"(, "params": {"commands": [["forward"]]})"), c + "/0", "'forward' needs one number");
   CHECK_ERROR(one(R"(, "params": {"commands": [["forward", 1, 2]]})"), c + "/0", "'forward' needs one number");
   CHECK_ERROR(one(R"(, "params": {"commands": [["right", "ninety"]]})"), c + "/0/1", "expected a number, got a string");
@@ -127,6 +127,24 @@ TEST_CASE("a script turtle's commands are checked at load time") {
   CHECK_ERROR(one(R"(, "params": {"commands": {"forward": 10}})"), c, "commands must be a list of [command, amount]");
   CHECK_ERROR(one(R"(, "params": {"comands": []})"), "/turtles/0/params/comands",
               "unknown key \"comands\" in the script controller's params; did you mean \"commands\"?");
+}
+
+TEST_CASE("a script's arcs and a turtle's axle are checked at load time", "[arc]") {
+  const tw::Scene s = parse(one(R"(, "axle": 25, "params": {"commands": [["arc", 50, -90], ["drive", -20, 45, 2],
+                                  ["wheels", 10, 30, 1.5]]})"));
+  CHECK(s.programs[0].params.at("commands").size() == 3);
+  CHECK(s.programs[0].axle == 25.0);
+  CHECK(parse(one("")).programs[0].axle == 0.0);  // the runtime's default: twice the radius
+  const std::string c = "/turtles/0/params/commands";
+  CHECK_ERROR(one(R"(, "params": {"commands": [["arc", 50]]})"), c + "/0",
+              "'arc' needs 2 numbers (units (radius) and degrees), e.g. [\"arc\", 50, 90]");
+  CHECK_ERROR(one(R"(, "params": {"commands": [["drive", 1, 2]]})"), c + "/0", "'drive' needs 3 numbers");
+  CHECK_ERROR(one(R"(, "params": {"commands": [["wheels", 1, "2", 3]]})"), c + "/0/2", "expected a number, got a string");
+  CHECK_ERROR(one(R"(, "params": {"commands": [["arc", -5, 90]]})"), c + "/0/1", "an arc's radius must be >= 0");
+  CHECK_ERROR(one(R"(, "params": {"commands": [["wheels", 1, 2, -3]]})"), c + "/0/3", "'wheels' needs a time >= 0");
+  CHECK_ERROR(one(R"(, "axle": 0)"), "/turtles/0/axle",
+              "axle (units between the wheels) must be > 0 (got 0); leave it out for twice the turtle's radius");
+  CHECK_ERROR(one(R"(, "axle": "wide")"), "/turtles/0/axle", "expected a number");
 }
 
 TEST_CASE("an unregistered controller names the registered ones") {

@@ -4,7 +4,10 @@
 #include "agent.hpp"
 
 #include <atomic>
+#include <algorithm>
 #include <cmath>
+#include <initializer_list>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -46,9 +49,16 @@ Result Agent::issue(sim::TurtleCommand c) {
   command = c;
   waiting_on = c.kind;
   waiting = true;
-  // The wall pen lays the stroke this command drives, in the pen mode it was issued in.
-  lays_wall = pen_down && pen_mode == PenMode::wall && c.kind == sim::TurtleCommand::Kind::move;
-  if (lays_wall) stroke_start = server->world.turtle(index).pos;
+  // The wall pen lays the stroke this command drives, in the pen mode it was issued in; on an
+  // arc, a lowered pen follows its chords, from where and how it started (pen_chords.hpp).
+  const bool arc = c.kind == sim::TurtleCommand::Kind::arc;
+  lays_wall = pen_down && pen_mode == PenMode::wall && (c.kind == sim::TurtleCommand::Kind::move || arc);
+  if (lays_wall || (pen_down && arc)) [[unlikely]] {
+    const sim::TurtleState s = server->world.turtle(index);
+    stroke_start = s.pos;
+    stroke_heading = s.heading;
+    stroke = c;
+  }
   fiber->suspend();
   // Resumed by the scheduler: the command has ended. The answer is taken first, since a handler's
   // own command leaves the next one; then interrupts, then messages.
@@ -81,7 +91,7 @@ void Agent::end_program() {
 }
 
 void Agent::refuse_while_ending(sim::TurtleCommand c) {
-  static constexpr const char* names[] = {"yield", "forward/back", "left/right", "wait"};
+  static constexpr const char* names[] = {"yield", "forward/back", "left/right", "wait", "arc/drive/wheels"};
   spdlog::warn("turtle '{}': its program issued a command ({}) while the run was ending, after catching the exception "
                "that unwinds it; a catch (...) in a controller must rethrow (docs/controllers.md). The program is "
                "abandoned",
@@ -115,6 +125,34 @@ namespace {
   throw std::invalid_argument("turtle '" + a.id + "': " + call + "(" + sim::format_number(amount) + "): " + what);
 }
 
+/// A call with several arguments that has no motion to give (a NaN, an infinity, a negative
+/// time): the program faults, naming the call.
+[[noreturn, gnu::noinline, gnu::cold]] void bad_call(const Agent& a, const char* call,
+                                                     std::initializer_list<double> args, const char* what) {
+  std::string text;
+  for (double x : args) text += (text.empty() ? "" : ", ") + sim::format_number(x);
+  throw std::invalid_argument("turtle '" + a.id + "': " + call + "(" + text + "): " + what);
+}
+
+bool finite(std::initializer_list<double> xs) {
+  for (double x : xs)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+/// An arc command: `speed` units/s along the heading while it turns at `rate` rad/s (positive
+/// clockwise) for `seconds`; `angle` its exact turn when known (arc()), else NaN.
+sim::TurtleCommand arc_command(double speed, double rate, double seconds,
+                               double angle = std::numeric_limits<double>::quiet_NaN()) {
+  sim::TurtleCommand c;
+  c.kind = sim::TurtleCommand::Kind::arc;
+  c.amount = seconds;
+  c.speed = speed;
+  c.rate = rate;
+  c.angle = angle;
+  return c;
+}
+
 }  // namespace
 
 // Negative amounts are directions: forward(-d) is back(d) and right(-a) is left(a), as in Logo
@@ -140,6 +178,48 @@ Result Turtle::wait(double seconds) {
   if (!(seconds >= 0.0 && std::isfinite(seconds))) [[unlikely]]
     bad_amount(*agent_, "wait", seconds, "the time must be a finite number of seconds >= 0");
   return seen(agent_->issue({sim::TurtleCommand::Kind::wait, seconds}));
+}
+// Arcs. Degrees at this interface, radians from here on (sim/angles.hpp). Through a mirror the
+// turn is negated and the wheels exchanged, exactly, so that mirror twins stay exact.
+Result Turtle::arc(double radius, double degrees) {
+  if (!(finite({radius, degrees}) && radius >= 0.0)) [[unlikely]]
+    bad_call(*agent_, "arc", {radius, degrees},
+             "the radius must be a finite number of units >= 0 and the angle a finite number of degrees (positive "
+             "turns right, negative left; drive() with a negative speed goes backwards)");
+  const sim::TurtleDef& d = agent_->server->def.turtles[agent_->index];
+  const double angle = sim::to_radians(mirror_.on ? -degrees : degrees);
+  // At the turtle's speed, unless that would turn faster than its turn rate (v = R w): a radius
+  // of 0 turns on the spot at the turn rate.
+  const double v = std::min(d.speed, d.turn_rate * radius);
+  const double w = v > 0.0 ? v / radius : d.turn_rate;
+  const double seconds = std::abs(angle) / w;
+  return seen(agent_->issue(arc_command(v, std::copysign(w, angle), seconds, angle)));
+}
+Result Turtle::drive(double v, double omega_degrees_per_s, double seconds) {
+  if (!(finite({v, omega_degrees_per_s, seconds}) && seconds >= 0.0)) [[unlikely]]
+    bad_call(*agent_, "drive", {v, omega_degrees_per_s, seconds},
+             "the speed (units/s) and turn rate (degrees/s) must be finite numbers, the time a finite number of "
+             "seconds >= 0");
+  const sim::TurtleDef& d = agent_->server->def.turtles[agent_->index];
+  const double w = sim::to_radians(mirror_.on ? -omega_degrees_per_s : omega_degrees_per_s);
+  // Too fast: both scaled by one factor, so the turtle keeps to the circle it was told.
+  double k = 1.0;
+  if (std::abs(v) > d.speed) k = d.speed / std::abs(v);
+  if (std::abs(w) * k > d.turn_rate) k = d.turn_rate / std::abs(w);
+  return seen(agent_->issue(arc_command(k * v, k * w, seconds)));
+}
+Result Turtle::wheels(double left, double right, double seconds) {
+  if (!(finite({left, right, seconds}) && seconds >= 0.0)) [[unlikely]]
+    bad_call(*agent_, "wheels", {left, right, seconds},
+             "the wheel speeds must be finite numbers of units/s, the time a finite number of seconds >= 0");
+  if (mirror_.on) std::swap(left, right);
+  const sim::TurtleDef& d = agent_->server->def.turtles[agent_->index];
+  // A wheel faster than the turtle's speed: both scaled by one factor (the same circle).
+  const double fastest = std::max(std::abs(left), std::abs(right));
+  const double k = fastest > d.speed ? d.speed / fastest : 1.0;
+  // Differential drive: the centre moves at the wheels' mean, and the heading turns at their
+  // difference over the axle (clockwise, Logo's right, when the left wheel is faster).
+  return seen(agent_->issue(arc_command(0.5 * (k * left + k * right), (k * left - k * right) / axle(), seconds)));
 }
 void Turtle::yield() { agent_->issue({sim::TurtleCommand::Kind::stop, 0.0}); }
 void Turtle::pen_up() { agent_->pen_down = false; }
@@ -217,6 +297,10 @@ void Turtle::log(const std::string& message) {
 double Turtle::radius() const { return agent_->server->def.turtles[agent_->index].radius; }
 double Turtle::speed() const { return agent_->server->def.turtles[agent_->index].speed; }
 double Turtle::turn_rate() const { return sim::to_degrees(agent_->server->def.turtles[agent_->index].turn_rate); }
+double Turtle::axle() const {
+  const double a = agent_->program.axle;
+  return a > 0.0 ? a : 2.0 * radius();
+}
 double Turtle::dt() const { return agent_->server->def.dt; }
 Display Turtle::display() const { return Display(*agent_); }
 nlohmann::json Turtle::game_rules() const {

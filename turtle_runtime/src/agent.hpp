@@ -65,7 +65,9 @@ class alignas(64) Agent {
   std::vector<std::string> sensor_names;      // what Touch::sensor_names points to
   std::size_t walls_laid = 0;                 // k of the next `<id>-w<k>`
   std::string fault;
-  sim::Vec2 stroke_start;                     // where the wall pen's stroke began
+  sim::Vec2 stroke_start;                     // where the wall pen's stroke (or a pen's arc) began
+  double stroke_heading = 0.0;                // an arc's heading at its start, radians
+  sim::TurtleCommand stroke;                  // the arc a lowered pen follows (pen_chords.hpp)
   std::optional<RemoteCommand> remote_input;  // the InputSource's command, for await_remote()
 
   Result issue(sim::TurtleCommand c);

@@ -3,11 +3,13 @@
 // lays while the world runs.
 #include <algorithm>
 #include <cstdint>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
 #include <spdlog/spdlog.h>
 
+#include "pen_chords.hpp"
 #include "server_impl.hpp"
 #include "turtlegas/turtle/world_server.hpp"
 
@@ -74,6 +76,29 @@ void WorldServer::Impl::lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to) {
     return;
   }
   emit({now, "wall-drawn", a.id, w.id, {}, 0.0, {}, {}, {}});
+}
+
+void WorldServer::Impl::pen_arc(Agent& a, const sim::TurtleState& s) {
+  const sim::TurtleCommand& c = a.stroke;
+  // The turn so far: its rate times the time driven (the distance along the arc over the speed).
+  const double turned = c.speed != 0.0 ? c.rate * (s.done / std::abs(c.speed)) : 0.0;
+  const std::vector<sim::Vec2> chords =
+      detail::arc_chords(a.stroke_start, a.stroke_heading, c.speed, c.rate, turned, s.pos, def.turtles[a.index].radius);
+  if (a.pen_down) a.trail.insert(a.trail.end(), chords.begin(), chords.end());
+  if (!a.lays_wall) return;
+  // Walls for the first lap only: the chords of later laps would lie on walls already laid. Past a
+  // lap, the last chord within it is closed back to the start.
+  constexpr double lap = 2.0 * std::numbers::pi;
+  const double per_chord = std::abs(detail::drawn_turn(turned)) / static_cast<double>(chords.size());
+  sim::Vec2 from = a.stroke_start;
+  std::size_t k = 0;
+  for (; k < chords.size() && static_cast<double>(k + 1) * per_chord <= lap * (1.0 + 1e-12); ++k) {
+    if (chords[k] != from) lay_wall(a, from, chords[k]);
+    from = chords[k];
+  }
+  // (Not when the first lap ended on the start, up to round-off: a wall of no length.)
+  const double r = std::abs(c.speed / c.rate);
+  if (k < chords.size() && norm(from - a.stroke_start) > 1e-9 * r) lay_wall(a, from, a.stroke_start);
 }
 
 void WorldServer::add_wall(const sim::WallDef& wall) {

@@ -8,8 +8,11 @@
 namespace turtlegas::turtle {
 namespace {
 
-constexpr std::array<std::string_view, 9> kind_names = {"forward", "back",  "left",     "right", "wait",
-                                                         "yield",   "pen_up", "pen_down", "sense"};
+constexpr std::array<std::string_view, 12> kind_names = {"forward", "back",  "left",     "right", "wait",  "yield",
+                                                          "pen_up",  "pen_down", "sense", "arc",   "drive", "wheels"};
+constexpr std::array<std::string_view, 2> arc_keys = {"radius", "degrees"};
+constexpr std::array<std::string_view, 3> drive_keys = {"v", "omega", "seconds"};
+constexpr std::array<std::string_view, 3> wheels_keys = {"left", "right", "seconds"};
 
 }  // namespace
 
@@ -22,8 +25,17 @@ std::optional<RemoteCommand::Kind> remote_command_kind(std::string_view name) {
 }
 
 bool takes_amount(RemoteCommand::Kind kind) {
-  return kind != RemoteCommand::Kind::yield && kind != RemoteCommand::Kind::pen_up &&
-         kind != RemoteCommand::Kind::pen_down && kind != RemoteCommand::Kind::sense;
+  using K = RemoteCommand::Kind;
+  return kind == K::forward || kind == K::back || kind == K::left || kind == K::right || kind == K::wait;
+}
+
+std::span<const std::string_view> steer_keys(RemoteCommand::Kind kind) {
+  switch (kind) {
+    case RemoteCommand::Kind::arc: return arc_keys;
+    case RemoteCommand::Kind::drive: return drive_keys;
+    case RemoteCommand::Kind::wheels: return wheels_keys;
+    default: return {};
+  }
 }
 
 }  // namespace turtlegas::turtle

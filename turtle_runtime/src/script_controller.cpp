@@ -43,6 +43,18 @@ void script_controller(Turtle& t, const Params& p) {
       t.scan(c[1].get<std::string>(), readings);  // logged as a `sense` event
       continue;
     }
+    if (command && command->steers()) {
+      bool numbers = c.size() == 1 + command->numbers();
+      for (std::size_t j = 1; numbers && j < c.size(); ++j) numbers = c[j].is_number();
+      if (!numbers)
+        throw std::invalid_argument(where + ": '" + name + "' needs " + std::to_string(command->numbers()) +
+                                    " numbers, e.g. " + std::string(command->example()));
+      const double x = c[1].get<double>(), y = c[2].get<double>();
+      if (op == Op::arc) t.arc(x, y);
+      else if (op == Op::drive) t.drive(x, y, c[3].get<double>());
+      else t.wheels(x, y, c[3].get<double>());
+      continue;
+    }
     if (c.size() != 2 || !c[1].is_number())
       throw std::invalid_argument(where + ": '" + name + "' needs one number, e.g. [\"" + name + "\", 100]");
     if (!command) {
@@ -58,7 +70,10 @@ void script_controller(Turtle& t, const Params& p) {
       case Op::wait: t.wait(amount); break;
       case Op::pendown:
       case Op::penup:
-      case Op::sense: break;  // handled above
+      case Op::sense:
+      case Op::arc:
+      case Op::drive:
+      case Op::wheels: break;  // handled above
     }
   }
 }

@@ -63,6 +63,9 @@ class WorldServer::Impl : public GameHost {
   void finish_command(Agent& a);
   void drain_sim_events();
   void lay_wall(Agent& a, sim::Vec2 from, sim::Vec2 to);
+  /// The pen along the arc that just ended in state s: its chords into the trail (a line pen) or
+  /// laid as walls, those of its first lap (a wall pen). builder_walls.cpp.
+  void pen_arc(Agent& a, const sim::TurtleState& s);
   bool id_taken(const std::string& id) const;
   void emit(LogEvent e) {
     if (log) log->push_back(std::move(e));

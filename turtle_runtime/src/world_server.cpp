@@ -124,9 +124,14 @@ void WorldServer::Impl::finish_command(Agent& a) {
     return;
   }
   const sim::TurtleState s = world.turtle(a.index);
-  if (a.waiting_on == sim::TurtleCommand::Kind::move) a.odometer += s.done;
-  if (a.pen_down) a.trail.push_back(s.pos);
-  if (a.lays_wall && s.pos != a.stroke_start) lay_wall(a, a.stroke_start, s.pos);
+  const bool arc = a.waiting_on == sim::TurtleCommand::Kind::arc;
+  if (a.waiting_on == sim::TurtleCommand::Kind::move || arc) a.odometer += s.done;  // an arc's: along it
+  if (arc && (a.pen_down || a.lays_wall) && s.pos != a.stroke_start) [[unlikely]] {
+    pen_arc(a, s);
+  } else {
+    if (a.pen_down) a.trail.push_back(s.pos);
+    if (a.lays_wall && s.pos != a.stroke_start) lay_wall(a, a.stroke_start, s.pos);
+  }
   const double done = a.waiting_on == sim::TurtleCommand::Kind::turn ? sim::to_degrees(s.done) : s.done;
   // A touch that cut the command short is the first of those delivered on resuming.
   a.answer = s.touched && !a.inbox.empty() ? Result(done, a.inbox.front()) : Result(done, std::nullopt);
@@ -232,8 +237,25 @@ bool WorldServer::Impl::resume(Agent& a) {
   switch (outcome) {
     case detail::Fiber::Outcome::suspended:
       if (a.command) {
-        world.command_turtle(a.index, *a.command);
-        if (a.command->kind == sim::TurtleCommand::Kind::move && a.command->amount != 0.0) a.in_contact.clear();
+        if (a.command->kind == sim::TurtleCommand::Kind::arc) [[unlikely]] {
+          // The engine refuses an arc where a wall turns or stretches (no exact solver): a fault
+          // of this turtle's program, as if its call had thrown, not the end of the run.
+          try {
+            world.command_turtle(a.index, *a.command);
+          } catch (const std::invalid_argument& e) {
+            a.command.reset();
+            a.waiting = false;
+            park(std::string("its arc was refused: ") + e.what());
+            return false;
+          }
+        } else {
+          world.command_turtle(a.index, *a.command);
+        }
+        // A turtle that drives away leaves its contacts (one turning on the spot keeps them).
+        const sim::TurtleCommand& c = *a.command;
+        if ((c.kind == sim::TurtleCommand::Kind::move && c.amount != 0.0) ||
+            (c.kind == sim::TurtleCommand::Kind::arc && c.amount > 0.0 && c.speed != 0.0))
+          a.in_contact.clear();
         a.command.reset();
         return false;
       }

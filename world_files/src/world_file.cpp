@@ -34,7 +34,7 @@ constexpr std::array<std::string_view, 0> reserved_keys = {};
 std::vector<std::string_view> draw_commands() {
   std::vector<std::string_view> names;
   for (const turtle::ScriptCommand& c : turtle::script_commands)
-    if (!c.timed_only() && !c.senses()) names.push_back(c.name);
+    if (!c.timed_only() && !c.senses() && !c.steers()) names.push_back(c.name);
   return names;
 }
 
@@ -215,7 +215,7 @@ void Reader::read_draw(const json& v, std::vector<sim::WallDef>& walls) {
       const std::string name = c[0].get<std::string>();
       if (std::find(commands_known.begin(), commands_known.end(), name) == commands_known.end())
         fail(at(kp, 0), "unknown command '" + name + "'; a draw builder knows: " + known +
-                            " (it runs at load time, so there is no wait)");
+                            " (it runs at load time, so there is no wait, sense, arc, drive or wheels)");
       if (name == "pendown" || name == "penup") {
         if (c.size() != 1) fail(kp, "'" + name + "' takes no amount: [\"" + name + "\"]");
         walker.pen_down = name == "pendown";

@@ -27,7 +27,7 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
     expect_object(t, p, "a turtle");
     check_keys(t, p, "a turtle",
                {"id", "pos", "heading", "radius", "speed", "turn_rate", "controller", "params", "sensors", "pen", "gps",
-                "bounce", "category", "collides_with", "builder", "senses"});
+                "bounce", "category", "collides_with", "builder", "senses", "axle"});
     sim::TurtleDef body;
     turtle::TurtleProgram program;
     body.id = id(t, p, "a turtle");
@@ -99,6 +99,14 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
       program.builder = b;
     }
     if (const json* x = find(t, "gps")) program.gps = boolean(*x, at(p, "gps"));
+    // The wheels' track for Turtle::wheels (and the script's "wheels"); left out, the runtime
+    // puts the wheels at the rim of the disc (twice the radius).
+    if (const json* x = find(t, "axle")) {
+      program.axle = number(*x, at(p, "axle"));
+      if (!(program.axle > 0.0))
+        fail(at(p, "axle"), "axle (units between the wheels) must be > 0 (got " + num(program.axle) +
+                                "); leave it out for twice the turtle's radius");
+    }
     turtles.push_back(std::move(body));
     programs.push_back(std::move(program));
   }
@@ -239,6 +247,21 @@ void Reader::check_script(const json& params, const std::string& path,
         fail(at(p, 1), "this turtle has no range sensor \"" + sensor + "\"" +
                            (known_senses.empty() ? std::string("; declare it under the turtle's \"senses\"")
                                                  : "; its senses: " + sim::join_names(known_senses)));
+      continue;
+    }
+    if (command->steers()) {
+      // ["arc", radius, degrees], ["drive", v, omega, seconds], ["wheels", left, right, seconds].
+      const std::string example(command->example());
+      if (c.size() != 1 + command->numbers())
+        fail(p, "'" + name + "' needs " + std::to_string(command->numbers()) + " numbers (" +
+                    std::string(turtle::unit_name(command->amount)) + "), e.g. " + example + ", got " + c.dump());
+      std::vector<double> xs;
+      for (std::size_t j = 1; j < c.size(); ++j) xs.push_back(number(c[j], at(p, j)));
+      if (command->op == turtle::ScriptCommand::Op::arc && xs[0] < 0.0)
+        fail(at(p, 1), "an arc's radius must be >= 0 (got " + num(xs[0]) +
+                           "); negative degrees turn left, and [\"drive\", v, omega, seconds] with v < 0 goes backwards");
+      if (command->op != turtle::ScriptCommand::Op::arc && xs[2] < 0.0)
+        fail(at(p, 3), "'" + name + "' needs a time >= 0 in seconds (got " + num(xs[2]) + ")");
       continue;
     }
     if (name == "pendown" || name == "penup") {

@@ -89,7 +89,8 @@ bool Turtles::command(std::size_t k, const TurtleCommand& c, Body& b, double& en
       break;
     case TurtleCommand::Kind::arc: {
       // The odometer counts the distance along the arc, |speed| * time (amount: it, at the end).
-      busy = c.amount > 0.0 && (c.speed != 0.0 || c.rate != 0.0);
+      // With no speed and no rate it stands still for its time, as the runtime's drive(0, 0, s).
+      busy = c.amount > 0.0;
       end = busy ? now + c.amount : kNever;
       r.omega = busy ? c.rate : 0.0;
       r.angle = std::isnan(c.angle) ? c.rate * c.amount : c.angle;

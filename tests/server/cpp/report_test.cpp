@@ -31,6 +31,11 @@ std::string reference(const turtle::RemoteReport& r, std::string_view turtle_id,
       out["turtle"] = turtle_id;
       out["command"] = turtle::to_string(r.command.kind);
       if (turtle::takes_amount(r.command.kind)) out["amount"] = r.command.amount;
+      if (const auto keys = turtle::steer_keys(r.command.kind); !keys.empty()) {
+        json args = json::object();
+        for (std::size_t k = 0; k < keys.size(); ++k) args[std::string(keys[k])] = r.command.steer[k];
+        out["args"] = std::move(args);
+      }
       out["done"] = r.result.done();
       out["touched"] = r.result.touched();
       if (r.result.touched()) out["touch"] = server::touch_json(r.result.touch());
@@ -95,6 +100,12 @@ TEST_CASE("report_text writes what the json object wrote") {
     r.pen_down = true;
     reports.push_back(r);
     r.result = turtle::Result(v, std::nullopt);
+    for (const auto kind : {turtle::RemoteCommand::Kind::arc, turtle::RemoteCommand::Kind::drive,
+                            turtle::RemoteCommand::Kind::wheels}) {
+      r.command = {kind, 0.0};
+      r.command.steer = {v, -v - 1.0, 2.5};
+      reports.push_back(r);
+    }
     r.command = {turtle::RemoteCommand::Kind::pen_down, 0.0};
     r.pen_mode = turtle::PenMode::wall;
     r.position = sim::Vec2{v, 250.0};

@@ -14,9 +14,11 @@
 // host records what next() returned (formats/input_log.hpp) and replays it headless.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,9 +36,12 @@ inline constexpr std::string_view remote_controller_name = "remote";
 
 /// One command for a remote turtle: what its C++ twin would call on its Turtle.
 struct RemoteCommand {
-  enum class Kind { forward, back, left, right, wait, yield, pen_up, pen_down, sense };
+  enum class Kind { forward, back, left, right, wait, yield, pen_up, pen_down, sense, arc, drive, wheels };
   Kind kind = Kind::yield;
   double amount = 0.0;          ///< forward/back: world units; left/right: degrees; wait: seconds
+  /// arc: radius (units), degrees; drive: v (units/s), omega (degrees/s), seconds; wheels: left,
+  /// right (units/s), seconds. Named as steer_keys(kind) names them.
+  std::array<double, 3> steer{};
   PenMode pen = PenMode::line;  ///< pen_down's mode
   std::string sensor{};         ///< sense: the range sensor to read (Turtle::scan); takes no time
   /// The sender's number for the command, echoed in its result; not part of the run (an input
@@ -44,11 +49,16 @@ struct RemoteCommand {
   std::uint64_t tag = 0;
 };
 
-/// "forward", "back", "left", "right", "wait", "yield", "pen_up", "pen_down", "sense".
+/// "forward", "back", "left", "right", "wait", "yield", "pen_up", "pen_down", "sense", "arc", "drive",
+/// "wheels".
 std::string_view to_string(RemoteCommand::Kind kind);
 std::optional<RemoteCommand::Kind> remote_command_kind(std::string_view name);
 /// Whether the command takes an amount (forward, back, left, right, wait).
 bool takes_amount(RemoteCommand::Kind kind);
+/// The names of RemoteCommand::steer's numbers in the protocol and in input logs: arc {"radius",
+/// "degrees"}, drive {"v", "omega", "seconds"}, wheels {"left", "right", "seconds"}; empty for
+/// the kinds that take none.
+std::span<const std::string_view> steer_keys(RemoteCommand::Kind kind);
 
 /// What a remote turtle's program reports, in the order its C++ twin would see it: the touches
 /// and messages delivered on resuming, then the result of the command they interrupted.

@@ -12,10 +12,10 @@ namespace turtlegas::turtle {
 
 /// One script command: its name in a world file and what its number measures.
 struct ScriptCommand {
-  enum class Op { forward, back, left, right, wait, pendown, penup, sense };
+  enum class Op { forward, back, left, right, wait, pendown, penup, sense, arc, drive, wheels };
   /// What the command's amount is: none for pendown and penup (pendown may name a pen mode), the
-  /// name of a range sensor for sense.
-  enum class Amount { none, units, degrees, seconds, sensor };
+  /// name of a range sensor for sense; arc, drive and wheels take several numbers (numbers()).
+  enum class Amount { none, units, degrees, seconds, sensor, arc, drive, wheels };
   std::string_view name;
   Op op;
   Amount amount;
@@ -24,10 +24,33 @@ struct ScriptCommand {
   bool timed_only() const { return amount == Amount::seconds; }
   /// Whether the command reads the world (sense): a draw builder, which runs at load time, has none.
   bool senses() const { return amount == Amount::sensor; }
+  /// Whether the command drives on an arc (arc, drive, wheels): a draw builder has none.
+  constexpr bool steers() const { return amount == Amount::arc || amount == Amount::drive || amount == Amount::wheels; }
+  /// How many numbers follow the name: ["arc", radius, degrees], ["drive", v, omega, seconds],
+  /// ["wheels", left, right, seconds]; one for the others that take an amount.
+  constexpr std::size_t numbers() const {
+    switch (amount) {
+      case Amount::none:
+      case Amount::sensor: return 0;
+      case Amount::arc: return 2;
+      case Amount::drive:
+      case Amount::wheels: return 3;
+      default: return 1;
+    }
+  }
+  /// An example of the command, for messages.
+  constexpr std::string_view example() const {
+    switch (amount) {
+      case Amount::arc: return "[\"arc\", 50, 90]";
+      case Amount::drive: return "[\"drive\", 20, 45, 2]";
+      case Amount::wheels: return "[\"wheels\", 20, 10, 2]";
+      default: return {};
+    }
+  }
 };
 
 /// Every script command, in the order messages list them.
-inline constexpr std::array<ScriptCommand, 8> script_commands = {{
+inline constexpr std::array<ScriptCommand, 11> script_commands = {{
     {"forward", ScriptCommand::Op::forward, ScriptCommand::Amount::units},
     {"back", ScriptCommand::Op::back, ScriptCommand::Amount::units},
     {"left", ScriptCommand::Op::left, ScriptCommand::Amount::degrees},
@@ -36,6 +59,9 @@ inline constexpr std::array<ScriptCommand, 8> script_commands = {{
     {"pendown", ScriptCommand::Op::pendown, ScriptCommand::Amount::none},
     {"penup", ScriptCommand::Op::penup, ScriptCommand::Amount::none},
     {"sense", ScriptCommand::Op::sense, ScriptCommand::Amount::sensor},
+    {"arc", ScriptCommand::Op::arc, ScriptCommand::Amount::arc},
+    {"drive", ScriptCommand::Op::drive, ScriptCommand::Amount::drive},
+    {"wheels", ScriptCommand::Op::wheels, ScriptCommand::Amount::wheels},
 }};
 
 /// The names of every script command, in table order ("known: ..." lists).
@@ -52,13 +78,16 @@ constexpr const ScriptCommand* find_script_command(std::string_view name) {
   return nullptr;
 }
 
-/// "units", "degrees" or "seconds" (empty for none).
+/// What the amounts measure: "units", "degrees", "seconds", ... (empty for none).
 constexpr std::string_view unit_name(ScriptCommand::Amount a) {
   switch (a) {
     case ScriptCommand::Amount::units: return "units";
     case ScriptCommand::Amount::degrees: return "degrees";
     case ScriptCommand::Amount::seconds: return "seconds";
     case ScriptCommand::Amount::sensor: return "sensor";
+    case ScriptCommand::Amount::arc: return "units (radius) and degrees";
+    case ScriptCommand::Amount::drive: return "units/s, degrees/s and seconds";
+    case ScriptCommand::Amount::wheels: return "units/s, units/s and seconds";
     case ScriptCommand::Amount::none: break;
   }
   return {};

@@ -158,13 +158,15 @@ struct Message {
 
 /// What a lowered pen does. `line` draws the turtle's path (in snapshots); `wall` lays a wall
 /// along each forward/back stroke (a real wall that every other body collides with; the turtle
-/// itself passes through its own walls). Wall mode needs a turtle the world lets build walls
+/// itself passes through its own walls). On an arc (arc, drive, wheels) both follow its chords:
+/// each spans at most 45 degrees of the turn and lies within radius() / 20 of the arc (its
+/// sagitta); an arc of more than a lap draws its circle once, then the rest. Wall mode needs a turtle the world lets build walls
 /// (`"builder": true` or `"pen": "wall"` in the world file).
 enum class PenMode { line, wall };
 
 class Agent;  // the runtime's side of a turtle
 
-/// Thrown by a command (forward, back, left, right, wait, yield) of a turtle that is no longer in
+/// Thrown by a command (forward, back, left, right, arc, drive, wheels, wait, yield) of a turtle that is no longer in
 /// the world: crushed (docs/physics.md, "Wedged and crushed bodies"), out of an open arena, or
 /// removed. The command it cuts short has ended where the turtle went; every later command throws
 /// it again. A program may catch it to tidy up, then return; uncaught, it ends the program without
@@ -184,13 +186,32 @@ class Turtle {
   Result left(double degrees);
   Result right(double degrees);
   Result wait(double seconds);
+  /// Drives along a circle of `radius` units (>= 0; 0 turns on the spot) through `degrees` of
+  /// turn: positive turns right (clockwise, as right() does), negative left. It drives at speed(),
+  /// or slower where that would turn faster than turn_rate() (at turn_rate() * radius, in
+  /// radians), and ends at the closed form of the exact turn. done(): the distance driven along
+  /// the arc (units; 0 for a turn on the spot), as the odometer counts it.
+  Result arc(double radius, double degrees);
+  /// Drives for `seconds` at `v` units/s along the heading (negative: backwards) while the heading
+  /// turns at `omega` degrees/s (positive: clockwise): a circle of radius |v / omega| (omega in
+  /// radians/s), a straight stroke when omega is 0, a turn on the spot when v is 0. When |v| >
+  /// speed() or |omega| > turn_rate(), both are scaled down by one factor (the same circle,
+  /// driven more slowly for the same time). done(): the distance driven along the arc (units).
+  Result drive(double v, double omega_degrees_per_s, double seconds);
+  /// Differential drive: the left and right wheels at `left` and `right` units/s (negative:
+  /// backwards) for `seconds`, the wheels axle() apart. The turtle drives at (left + right) / 2
+  /// and turns at (left - right) / axle() radians/s (clockwise when the left wheel is faster): a
+  /// circle of radius axle() / 2 * |left + right| / |right - left|. A wheel faster than speed()
+  /// scales both wheels down by one factor (the same circle); turn_rate() does not apply, the
+  /// wheels are the limit. done(): the distance the centre drove along the arc (units).
+  Result wheels(double left, double right, double seconds);
   /// Gives up the rest of this control step without a command.
   void yield();
   void pen_up();
   /// Lowers the pen. In PenMode::wall, each forward/back command from now on lays a wall from
   /// where it started to where it ended (also when a touch cut it short), at the control step at
   /// which the command returns; it is logged as a `wall-drawn` event with the id
-  /// `<turtle id>-w<k>`. A wall that would overlap a body it collides with is not laid (a
+  /// `<turtle id>-w<k>`; an arc lays one wall per chord (PenMode). A wall that would overlap a body it collides with is not laid (a
   /// `wall-refused` event says why). Throws std::logic_error for PenMode::wall when the turtle is
   /// not a builder (which stops its program with a fault naming the fix).
   void pen_down(PenMode mode = PenMode::line);
@@ -238,6 +259,9 @@ class Turtle {
   double radius() const;
   double speed() const;
   double turn_rate() const;
+  /// The distance between the wheels of wheels() (units): the world file's `"axle"`, by default
+  /// twice the turtle's radius (wheels at the rim of its disc).
+  double axle() const;
   double dt() const;
   /// The rules of the world's game as JSON; {} when the world has no game. The tag game gives
   /// {"kind": "tag", "no_tag_back": <seconds>}.
@@ -251,7 +275,8 @@ class Turtle {
   /// This turtle seen through a mirror whose line has heading `axis_degrees` (Logo degrees; 0, the
   /// default, is a vertical line), to run a program as its own mirror image (the `mirror`
   /// controller). The handle it returns exchanges left and right, and reflects across the line
-  /// the heading (heading() is 2 axis - the real heading), every touch (bearing b seen as 360 - b,
+  /// the heading (heading() is 2 axis - the real heading), arcs (arc and drive turn the other
+  /// way; wheels exchanges the left and right wheel), every touch (bearing b seen as 360 - b,
   /// sensors those of the reflected bearing: Result::touch(), on_touch, touching(); a range
   /// sensor's ray at bearing b reads what lies at 360 - b) and, when
   /// `through` names a point of the line, position() (without it a mirrored position() is

@@ -83,6 +83,8 @@ struct TurtleProgram {
   bool builder = false;
   bool gps = false;  ///< whether the program may read its global position
   std::vector<RangeSensor> senses;  ///< range sensors, by name (none by default)
+  /// Units between the wheels of Turtle::wheels; 0: twice the turtle's radius.
+  double axle = 0.0;
 };
 
 /// The scene the world server runs: `def` with every builder turtle (programs[k].builder) moved
