@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "turtlegas/formats/engine_state.hpp"
 #include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::apps {
@@ -53,12 +54,22 @@ void write_checkpoint(std::ostream& out, const Checkpoint& c) {
       {"events", c.events},
       {"state_fnv1a", hex(c.state_hash)},
       {"why", c.why},
-      {"resume", "turtlegas run " + c.world + " --resume THIS_FILE --until T: replays the run to t without outputs, "
-                                              "checks the state there, and goes on"},
+      {"resume", "turtlegas run " + c.world + " --resume THIS_FILE --until T: " +
+                     (c.engine ? "builds the world from the engine state below, checks it, and goes on"
+                               : "replays the run to t without outputs, checks the state there, and goes on")},
   };
+  if (c.engine) j["engine"] = formats::engine_state_json(*c.engine);
   // Its own hash: a checkpoint edited or cut is told from a run that does not replay.
   j["fnv1a"] = hex(fnv1a64(j.dump()));
-  out << j.dump(2) << '\n';
+  // A key a line; the values on one line each (the engine's state is long: indenting it would
+  // double the file).
+  out << "{\n";
+  bool first = true;
+  for (const auto& [key, value] : j.items()) {
+    out << (first ? "" : ",\n") << "  " << nlohmann::json(key).dump() << ": " << value.dump();
+    first = false;
+  }
+  out << "\n}\n";
 }
 
 Checkpoint read_checkpoint(const std::string& path) {
@@ -107,6 +118,13 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.events = field("events").get<std::uint64_t>();
     c.state_hash = hash("state_fnv1a");
     c.why = j.value("why", std::string());
+    if (j.contains("engine")) {
+      try {
+        c.engine = formats::engine_state_from_json(j.at("engine"));
+      } catch (const std::invalid_argument& e) {
+        throw BadInput(where + e.what() + "; the checkpoint is damaged");
+      }
+    }
   } catch (const nlohmann::json::exception& e) {
     throw BadInput(where + "a key has the wrong type (" + e.what() + "); the checkpoint is damaged");
   }
