@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "version_info.hpp"
 #include "turtlegas/formats/engine_state.hpp"
 #include "turtlegas/turtle/json_depth.hpp"
 
@@ -25,6 +26,8 @@ std::string hex(std::uint64_t v) {
 }
 
 }  // namespace
+
+std::string engine_build() { return std::string(version_string) + " " + version_commit; }
 
 std::uint64_t fnv1a64(std::string_view bytes) {
   std::uint64_t h = 1469598103934665603ull;
@@ -58,7 +61,10 @@ void write_checkpoint(std::ostream& out, const Checkpoint& c) {
                      (c.engine ? "builds the world from the engine state below, checks it, and goes on"
                                : "replays the run to t without outputs, checks the state there, and goes on")},
   };
-  if (c.engine) j["engine"] = formats::engine_state_json(*c.engine);
+  if (c.engine) {
+    j["engine"] = formats::engine_state_json(*c.engine);
+    j["engine_build"] = c.engine_build;
+  }
   // Its own hash: a checkpoint edited or cut is told from a run that does not replay.
   j["fnv1a"] = hex(fnv1a64(j.dump()));
   // A key a line; the values on one line each (the engine's state is long: indenting it would
@@ -122,6 +128,7 @@ Checkpoint read_checkpoint(const std::string& path) {
     if (j.contains("engine")) {
       try {
         c.engine = formats::engine_state_from_json(j.at("engine"));
+        c.engine_build = field("engine_build").get<std::string>();
       } catch (const std::invalid_argument& e) {
         throw BadInput(where + e.what() + "; the checkpoint is damaged");
       }

@@ -38,7 +38,13 @@ struct Checkpoint {
   /// The engine's whole memory there, for a gas (World::save_state); none for a world with turtles,
   /// which --resume replays.
   std::optional<sim::EngineState> engine;
+  /// With an engine state: the turtlegas that wrote it ("0.1.0 <commit>"; engine_build()). Another
+  /// build's engine may keep its memory otherwise, so --resume replays instead of using it.
+  std::string engine_build;
 };
+
+/// This turtlegas, as a checkpoint's engine_build names it: the version and the commit built.
+std::string engine_build();
 
 /// 64-bit FNV-1a.
 std::uint64_t fnv1a64(std::string_view bytes);

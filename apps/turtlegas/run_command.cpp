@@ -420,7 +420,11 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     bare.emplace(make_world(std::move(given), mode, opt.world));
     sim::World& world = *bare;
     totals.energy_start = world.energy();  // at t = 0, resumed or not: --stats says the run's
-    if (resume && resume->engine && !observe_file && !trails) {
+    if (resume && resume->engine && resume->engine_build != engine_build())
+      spdlog::warn("--resume {}: its engine state was written by turtlegas {}, this is {}: it is not used (another "
+                   "build may keep its memory otherwise); the run is replayed to t = {} s instead",
+                   opt.resume, resume->engine_build, engine_build(), fmt(resume->t));
+    else if (resume && resume->engine && !observe_file && !trails) {
       // The checkpoint holds the engine's memory: the world goes on from it (checked below), with
       // nothing simulated twice. --observe and --svg-trails measure from before the checkpoint,
       // which only the replay gives them.
@@ -554,7 +558,10 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     c.events = world.stats().events;
     c.state_hash = state_hash(world, current_names());
     c.why = why;
-    if (bare && bare->can_save_state()) c.engine = bare->save_state();
+    if (bare && bare->can_save_state()) {
+      c.engine = bare->save_state();
+      c.engine_build = engine_build();
+    }
     OutputFile out(opt.checkpoint, "--checkpoint");
     write_checkpoint(out.stream(), c);
     out.commit();

@@ -185,17 +185,20 @@ TEST_CASE("resume: an edited world and a damaged engine state are refused") {
   CHECK(contains(changed.err, "is not the one the checkpoint was written for"));
   dir.write("g.json", long_gas);
 
-  // A state whose own hash is made to match, but which is not the run's: a ball moved by 1e-9.
+  // Edited, with its own hash made to match again (FNV-1a of the compact dump, 16 hex digits).
+  auto rewrite = [&](json j) {
+    j.erase("fnv1a");
+    std::uint64_t h = 1469598103934665603ull;
+    for (unsigned char ch : j.dump()) h = (h ^ ch) * 1099511628211ull;
+    char hex[20];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    j["fnv1a"] = hex;
+    dir.write("c.json", j.dump());
+  };
+  // A state that is not the run's: a ball moved by 1e-9.
   json j = json::parse(good);
   j["engine"]["bodies"][7][0] = j["engine"]["bodies"][7][0].get<double>() + 1e-9;
-  j.erase("fnv1a");
-  // (the checkpoint's hash: FNV-1a of the compact dump, 16 hex digits)
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char ch : j.dump()) h = (h ^ ch) * 1099511628211ull;
-  char hex[20];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  j["fnv1a"] = hex;
-  dir.write("c.json", j.dump());
+  rewrite(j);
   const Result moved = run(dir, {"run", g.string(), "--until", "1", "--resume", c});
   CHECK(moved.code == 2);
   CHECK(contains(moved.err, "the engine state does not give the state the checkpoint hashed"));
@@ -203,15 +206,23 @@ TEST_CASE("resume: an edited world and a damaged engine state are refused") {
   // Links that do not hold together.
   j = json::parse(good);
   j["engine"]["bodies"][0][7] = 100000;  // next: no such body
-  j.erase("fnv1a");
-  h = 1469598103934665603ull;
-  for (unsigned char ch : j.dump()) h = (h ^ ch) * 1099511628211ull;
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  j["fnv1a"] = hex;
-  dir.write("c.json", j.dump());
+  rewrite(j);
   const Result broken = run(dir, {"run", g.string(), "--until", "1", "--resume", c});
   CHECK(broken.code == 2);
   CHECK(contains(broken.err, "the engine state does not fit"));
+
+  // Another build's state is not used: the run is replayed, and ends as the whole run does.
+  j = json::parse(good);
+  j["engine_build"] = "0.0.1 0123abc";
+  rewrite(j);
+  const std::string replayed = (dir.path / "replayed.json").string(), whole = (dir.path / "whole.json").string();
+  const Result other = run(dir, {"run", g.string(), "--until", "1", "--resume", c, "--state-out", replayed});
+  INFO(other.err);
+  CHECK(other.code == 0);
+  CHECK(contains(other.err, "its engine state was written by turtlegas 0.0.1 0123abc"));
+  CHECK(contains(other.err, "the run is replayed to t = 0.5 s instead"));
+  REQUIRE(run(dir, {"run", g.string(), "--until", "1", "--state-out", whole}).code == 0);
+  CHECK(read(replayed) == read(whole));
 
   // Cut: its own hash no longer matches.
   dir.write("c.json", good.substr(0, good.size() / 2) + "]]}}");
