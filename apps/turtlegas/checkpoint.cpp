@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "version_info.hpp"
+#include "turtlegas/formats/engine_state.hpp"
 #include "turtlegas/turtle/json_depth.hpp"
 
 namespace turtlegas::apps {
@@ -24,6 +26,8 @@ std::string hex(std::uint64_t v) {
 }
 
 }  // namespace
+
+std::string engine_build() { return std::string(version_string) + " " + version_commit; }
 
 std::uint64_t fnv1a64(std::string_view bytes) {
   std::uint64_t h = 1469598103934665603ull;
@@ -53,12 +57,25 @@ void write_checkpoint(std::ostream& out, const Checkpoint& c) {
       {"events", c.events},
       {"state_fnv1a", hex(c.state_hash)},
       {"why", c.why},
-      {"resume", "turtlegas run " + c.world + " --resume THIS_FILE --until T: replays the run to t without outputs, "
-                                              "checks the state there, and goes on"},
+      {"resume", "turtlegas run " + c.world + " --resume THIS_FILE --until T: " +
+                     (c.engine ? "builds the world from the engine state below, checks it, and goes on"
+                               : "replays the run to t without outputs, checks the state there, and goes on")},
   };
+  if (c.engine) {
+    j["engine"] = formats::engine_state_json(*c.engine);
+    j["engine_build"] = c.engine_build;
+  }
   // Its own hash: a checkpoint edited or cut is told from a run that does not replay.
   j["fnv1a"] = hex(fnv1a64(j.dump()));
-  out << j.dump(2) << '\n';
+  // A key a line; the values on one line each (the engine's state is long: indenting it would
+  // double the file).
+  out << "{\n";
+  bool first = true;
+  for (const auto& [key, value] : j.items()) {
+    out << (first ? "" : ",\n") << "  " << nlohmann::json(key).dump() << ": " << value.dump();
+    first = false;
+  }
+  out << "\n}\n";
 }
 
 Checkpoint read_checkpoint(const std::string& path) {
@@ -78,9 +95,10 @@ Checkpoint read_checkpoint(const std::string& path) {
     throw BadInput(where + "not a checkpoint: /format must be \"" + checkpoint_format +
                    "\" (write one with run --checkpoint F)");
   if (j.contains("fnv1a")) {  // checkpoints before it have none
-    nlohmann::json body = j;
-    body.erase("fnv1a");
-    if (!j["fnv1a"].is_string() || j["fnv1a"].get<std::string>() != hex(fnv1a64(body.dump())))
+    // Taken out rather than copied: an engine state makes the rest long.
+    const nlohmann::json own = std::move(j["fnv1a"]);
+    j.erase("fnv1a");
+    if (!own.is_string() || own.get<std::string>() != hex(fnv1a64(j.dump())))
       throw BadInput(where + "the checkpoint is damaged: its contents do not match its own hash (/fnv1a); it was "
                      "edited or cut. Resume from an undamaged copy, or rerun from the start");
   }
@@ -107,6 +125,14 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.events = field("events").get<std::uint64_t>();
     c.state_hash = hash("state_fnv1a");
     c.why = j.value("why", std::string());
+    if (j.contains("engine")) {
+      try {
+        c.engine = formats::engine_state_from_json(j.at("engine"));
+        c.engine_build = field("engine_build").get<std::string>();
+      } catch (const std::invalid_argument& e) {
+        throw BadInput(where + e.what() + "; the checkpoint is damaged");
+      }
+    }
   } catch (const nlohmann::json::exception& e) {
     throw BadInput(where + "a key has the wrong type (" + e.what() + "); the checkpoint is damaged");
   }

@@ -1,21 +1,25 @@
 // SPDX-License-Identifier: MIT
 // `run --checkpoint F` and `run --resume F`: what a checkpoint holds, and reading and writing one.
 //
-// A checkpoint holds a run's inputs and how far it got, not its memory: the world file's hash, the
-// mode and dt, the time reached, and the hash of the state and the event count there. Turtle
-// programs are coroutines, which cannot be written to a file, and the engine's event queue is its
-// own; so `--resume` rebuilds the run from the world file and replays it, without writing
-// anything, to the checkpoint's time (determinism makes that the same run, bit for bit), checks
-// that it arrived at the same state, and carries on from there, writing its outputs. The replay
-// costs the simulation up to that time, without the outputs; what it buys is that a resumed run
-// is exactly the run that was interrupted (docs/controllers.md, "Checkpoints").
+// A checkpoint holds a run's inputs and how far it got: the world file's hash, the mode and dt,
+// the time reached, and the hash of the state and the event count there. For a gas (no turtles,
+// layers or moving walls) it holds the engine's whole memory as well (`engine`, formats/
+// engine_state.hpp): `--resume` builds the world from the world file, puts that memory in, checks
+// that it is at the checkpoint's state, and goes on, without simulating the time before. A world
+// with turtles cannot be written down: programs are coroutines, whose stacks no file can hold; so
+// `--resume` rebuilds the run from the world file and replays it, without writing anything, to the
+// checkpoint's time (determinism makes that the same run, bit for bit), checks that it arrived at
+// the same state, and carries on from there. Either way the resumed run is exactly the run that
+// was interrupted (docs/controllers.md, "Checkpoints").
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <string_view>
 
+#include "turtlegas/sim/engine_state.hpp"
 #include "turtlegas/sim/world.hpp"
 #include "turtlegas/sim/world_def.hpp"
 
@@ -31,7 +35,16 @@ struct Checkpoint {
   std::uint64_t events = 0;        ///< the engine's event count there
   std::uint64_t state_hash = 0;    ///< FNV-1a of the state file there (formats/state_file.hpp)
   std::string why;                 ///< "every 10 s", "SIGINT", "max-events", ...
+  /// The engine's whole memory there, for a gas (World::save_state); none for a world with turtles,
+  /// which --resume replays.
+  std::optional<sim::EngineState> engine;
+  /// With an engine state: the turtlegas that wrote it ("0.1.0 <commit>"; engine_build()). Another
+  /// build's engine may keep its memory otherwise, so --resume replays instead of using it.
+  std::string engine_build;
 };
+
+/// This turtlegas, as a checkpoint's engine_build names it: the version and the commit built.
+std::string engine_build();
 
 /// 64-bit FNV-1a.
 std::uint64_t fnv1a64(std::string_view bytes);

@@ -193,7 +193,9 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
   line.checkpoint_every_option =
       run->add_option("--checkpoint-every", line.checkpoint_every, "Simulated seconds between checkpoints")
           ->check(real_in(0, big, "seconds", true));
-  run->add_option("--resume", opt.resume, "Continue the run a checkpoint was written for (replays it to there)");
+  run->add_option("--resume", opt.resume,
+                  "Continue the run a checkpoint was written for (a gas from the engine state it holds; a world with "
+                  "turtles is replayed to there)");
   run->add_option("--observe", opt.observe,
                   "Write the gas observables here (JSON; - for standard output): temperature, pressure, collision "
                   "rate, mean free path, speed histogram, density profile, g(r), MSD, VACF and D, per species, per time "
@@ -354,6 +356,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   // Exactly one of these runs the scene: the bare engine, or the world server when there are
   // turtles (which then owns the engine).
   std::optional<sim::World> bare;
+  bool restored = false;  // resumed from the checkpoint's engine state, not replayed
   std::unique_ptr<turtle::WorldServer> server;
   std::shared_ptr<formats::ReplayInput> replay;
   if (!opt.inputs.empty()) {
@@ -416,7 +419,23 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     scales = predict_scales(given, mode);
     bare.emplace(make_world(std::move(given), mode, opt.world));
     sim::World& world = *bare;
-    totals.energy_start = world.energy();
+    totals.energy_start = world.energy();  // at t = 0, resumed or not: --stats says the run's
+    if (resume && resume->engine && resume->engine_build != engine_build())
+      spdlog::warn("--resume {}: its engine state was written by turtlegas {}, this is {}: it is not used (another "
+                   "build may keep its memory otherwise); the run is replayed to t = {} s instead",
+                   opt.resume, resume->engine_build, engine_build(), fmt(resume->t));
+    else if (resume && resume->engine && !observe_file && !trails) {
+      // The checkpoint holds the engine's memory: the world goes on from it (checked below), with
+      // nothing simulated twice. --observe and --svg-trails measure from before the checkpoint,
+      // which only the replay gives them.
+      try {
+        world.restore_state(*resume->engine);
+      } catch (const std::invalid_argument& e) {
+        throw BadInput("--resume " + opt.resume + ": the engine state does not fit " + opt.world + " (" + e.what() +
+                       "); the checkpoint is damaged, or of another turtlegas: rerun from the start");
+      }
+      restored = true;
+    }
     world.set_event_log(&bare_events);
     stop_inside_steps(world, limits, start);
     if (observe_file) observer.emplace(world, def, observing, opt.until);
@@ -539,6 +558,10 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
     c.events = world.stats().events;
     c.state_hash = state_hash(world, current_names());
     c.why = why;
+    if (bare && bare->can_save_state()) {
+      c.engine = bare->save_state();
+      c.engine_build = engine_build();
+    }
     OutputFile out(opt.checkpoint, "--checkpoint");
     write_checkpoint(out.stream(), c);
     out.commit();
@@ -546,7 +569,13 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
 
   Stopped end{Stop::until, 0};
   std::string checkpoint_failed;  // why a periodic checkpoint could not be written
-  if (resume) {
+  if (resume && restored) {
+    // The proof that the engine state is the run's: the state file the checkpoint hashed.
+    if (!(world.time() == resume->t && world.stats().events == resume->events &&
+          state_hash(world, current_names()) == resume->state_hash))
+      throw BadInput("--resume " + opt.resume + ": the engine state does not give the state the checkpoint hashed (t = " +
+                     fmt(resume->t) + " s); the checkpoint is damaged, or of another turtlegas: rerun from the start");
+  } else if (resume) {
     // The replay: the same run to the checkpoint's time, its events dropped, then the proof that
     // it is the same run.
     Limits to_checkpoint = limits;

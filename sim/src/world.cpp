@@ -24,6 +24,9 @@ World World::copy() const {
   impl->engine = impl_->engine->clone();
   return World(std::move(impl));
 }
+bool World::can_save_state() const { return impl_->engine->can_save_state(); }
+EngineState World::save_state() const { return impl_->engine->save_state(); }
+void World::restore_state(const EngineState& state) { impl_->engine->restore_state(state); }
 World::~World() = default;
 World::World(World&&) noexcept = default;
 World& World::operator=(World&&) noexcept = default;

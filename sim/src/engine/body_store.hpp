@@ -41,6 +41,7 @@ class BodyStore {
   std::size_t size() const { return body.size(); }
   /// The queue's nodes, one in each record (EventQueue::reset).
   EventQueue::Node* nodes() const { return size() > 0 ? &records_[0].node : nullptr; }
+  EventQueue::Node& node_at(std::size_t i) const { return records_[i].node; }
 
   Column<Body, body_of> body;
   Column<double, mass_of> mass;         ///< balls only

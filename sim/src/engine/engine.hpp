@@ -29,6 +29,7 @@
 //   cell_size.*, checks.hpp    the cell-size policy; energy and overlap
 //   exact_clock.hpp            cell crossings, exits, the rebase of internal time
 //   step_clock.hpp             the start and the end of one of the memo's steps
+//   saved_state.hpp            the engine's whole memory as plain data, and back (checkpoints)
 //   world_changes.hpp          spawn, remove, teleport: changes to a running world
 //   region.hpp                 the balls in a rectangle, from the cell lists
 //   rays.hpp                   ray casts (range sensors): the grid walked along a ray
@@ -125,6 +126,10 @@ class Engine final : public EngineBase {
     copy->arm_check();
     return copy;
   }
+  // A saved state (saved_state.hpp).
+  bool can_save_state() const override { return !kExtras; }
+  EngineState save_state() const override;
+  void restore_state(const EngineState& state) override;
   void set_impulse_log(std::vector<Impulse>* log) override { record_.impulses = log; }
   void set_event_limit(std::uint64_t limit) override {
     event_limit_ = limit;
@@ -694,6 +699,7 @@ void Engine<F, kBallBall, kStep, kExtras>::advance_to(double t) {
 #include "region.hpp"
 #include "rays.hpp"
 #include "step_clock.hpp"
+#include "saved_state.hpp"
 
 namespace turtlegas::sim::detail {
 

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "turtlegas/sim/engine_state.hpp"
 #include "turtlegas/sim/ray_cast.hpp"
 #include "turtlegas/sim/world.hpp"
 
@@ -18,6 +19,10 @@ class EngineBase {
   virtual void advance_to(double t) = 0;
   /// An exact copy of the whole engine (World::copy), logging nowhere.
   virtual std::unique_ptr<EngineBase> clone() const = 0;
+  /// World::can_save_state, save_state and restore_state (saved_state.hpp).
+  virtual bool can_save_state() const = 0;
+  virtual EngineState save_state() const = 0;
+  virtual void restore_state(const EngineState& state) = 0;
   virtual void set_event_log(std::vector<Event>* log) = 0;
   virtual void set_impulse_log(std::vector<Impulse>* log) = 0;
   virtual void set_event_limit(std::uint64_t limit) = 0;

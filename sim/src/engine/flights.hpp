@@ -223,6 +223,13 @@ struct GravityFlight {
     slides_[ball].wall = kNone;
     --sliding_;
   }
+  /// Every ball's slide, by ball index (a saved engine state, saved_state.hpp), and the same put back.
+  const std::vector<Slide>& slides() const { return slides_; }
+  void restore_slides(std::vector<Slide> slides) {
+    slides_ = std::move(slides);
+    sliding_ = 0;
+    for (const Slide& s : slides_) sliding_ += s.wall != kNone ? 1 : 0;
+  }
 
  private:
   std::vector<Slide> slides_;  ///< by ball index, grown at a ball's first slide

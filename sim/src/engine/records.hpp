@@ -60,6 +60,9 @@ class LastPartner {
   Partner kind() const { return static_cast<Partner>(code_ >> kIndexBits); }
   std::uint32_t index() const { return code_ & ((1u << kIndexBits) - 1); }
   bool operator==(const LastPartner&) const = default;
+  /// The packed bits, and a LastPartner from them (a saved engine state, saved_state.hpp).
+  std::uint32_t code() const { return code_; }
+  static constexpr LastPartner from_code(std::uint32_t code) { return LastPartner{code}; }
 
  private:
   explicit constexpr LastPartner(std::uint32_t code) : code_(code) {}

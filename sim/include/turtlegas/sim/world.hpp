@@ -15,6 +15,7 @@ namespace turtlegas::sim {
 
 struct Ray;
 struct RayHit;
+struct EngineState;
 
 /// Counters a run accumulates. Collisions are physical contacts; events also count internal
 /// bookkeeping (cell crossings, step boundaries, stale predictions).
@@ -164,6 +165,19 @@ class World {
   /// and the state the original would, bit for bit. The copy logs nowhere (set_event_log,
   /// set_impulse_log). Costs about what the engine holds (~300 bytes a ball).
   World copy() const;
+
+  /// Whether save_state can write this engine's memory down: a gas (balls, walls, fields), not a
+  /// scene with turtles, collision layers or moving walls (the engine's extras).
+  bool can_save_state() const;
+  /// The engine's whole memory as plain data (engine_state.hpp says what and why): a World built
+  /// from the same scene and mode that takes it with restore_state goes on exactly as this one
+  /// would, bit for bit. Throws std::logic_error when !can_save_state(). Costs about 100 bytes a body.
+  EngineState save_state() const;
+  /// Makes this World (built from the scene the state was saved from, in its mode, not advanced
+  /// since) the one that saved `state`. Throws std::invalid_argument, changing nothing, for a state
+  /// of another engine row, another number of bodies or walls, or links that do not hold together.
+  /// The logs, the event limit and the stop poll stay this World's.
+  void restore_state(const EngineState& state);
 
   /// Runs the physics until time t (seconds; t >= time()). Output at any t in both modes: in step
   /// mode a stop inside a step leaves the step's remaining events for the next call, so the
