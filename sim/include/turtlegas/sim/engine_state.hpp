@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "turtlegas/sim/vec2.hpp"
-#include "turtlegas/sim/world.hpp"
+#include "turtlegas/sim/world_stats.hpp"
 
 namespace turtlegas::sim {
 
