@@ -16,6 +16,7 @@
 #include "cli_common.hpp"
 #include "output_file.hpp"
 #include "turtlegas/formats/observables.hpp"
+#include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/file_error.hpp"
 
 namespace turtlegas::apps {
@@ -64,8 +65,14 @@ int check3d(const std::string& file, const world::World3File& w) {
   return exit_ok;
 }
 
-int run3d(const RunOptions& opt, const world::World3File& w) {
-  if (opt.mode && *opt.mode != "exact") throw BadInput("--mode step is not simulated in 3-D yet; use --mode exact");
+int run3d(const RunOptions& opt, const world::World3File& file) {
+  world::World3File w = file;
+  if (opt.mode) {
+    const std::optional<sim::Mode> mode = sim::mode_from_string(*opt.mode);
+    if (!mode) throw BadInput("--mode " + *opt.mode + ": exact or step");
+    w.def.mode = *mode;
+  }
+  if (opt.dt) w.def.dt = *opt.dt;
   for (const auto& [set, name] : {std::pair{!opt.svg.empty(), "--svg"},
                                   {!opt.record.empty(), "--record"}, {!opt.checkpoint.empty(), "--checkpoint"},
                                   {!opt.resume.empty(), "--resume"}, {!opt.inputs.empty(), "--inputs"}})
@@ -132,6 +139,7 @@ int run3d(const RunOptions& opt, const world::World3File& w) {
   }
   const double overlap = world->sphere_count() <= 4096 ? world->max_overlap_now() : 0.0;
   nlohmann::json stats{{"dimensions", 3},
+                       {"mode", std::string(sim::to_string(w.def.mode))},
                        {"collisions", world->collisions()},
                        {"events", world->events()},
                        {"wall_seconds", wall},
@@ -141,8 +149,8 @@ int run3d(const RunOptions& opt, const world::World3File& w) {
                        {"max_contact_error", world->max_contact_error()}};
   if (stats_file) stats_file->stream() << stats.dump(1) + "\n";
   if (opt.stats)
-    std::printf("3-D run to t = %g: %llu collisions, %llu events, energy %.15g -> %.15g, max overlap %.3g r, %.3f s\n",
-                world->time(), static_cast<unsigned long long>(world->collisions()),
+    std::printf("3-D %s run to t = %g: %llu collisions, %llu events, energy %.15g -> %.15g, max overlap %.3g r, %.3f s\n",
+                std::string(sim::to_string(w.def.mode)).c_str(), world->time(), static_cast<unsigned long long>(world->collisions()),
                 static_cast<unsigned long long>(world->events()), e0, world->energy(), std::max(overlap, 0.0), wall);
   if (observe_file) {
     observe_file->stream() << observer->result().dump(1) << '\n';

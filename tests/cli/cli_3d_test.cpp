@@ -83,6 +83,34 @@ TEST_CASE("check and run of worlds/gas3d_box.json") {
   CHECK(nlohmann::json::parse(read(dir.path / "st0.json"))["max_overlap"].get<double>() < 1e-9);
 }
 
+TEST_CASE("run --mode step of a 3-D world: the kick at each step's end, the floor met inside a step") {
+  // worlds/tests/fall_step3d.json's sphere (z_n = 9 - n (n - 1) / 128 at dt = 1/16): the floor at
+  // t = 2.03125 in step mode, t = 2 in exact mode (9 - 2 t^2 = 1); --dt halves the step.
+  TempDir dir;
+  struct Case { std::vector<std::string> mode; double t; const char* name; };
+  const Case cases[] = {{{"--mode", "step"}, 2.03125, "step"},
+                        {{"--mode", "exact"}, 2.0, "exact"},
+                        {{}, 2.0, "exact"},
+                        // dt = 1/32: z_n = 9 - n (n - 1) / 512; n = 64 (t = 2) gives z = 1.125, vz = -8.
+                        {{"--mode", "step", "--dt", "0.03125"}, 2.0 + 0.125 / 8, "step"}};
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"run", "worlds/tests/fall_step3d.json", "--until", "2.05", "--events",
+                                     (dir.path / "e.jsonl").string(), "--stats-json", (dir.path / "st.json").string()};
+    args.insert(args.end(), c.mode.begin(), c.mode.end());
+    const auto r = run(dir, args);
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    const auto e = nlohmann::json::parse(read(dir.path / "e.jsonl").substr(0, read(dir.path / "e.jsonl").find('\n')));
+    CHECK(e["b"] == "arena-z0");
+    CHECK(std::abs(e["t"].get<double>() - c.t) < 1e-12);
+    const auto st = nlohmann::json::parse(read(dir.path / "st.json"));
+    CHECK(st["mode"] == c.name);
+  }
+  const auto r = run(dir, {"run", "worlds/tests/fall_step3d.json", "--mode", "step", "--dt", "0", "--until", "1"});
+  CHECK(r.code == 2);
+  CHECK(contains(r.out + r.err, "--dt"));
+}
+
 TEST_CASE("3-D world file errors name the JSON path and the fix, exit 2") {
   TempDir dir;
   struct Case { const char* text; const char* says; };
@@ -157,7 +185,7 @@ TEST_CASE("test of 3-D worlds: the project's pass, and bad entries are errors at
       {R"([{"until": 1}, {"near": [1, 2], "who": "s", "within": 1}])", "/expect/1/near: expected [x, y, z]"},
       {R"([{"until": 1}, {"near": [1, 2, 3], "who": "nobody", "within": 1}])", "/expect/1/who: no ball has the id \"nobody\""},
       {R"([{"until": 1}, {"heading": 90, "who": "s"}])", "/expect/1: no assertion kind; a 3-D expectation names one of"},
-      {R"([{"until": 1}, {"mode": "step"}])", "/expect/1/mode: a 3-D world runs in exact mode only"},
+      {R"([{"until": 1}, {"mode": "fast"}])", "/expect/1/mode: mode must be \"exact\", \"step\" or \"both\""},
       {R"([{"until": 1}, {"count": "exit", "min": 1, "mx": 2}])", "/expect/1/mx: unknown key \"mx\" in a \"count\""},
       {R"([{"count": "exit", "min": 1}])", "no {\"until\": T}"},
   };

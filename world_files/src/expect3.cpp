@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/file_error.hpp"
 #include "turtlegas/world/json_read.hpp"
 
@@ -391,9 +392,9 @@ Expectations3 parse_expect3(std::string_view text, const std::string& file, cons
     if (kind == "mode") {
       keys({});
       const std::string m = p.rd().string(e["mode"], path + "/mode");
-      if (m != "exact")
-        p.fail(path + "/mode", "a 3-D world runs in exact mode only (step mode is not simulated in 3-D yet); "
-                               "give \"exact\" or drop the entry");
+      if (const auto mode = sim::mode_from_string(m)) out.modes = {*mode};
+      else if (m == "both") out.modes = {sim::Mode::exact, sim::Mode::step};
+      else p.fail(path + "/mode", "mode must be \"exact\", \"step\" or \"both\" (got \"" + m + "\")");
       continue;
     }
     if (kind == "event" || kind == "no_event" || kind == "count") {

@@ -48,6 +48,7 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
   std::uint64_t seed = 1;
   if (const json* s = rd.find(doc, "seed")) seed = rd.natural(*s, "/seed");
   sim::World3Def& def = out.def;
+  if (const json* d = rd.find(doc, "dt")) def.dt = rd.positive(*d, "/dt", "dt");  // step mode's step
 
   const json& arena = rd.require(doc, "", "arena", "a world file");
   rd.expect_object(arena, "/arena", "the arena");

@@ -50,7 +50,7 @@ json run_one_3d(const Spec& spec, const json& w, json line, const std::string& l
   } catch (const world::WorldFileError& e) {
     throw BadInput(e.what());
   }
-  if (spec.mode != sim::Mode::exact) throw BadInput(label + ": a 3-D world runs in exact mode only; drop \"mode\"");
+  f.def.mode = spec.mode;
   std::optional<sim::World3> world;
   try {
     world.emplace(f.def);
@@ -67,6 +67,7 @@ json run_one_3d(const Spec& spec, const json& w, json line, const std::string& l
     world->advance_to(spec.until);
   }
   line["stats"] = {{"dimensions", 3},
+                   {"mode", std::string(sim::to_string(f.def.mode))},
                    {"collisions", world->collisions()},
                    {"events", world->events()},
                    {"energy_start", e0},

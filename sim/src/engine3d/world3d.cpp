@@ -124,6 +124,7 @@ std::string check_world3(const World3Def& def) {
     if (!(def.size[a] > 0.0) || !std::isfinite(def.size[a])) return "the arena's width, height and depth must be finite and > 0";
   if (!is_finite(def.gravity) || !is_finite(def.electric)) return "gravity and electric must be finite";
   if (!(def.tc >= 0.0) || !std::isfinite(def.tc)) return "tc must be finite and >= 0";
+  if (def.mode == Mode::step && !(def.dt > 0.0 && std::isfinite(def.dt))) return "step mode's dt must be finite and > 0";
   for (std::size_t i = 0; i < def.spheres.size(); ++i) {
     const Sphere3Def& s = def.spheres[i];
     const std::string at = "sphere " + std::to_string(i) + ": ";
@@ -196,6 +197,12 @@ struct World3::Impl {
   bool inelastic = false;
   double tc = 0.0;
   std::vector<double> e_sphere, e_wall, last_change;
+  // Step mode with a field (World3Def::mode): the spheres fly straight (their records' a = 0) and
+  // take field_a dt at the end of each step; `steps` steps have ended. Empty in exact mode and
+  // without a field, where the two modes are one.
+  std::vector<Vec3> field_a;
+  double dt = 0.0;
+  std::uint64_t steps = 0;
 
   std::uint32_t cell_index(int cx, int cy, int cz) const {
     return static_cast<std::uint32_t>((cz * n[1] + cy) * n[0] + cx);
@@ -278,15 +285,40 @@ struct World3::Impl {
       b.x = s.pos;
       b.v = s.vel;
       b.a = def.gravity + (s.charge / s.mass) * def.electric;
+      if (def.mode == Mode::step && (b.a.x != 0.0 || b.a.y != 0.0 || b.a.z != 0.0)) {
+        field_a.resize(def.spheres.size());
+        field_a[i] = b.a;
+      }
       b.r = s.radius;
       b.m = s.mass;
       int k[3];
       for (int a = 0; a < 3; ++a) k[a] = std::clamp(static_cast<int>(std::floor(s.pos[a] / w[a])), 0, n[a] - 1);
       link(i, cell_index(k[0], k[1], k[2]));
     }
+    if (!field_a.empty()) {
+      dt = def.dt;
+      for (Record& b : rec) b.a = {};
+    }
     queue.reset(&rec[0].node, sizeof(Record), rec.size());
     for (std::uint32_t i = 0; i < rec.size(); ++i) predict(i);
   }
+
+  // Step mode: the end of step k, where every sphere takes its kick. Every count moves, so each
+  // pending pair contact is found stale when it comes up; every sphere is predicted anew.
+  void kick(double t) {
+    now = t;
+    for (Record& b : rec) {
+      if (!b.alive) continue;
+      bring(b, t);
+      ++b.count;
+    }
+    for (std::uint32_t i = 0; i < rec.size(); ++i) {
+      if (!rec[i].alive) continue;
+      rec[i].v += dt * field_a[i];
+      predict(i);
+    }
+  }
+  double step_end(std::uint64_t k) const { return static_cast<double>(k) * dt; }
 
   // The earliest cell exit of body b (at now) over the three axes.
   double cell_exit(const Record& b, std::uint8_t& axis, std::int8_t& dir) const {
@@ -589,14 +621,27 @@ struct World3::Impl {
     predict_strip(i, a, dir);
   }
 
-  void advance_to(double t) {
+  void serve_until(double t) {
     while (!queue.empty() && queue.top_key() <= t) {
       const std::uint32_t i = queue.top_id();
       now = queue.top_key();
       serve(i);
     }
+  }
+
+  void advance_to(double t) {
+    // Step mode: the contacts of a step (up to and at its end), then the kick.
+    if (!field_a.empty())
+      while (step_end(steps + 1) <= t) {
+        serve_until(step_end(steps + 1));
+        kick(step_end(++steps));
+      }
+    serve_until(t);
     now = t;
   }
+
+  // The acceleration the fields give sphere i (step mode keeps it beside the straight flight).
+  Vec3 accel(std::size_t i) const { return field_a.empty() ? rec[i].a : field_a[i]; }
 };
 
 World3::World3(const World3Def& def) {
@@ -634,7 +679,7 @@ double World3::kinetic_energy() const {
 double World3::energy() const {
   double e = kinetic_energy();
   for (std::size_t i = 0; i < impl_->rec.size(); ++i)
-    if (impl_->rec[i].alive) e -= impl_->rec[i].m * dot(impl_->rec[i].a, position(i));
+    if (impl_->rec[i].alive) e -= impl_->rec[i].m * dot(impl_->accel(i), position(i));
   return e;
 }
 Vec3 World3::momentum() const {

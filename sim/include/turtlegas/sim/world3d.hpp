@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "turtlegas/sim/vec3.hpp"
+#include "turtlegas/sim/world_def.hpp"
 
 namespace turtlegas::sim {
 
@@ -46,6 +47,12 @@ struct World3Def {
   /// than t_c ago collides elastically (the TC rule); a sphere pressed onto a wall feature by its
   /// acceleration leaves an inelastic bounce at least at |a_n| t_c / 2 (the rest threshold).
   double tc = 1e-4;
+  /// exact: parabolic flights under the fields, every contact at its exact time. step: the memo's
+  /// steps of dt (docs/physics.md, "3-D: step mode"): straight flights and every contact exact
+  /// within a step, the fields' kick v += a dt at each step's end (drift, then kick, as in 2-D).
+  /// Without a field the two modes are the same run.
+  Mode mode = Mode::exact;
+  double dt = 1.0 / 30.0;  ///< step mode's step, seconds (the world file's dt)
   std::vector<Sphere3Def> spheres;
   std::vector<Wall3Def> walls;  ///< with boundary walls, six more follow these (x0 x1 y0 y1 z0 z1)
 };

@@ -24,6 +24,7 @@ struct Expectations3 {
   bool present = false;  ///< the file had an `expect` key
   double until = -1.0;   ///< {"until": T}; < 0 when absent
   double dt = 1.0 / 30;  ///< the file's `dt`: the checks' step (inside, energy, max_overlap)
+  std::vector<sim::Mode> modes;  ///< {"mode": "exact"|"step"|"both"}; empty: the caller's choice (exact)
   std::vector<std::shared_ptr<const Assertion3>> entries;
 };
 
