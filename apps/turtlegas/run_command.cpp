@@ -108,6 +108,11 @@ void print_summary(const formats::RunFigures& run, const sim::World& world, cons
                 fmt(st.energy_folded).c_str());
   std::printf("  events       %llu  (cell crossings %llu, stale %llu, steps %llu)\n", ull(st.events),
               ull(st.cell_crossings), ull(st.stale), ull(st.steps));
+  if (run.resumed == "state")
+    std::printf("  resumed      from the engine state at t = %s s (its %llu collisions not simulated here)\n",
+                fmt(run.resumed_t).c_str(), ull(run.collisions_before));
+  else if (run.resumed == "replay")
+    std::printf("  resumed      by replaying the run to t = %s s (counted in the wall time)\n", fmt(run.resumed_t).c_str());
   if (run.check_seconds > 0.0)
     std::printf("  wall time    %.3f s  (%s collisions/s; the overlap self-check's %.3f s left out, docs/cli.md)\n",
                 run.wall_seconds, fmt(run.collisions_per_second(st)).c_str(), run.check_seconds);
@@ -357,6 +362,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   // turtles (which then owns the engine).
   std::optional<sim::World> bare;
   bool restored = false;  // resumed from the checkpoint's engine state, not replayed
+  std::uint64_t collisions_restored = 0;  // the restored engine's, not simulated here
   std::unique_ptr<turtle::WorldServer> server;
   std::shared_ptr<formats::ReplayInput> replay;
   if (!opt.inputs.empty()) {
@@ -435,6 +441,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
                        "); the checkpoint is damaged, or of another turtlegas: rerun from the start");
       }
       restored = true;
+      collisions_restored = world.stats().collisions();
     }
     world.set_event_log(&bare_events);
     stop_inside_steps(world, limits, start);
@@ -655,6 +662,11 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   run.check_seconds = check_seconds;
   run.energy_start = totals.energy_start;
   run.overlap_samples = samples;
+  if (resume) {
+    run.resumed = restored ? "state" : "replay";
+    run.resumed_t = resume->t;
+    run.collisions_before = collisions_restored;
+  }
   finish_run(run, world, server.get(), sampled);
 
   if (events_file) events_file->commit();

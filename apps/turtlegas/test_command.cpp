@@ -122,6 +122,34 @@ std::string read_text(const std::string& file) {
   return text.str();
 }
 
+/// One mode's run of a world's expect list, added to its outcome: the assertions, and each failure
+/// named by its mode when the world runs in both.
+void tally_mode(Outcome& o, std::string& failures, std::size_t assertions, const std::vector<std::string>& found,
+                sim::Mode mode, bool both) {
+  o.assertions += assertions;
+  for (const std::string& f : found) {
+    failures += failures.empty() ? "" : "; ";
+    if (both) failures += std::string(mode_name(mode)) + " mode: ";
+    failures += f;
+  }
+}
+
+/// The outcome of a world whose modes all ran: failed with their failures, or passed with a summary.
+Outcome finish_modes(Outcome o, const std::string& failures, Clock::time_point start, bool both, bool three_d) {
+  o.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (!failures.empty()) {
+    o.status = Outcome::Status::fail;
+    o.message = failures;
+    return o;
+  }
+  o.status = Outcome::Status::pass;
+  char line[160];
+  std::snprintf(line, sizeof line, "(%s%s%zu assertion%s, %.2f s)", three_d ? "3-D, " : "", both ? "exact and step, " : "",
+                o.assertions, o.assertions == 1 ? "" : "s", o.seconds);
+  o.message = line;
+  return o;
+}
+
 /// Runs one 3-D world ("dimensions": 3) against its `expect` list (world/expect3.hpp).
 Outcome test_one_3d(const std::string& file, const tw::World3File& world3, const TestOptions& options) {
   Outcome o;
@@ -184,25 +212,9 @@ Outcome test_one_3d(const std::string& file, const tw::World3File& world3, const
     }
     events_before += events;
     ++at.part;
-    o.assertions += r.assertions;
-    for (const std::string& f : r.failures) {
-      failures += failures.empty() ? "" : "; ";
-      if (modes.size() > 1) failures += std::string(mode_name(mode)) + " mode: ";
-      failures += f;
-    }
+    tally_mode(o, failures, r.assertions, r.failures, mode, modes.size() > 1);
   }
-  o.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  if (!failures.empty()) {
-    o.status = Outcome::Status::fail;
-    o.message = failures;
-    return o;
-  }
-  o.status = Outcome::Status::pass;
-  char line[160];
-  std::snprintf(line, sizeof line, "(3-D, %s%zu assertion%s, %.2f s)", modes.size() > 1 ? "exact and step, " : "",
-                o.assertions, o.assertions == 1 ? "" : "s", o.seconds);
-  o.message = line;
-  return o;
+  return finish_modes(o, failures, start, modes.size() > 1, true);
 }
 
 /// Runs one world in this process: the child's whole job.
@@ -274,25 +286,9 @@ Outcome test_one(const std::string& file, const TestOptions& options, const turt
     }
     events_before += events;
     ++at.part;
-    o.assertions += r.assertions;
-    for (const std::string& f : r.failures) {
-      failures += failures.empty() ? "" : "; ";
-      if (modes.size() > 1) failures += std::string(mode_name(mode)) + " mode: ";
-      failures += f;
-    }
+    tally_mode(o, failures, r.assertions, r.failures, mode, modes.size() > 1);
   }
-  o.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  if (!failures.empty()) {
-    o.status = Outcome::Status::fail;
-    o.message = failures;
-    return o;
-  }
-  o.status = Outcome::Status::pass;
-  char line[160];
-  std::snprintf(line, sizeof line, "(%s%zu assertion%s, %.2f s)", modes.size() > 1 ? "exact and step, " : "",
-                o.assertions, o.assertions == 1 ? "" : "s", o.seconds);
-  o.message = line;
-  return o;
+  return finish_modes(o, failures, start, modes.size() > 1, false);
 }
 
 /// The child's side: runs its world, writes the outcome as one JSON line on descriptor 3.

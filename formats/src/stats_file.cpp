@@ -73,6 +73,7 @@ nlohmann::json stats_json(const RunFigures& run, const sim::World& world) {
       {"overlap_samples", run.overlap_samples},
   };
   if (!run.stopped.empty()) j["stopped"] = run.stopped;
+  if (!run.resumed.empty()) j["resumed"] = {{"from", run.resumed}, {"t", run.resumed_t}, {"collisions", run.collisions_before}};
   j["energy_rules"] = energy_rules_json(run, world);
   return j;
 }

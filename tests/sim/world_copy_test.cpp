@@ -6,9 +6,9 @@
 // rebase of its internal time) and step mode.
 #include <catch2/catch.hpp>
 
-#include <cstring>
 #include <vector>
 
+#include "same_bits.hpp"
 #include "scenes.hpp"
 #include "turtlegas/sim/world.hpp"
 
@@ -16,25 +16,12 @@ namespace {
 
 using namespace turtlegas;
 using turtlegas::test::random_gas;
-
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
-bool same_events(const std::vector<sim::Event>& a, const std::vector<sim::Event>& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (!same_bits(a[i].t, b[i].t) || a[i].kind != b[i].kind || a[i].a != b[i].a || a[i].b != b[i].b) return false;
-  return true;
-}
+using turtlegas::test::same_balls;
+using turtlegas::test::same_bits;
+using turtlegas::test::same_events;
 
 bool same_state(const sim::World& x, const sim::World& y) {
-  if (x.ball_count() != y.ball_count() || !same_bits(x.time(), y.time())) return false;
-  for (std::size_t i = 0; i < x.ball_count(); ++i) {
-    const sim::BallState a = x.ball(i), b = y.ball(i);
-    if (a.alive != b.alive || !same_bits(a.pos.x, b.pos.x) || !same_bits(a.pos.y, b.pos.y) ||
-        !same_bits(a.vel.x, b.vel.x) || !same_bits(a.vel.y, b.vel.y))
-      return false;
-  }
-  return x.stats().events == y.stats().events;
+  return same_balls(x, y) && x.stats().events == y.stats().events;
 }
 
 /// Returns the events the original took.

@@ -44,13 +44,21 @@ struct RunFigures {
   double max_overlap_relative = 0.0;  ///< of the smaller radius
   /// Instants of the run (besides every contact and the end) the overlap was measured at.
   std::uint64_t overlap_samples = 0;
+  /// A resumed run (--resume): "state" when it went on from the checkpoint's engine state,
+  /// "replay" when it simulated the run again up to the checkpoint; empty otherwise.
+  std::string resumed;
+  double resumed_t = 0.0;  ///< seconds: the checkpoint's time
+  /// Collisions the run had at the checkpoint, when this process took it over from an engine
+  /// state without simulating them: not counted in collisions_per_second.
+  std::uint64_t collisions_before = 0;
   /// The id of ball i, for the per-body lines of `energy_rules` (absent: "#i", its index).
   std::function<std::string(std::size_t)> ball_name;
-  /// Collisions per wall-clock second of simulation: the self-check's time left out (0 for a run
-  /// that took no measurable time).
+  /// Collisions per wall-clock second of simulation: the self-check's time left out, and the
+  /// collisions a resumed run took over from its checkpoint's engine state (0 for a run that took
+  /// no measurable time).
   double collisions_per_second(const sim::Stats& st) const {
     const double simulating = wall_seconds - check_seconds;
-    return simulating > 0.0 ? static_cast<double>(st.collisions()) / simulating : 0.0;
+    return simulating > 0.0 ? static_cast<double>(st.collisions() - collisions_before) / simulating : 0.0;
   }
 };
 
