@@ -391,6 +391,46 @@ TEST_CASE("a wall pen on an arc lays the chords of one lap, closed; others colli
   CHECK(hit);
 }
 
+TEST_CASE("an arc of exactly one lap ends where it began, and its pens draw and lay the whole circle", "[runtime][arc][pen]") {
+  // The closed form brings a 360-degree arc back to its start exactly: the pens must not take
+  // that for a stroke of no length (before, a lap laid no wall and drew no line).
+  OneTurtle line([](Turtle& t) {
+    t.pen_down();
+    t.arc(100, 360);
+  });
+  line->run_until(30);
+  const auto trail = line->turtle(0).trail;
+  REQUIRE(line->turtle(0).state.pos == sim::Vec2{200, 200});
+  // The start, then 32 chords of 0.2 rad (one more vertex when the lap's turn comes out past 2 pi
+  // by round-off: the rest of the turn past the lap, a chord of almost no length).
+  REQUIRE(trail.size() >= 33);
+  REQUIRE(trail.size() <= 34);
+  CHECK(trail.back() == sim::Vec2{200, 200});
+  for (const auto& v : trail) CHECK(std::abs(norm(v - sim::Vec2{300, 200}) - 100) <= 1e-9);
+  for (std::size_t k = 0; k + 1 < trail.size(); ++k) CHECK(norm(trail[k + 1] - trail[k]) <= 2 * 100 * std::sin(0.1) + 1e-9);
+
+  sim::WorldDef d = wide();
+  d.turtles.push_back(body("t", {200, 200}, 0));
+  Registry r = base_registry();
+  r.add("p", [](Turtle& t, const Params&) {
+    t.pen_down(PenMode::wall);
+    t.arc(100, 360);
+  });
+  TurtleProgram p;
+  p.controller = "p";
+  p.builder = true;
+  WorldServer s(d, {p}, r);
+  s.run_until(30);
+  std::size_t laid = 0;
+  for (const auto& w : s.world().walls())
+    if (w.id.rfind("t-w", 0) == 0) {
+      ++laid;
+      CHECK(std::abs(norm(w.from - sim::Vec2{300, 200}) - 100) <= 1e-9);
+      CHECK(std::abs(norm(w.to - sim::Vec2{300, 200}) - 100) <= 1e-9);
+    }
+  CHECK(laid == 32);
+}
+
 TEST_CASE("the script controller drives arcs, drive and wheels", "[runtime][arc]") {
   sim::WorldDef d = arena();
   d.turtles.push_back(body("t", {200, 200}, 0));

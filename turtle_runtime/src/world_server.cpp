@@ -126,7 +126,8 @@ void WorldServer::Impl::finish_command(Agent& a) {
   const sim::TurtleState s = world.turtle(a.index);
   const bool arc = a.waiting_on == sim::TurtleCommand::Kind::arc;
   if (a.waiting_on == sim::TurtleCommand::Kind::move || arc) a.odometer += s.done;  // an arc's: along it
-  if (arc && (a.pen_down || a.lays_wall) && s.pos != a.stroke_start) [[unlikely]] {
+  // (An arc's length, not where it ended: a whole lap ends exactly where it began.)
+  if (arc && (a.pen_down || a.lays_wall) && s.done != 0.0) [[unlikely]] {
     pen_arc(a, s);
   } else {
     if (a.pen_down) a.trail.push_back(s.pos);
