@@ -56,6 +56,7 @@ std::span<const WorldHost::Handler> WorldHost::handlers() {
       {"yield", A::controller, false, &WorldHost::on_command},
       {"pen", A::controller, false, &WorldHost::on_command},
       {"sense", A::controller, false, &WorldHost::on_command},
+      {"camera", A::controller, false, &WorldHost::on_command},
       {"arc", A::controller, false, &WorldHost::on_command},
       {"drive", A::controller, false, &WorldHost::on_command},
       {"wheels", A::controller, false, &WorldHost::on_command},
