@@ -36,7 +36,7 @@ struct WorldHost::Handler {
 std::span<const WorldHost::Handler> WorldHost::handlers() {
   using A = Access;
   // In docs/protocol.md's order (an unknown type's error lists them so).
-  static constexpr std::array<Handler, 36> table = {{
+  static constexpr std::array<Handler, 37> table = {{
       {"hello", A::anyone, true, &WorldHost::on_hello},
       {"subscribe", A::viewer, true, &WorldHost::on_subscribe},
       {"unsubscribe", A::viewer, true, &WorldHost::on_unsubscribe},
