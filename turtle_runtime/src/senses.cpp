@@ -105,8 +105,7 @@ void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& 
       hits += "null";
       if (sensor->camera) r.colour = sensor->background;
     }
-    // Colours are "#rrggbb" (the loader and set_colours' callers write them so): no escaping.
-    if (sensor->camera) colours += "\"" + r.colour + "\"";
+    if (sensor->camera) colours += nlohmann::json(r.colour).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     out.push_back(std::move(r));
   }
   LogEvent e;
