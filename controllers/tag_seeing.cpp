@@ -8,15 +8,14 @@
 // (Turtle::uniform) for the blind legs.
 //   params: declared in tag_seeing_info() below (`turtlegas controllers` lists them)
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "tag_common.hpp"
-#include "turtlegas/turtle/colours.hpp"
 #include "turtlegas/turtle/registry.hpp"
 #include "turtlegas/turtle/turtle.hpp"
 
@@ -25,11 +24,12 @@ namespace turtlegas::controllers {
 void tag_seeing(turtle::Turtle& t, const turtle::Params& p) {
   const std::string camera = p.get<std::string>("camera");
   std::string prey = p.get<std::string>("prey");
-  if (!prey.empty()) {
-    const std::optional<std::string> c = turtle::parse_colour(prey);
-    if (!c) throw std::invalid_argument("tag_seeing: prey must be a colour, \"#rrggbb\" or a name such as \"red\" (got \"" + prey + "\")");
-    prey = *c;
-  }
+  // Cameras read "#rrggbb" in lower case (a controller sees the controller API only, not the
+  // loader's colour names).
+  for (char& c : prey) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (!prey.empty() && (prey.size() != 7 || prey[0] != '#' ||
+                        !std::all_of(prey.begin() + 1, prey.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)) != 0; })))
+    throw std::invalid_argument("tag_seeing: prey must be a colour \"#rrggbb\", e.g. \"#e15759\" (got \"" + prey + "\")");
   const double step = p.get<double>("step");
   const double search = p.get<double>("search");
   const double leg = p.get<double>("leg");
@@ -84,7 +84,7 @@ turtle::ControllerInfo tag_seeing_info() {
   turtle::ControllerInfo info;
   info.summary = "tag: when it, steer at the nearest turtle its camera sees; else keep still";
   info.params = {turtle::string_param("camera", "eye", {}, "the turtle's line camera (a \"camera\" under its \"senses\")"),
-                 turtle::string_param("prey", "", {}, "chase only turtles of this colour (\"#rrggbb\" or a name); \"\": any"),
+                 turtle::string_param("prey", "", {}, "chase only turtles of this colour, \"#rrggbb\"; \"\": any"),
                  turtle::number_param("step", 60.0, 1e-9, inf, "the longest drive towards a turtle in view before looking again, units"),
                  turtle::number_param("search", 45.0, 1e-9, 360.0, "the turn on the spot when nobody is in view, degrees"),
                  turtle::number_param("leg", 300.0, 0, inf, "the blind sweeping leg after a whole turn with nobody seen, units"),
