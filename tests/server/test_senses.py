@@ -18,7 +18,7 @@ from turtlegas_client import ServerError, World
 def drive(w):
     t = w.claim("t1")
     check([(x["name"], x["bearings"], x["range"]) for x in t.senses] ==
-          [("front", [0], 500), ("ring", [0, 90, 180, 270], 160), ("eye", [-40, 0, 40], 220)],
+          [("front", [0], 500), ("ring", [0, 90, 180, 270], 160), ("eye", [-40, 0, 40], 180)],
           "the claimed reply lists the range sensors: %r" % t.senses)
     check([x.get("camera", False) for x in t.senses] == [False, False, True], "and marks the camera: %r" % t.senses)
     w.resume()
@@ -47,7 +47,7 @@ def drive(w):
     check([p.bearing for p in eye] == [-40, 0, 40], "the pixels' bearings: %r" % eye)
     check([p.colour for p in eye] == ["#ffffff", "#ff0000", "#ffffff"], "white, red, white: %r" % eye)
     check(eye[1].what == "target" and abs(eye[1].distance - 150) < 1e-9, "the target at 150: %r" % eye)
-    check(not eye[0].hit and math.isinf(eye[0].distance) and eye[0].what is None, "nothing within 220: %r" % eye[0])
+    check(not eye[0].hit and math.isinf(eye[0].distance) and eye[0].what is None, "nothing within 180: %r" % eye[0])
     check(t.sense("front")[0].colour is None, "a range sensor's readings have no colour")
     try:
         t.camera("ring")
