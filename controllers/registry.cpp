@@ -20,6 +20,8 @@ void tag_random(turtle::Turtle&, const turtle::Params&);
 turtle::ControllerInfo tag_random_info();
 void tag_camera(turtle::Turtle&, const turtle::Params&);
 turtle::ControllerInfo tag_camera_info();
+void tag_seeing(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo tag_seeing_info();
 void braitenberg(turtle::Turtle&, const turtle::Params&);
 turtle::ControllerInfo braitenberg_info();
 
@@ -33,6 +35,7 @@ turtle::Registry builtin_registry() {
   r.add("tag_evader", tag_evader, tag_evader_info());
   r.add("tag_random", tag_random, tag_random_info());
   r.add("tag_camera", tag_camera, tag_camera_info());
+  r.add("tag_seeing", tag_seeing, tag_seeing_info());
   r.add("braitenberg", braitenberg, braitenberg_info());
   return r;
 }

@@ -98,19 +98,25 @@ class Result:
 class Reading:
     """One ray of a range sensor, as Reading in turtle.hpp: distance (world units from the turtle's
     centre; math.inf when nothing is within range), bearing (degrees clockwise from the heading),
-    what (an id) and kind ("wall", "wall-end", "ball", "turtle"; None when nothing is hit)."""
+    what (an id) and kind ("wall", "wall-end", "ball", "turtle"; None when nothing is hit); a
+    camera's pixel also has colour ("#rrggbb" of what it hit, or the camera's background; None for
+    a range sensor that is no camera)."""
 
     def __init__(self, d):
         self.bearing = d["bearing"]
         self.distance = d["distance"] if d.get("distance") is not None else float("inf")
         self.what = d.get("what")
         self.kind = d.get("kind")
+        self.colour = d.get("colour")
 
     @property
     def hit(self):
         return self.kind is not None
 
     def __repr__(self):
+        if self.colour is not None:
+            return "Reading(bearing=%g, distance=%g, what=%r, colour=%r)" % (
+                self.bearing, self.distance, self.what, self.colour)
         return "Reading(bearing=%g, distance=%g, what=%r)" % (self.bearing, self.distance, self.what)
 
 
@@ -682,6 +688,13 @@ class RemoteTurtle:
         """Reads range sensor `sensor` (the turtle's "senses" in the world file) at the next control
         boundary, taking no simulated time: a list of Reading, one per ray, as Turtle::scan."""
         r = self._command({"type": "sense", "sensor": sensor})
+        return [Reading(d) for d in r.reply.get("readings", [])]
+
+    def camera(self, sensor):
+        """Reads line camera `sensor` (a "camera" under the turtle's "senses") at the next control
+        boundary, taking no simulated time: a list of Reading, one per pixel left to right, each
+        with its colour, as Turtle::camera."""
+        r = self._command({"type": "camera", "sensor": sensor})
         return [Reading(d) for d in r.reply.get("readings", [])]
 
     @property

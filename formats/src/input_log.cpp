@@ -82,7 +82,7 @@ std::string input_command_line(std::uint64_t step, std::string_view turtle, cons
   }
   if (c.kind == turtle::RemoteCommand::Kind::pen_down)
     members += c.pen == turtle::PenMode::wall ? ", \"mode\": \"wall\"" : ", \"mode\": \"line\"";
-  if (c.kind == turtle::RemoteCommand::Kind::sense) {
+  if (c.kind == turtle::RemoteCommand::Kind::sense || c.kind == turtle::RemoteCommand::Kind::camera) {
     members += ", \"sensor\": ";
     append_json_string(members, c.sensor);
   }
@@ -208,7 +208,7 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
       if (j.contains("turtle")) {
         const std::size_t i = index_of(j.at("turtle").get<std::string>(), line, "turtle");
         const auto kind = turtle::remote_command_kind(j.at("command").get<std::string>());
-        if (!kind) fail("/command: not a command (forward, back, left, right, wait, yield, pen_up, pen_down, sense, arc, drive, wheels)");
+        if (!kind) fail("/command: not a command (forward, back, left, right, wait, yield, pen_up, pen_down, sense, arc, drive, wheels, camera)");
         turtle::RemoteCommand c;
         c.kind = *kind;
         if (turtle::takes_amount(c.kind)) {
@@ -222,7 +222,8 @@ ReplayInput::ReplayInput(std::istream& in, const sim::WorldDef& def, std::string
         }
         if (c.kind == turtle::RemoteCommand::Kind::pen_down)
           c.pen = j.value("mode", std::string("line")) == "wall" ? turtle::PenMode::wall : turtle::PenMode::line;
-        if (c.kind == turtle::RemoteCommand::Kind::sense) c.sensor = j.at("sensor").get<std::string>();
+        if (c.kind == turtle::RemoteCommand::Kind::sense || c.kind == turtle::RemoteCommand::Kind::camera)
+          c.sensor = j.at("sensor").get<std::string>();
         commands_[i].push_back({step, c});
       } else if (j.contains("takeover")) {
         Change c = change(Change::Kind::takeover);

@@ -47,7 +47,7 @@ py::object touch_object(const py::object& progs, const turtle::Touch& t) {
 }
 
 py::object reading_object(const py::object& progs, const turtle::Reading& r) {
-  return progs.attr("Reading")(r.distance, r.bearing, r.what, r.kind);
+  return progs.attr("Reading")(r.distance, r.bearing, r.what, r.kind, r.colour);
 }
 
 /// The Python objects of one running program, let go with the GIL held however the program ends
@@ -168,12 +168,13 @@ void run(Programs& programs, turtle::Turtle& t, const turtle::Params& p) {
     else if (c.kind == "pen_up") t.pen_up();
     else if (c.kind == "pen_down") t.pen_down(c.pen);
     else if (c.kind == "sense") t.scan(c.sensor, readings);
+    else if (c.kind == "camera") t.camera(c.sensor, readings);
     else throw std::logic_error("programs.py made an unknown command '" + c.kind + "'");
     py::gil_scoped_acquire gil;
     if (result) {
       held.answer = held.progs.attr("Result")(result->done(),
                                               result->touched() ? touch_object(held.progs, result->touch()) : py::none());
-    } else if (c.kind == "sense") {
+    } else if (c.kind == "sense" || c.kind == "camera") {
       py::list rays;
       for (const turtle::Reading& r : readings) rays.append(reading_object(held.progs, r));
       held.answer = c.first ? (rays.empty() ? py::none() : py::object(rays[0])) : py::object(rays);

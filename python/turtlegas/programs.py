@@ -47,10 +47,11 @@ class Touch(collections.namedtuple("Touch", "sensors bearing what kind t")):
     left = property(lambda self: "left" in self.sensors)
 
 
-class Reading(collections.namedtuple("Reading", "distance bearing what kind")):
+class Reading(collections.namedtuple("Reading", "distance bearing what kind colour", defaults=("",))):
     """One ray of a range sensor: the distance to what it met (inf when nothing is within range),
     the ray's bearing (degrees clockwise from the heading), the id and kind of what it hit ("" when
-    nothing)."""
+    nothing); for a camera's pixel the colour ("#rrggbb") of what it hit, or the camera's background
+    ("" for a range sensor that is no camera)."""
 
     __slots__ = ()
     hit = property(lambda self: self.kind != "")
@@ -86,8 +87,8 @@ class Command:
         self.steer = tuple(float(x) for x in steer)  # arc, drive, wheels: their numbers
 
     def __repr__(self):
-        if self.kind == "sense":
-            return "Command(sense %r)" % self.sensor
+        if self.kind in ("sense", "camera"):
+            return "Command(%s %r)" % (self.kind, self.sensor)
         if self.steer:
             return "Command(%s %s)" % (self.kind, ", ".join(repr(x) for x in self.steer))
         return "Command(%s %r)" % (self.kind, self.amount)
@@ -106,7 +107,7 @@ class Turtle:
 
     # Commands: yield them. The yield's value is a Result for forward, back, left, right, wait, arc,
     # drive and wheels;
-    # a list of Readings for scan; one Reading for range; None for yield_, pen_up and pen_down.
+    # a list of Readings for scan and camera; one Reading for range; None for yield_, pen_up and pen_down.
     def forward(self, distance):
         return Command("forward", distance)
 
@@ -154,6 +155,11 @@ class Turtle:
     def range(self, sensor):
         """The sensor's first ray, read now: a Reading."""
         return Command("sense", sensor=sensor, first=True)
+
+    def camera(self, sensor):
+        """Every pixel of the line camera, left to right, read now (no time passes): a list of
+        Readings with their colours, as Turtle::camera."""
+        return Command("camera", sensor=sensor)
 
     # Handlers, run by the runtime as the program resumes (touches first, then messages), before
     # the command they interrupted returns.

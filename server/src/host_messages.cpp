@@ -36,7 +36,7 @@ struct WorldHost::Handler {
 std::span<const WorldHost::Handler> WorldHost::handlers() {
   using A = Access;
   // In docs/protocol.md's order (an unknown type's error lists them so).
-  static constexpr std::array<Handler, 36> table = {{
+  static constexpr std::array<Handler, 37> table = {{
       {"hello", A::anyone, true, &WorldHost::on_hello},
       {"subscribe", A::viewer, true, &WorldHost::on_subscribe},
       {"unsubscribe", A::viewer, true, &WorldHost::on_unsubscribe},
@@ -56,6 +56,7 @@ std::span<const WorldHost::Handler> WorldHost::handlers() {
       {"yield", A::controller, false, &WorldHost::on_command},
       {"pen", A::controller, false, &WorldHost::on_command},
       {"sense", A::controller, false, &WorldHost::on_command},
+      {"camera", A::controller, false, &WorldHost::on_command},
       {"arc", A::controller, false, &WorldHost::on_command},
       {"drive", A::controller, false, &WorldHost::on_command},
       {"wheels", A::controller, false, &WorldHost::on_command},

@@ -112,6 +112,7 @@ void WorldHost::on_command(ClientState& c, const json& m, const std::string& typ
   require_live();
   const std::string ex = "{\"type\": \"" + type + "\", \"turtle\": \"t1\"" +
                          (type == "pen" ? ", \"down\": true}" : type == "yield" ? "}" : type == "sense" ? ", \"sensor\": \"ir\"}"
+                          : type == "camera" ? ", \"sensor\": \"cam\"}"
                           : type == "arc" ? ", \"radius\": 50, \"degrees\": 90}" : type == "drive" ? ", \"v\": 20, \"omega\": 45, \"seconds\": 2}"
                           : type == "wheels" ? ", \"left\": 20, \"right\": 10, \"seconds\": 2}" : ", \"amount\": 100}");
   const std::size_t i = turtle_index(m, ex.c_str());
@@ -122,18 +123,21 @@ void WorldHost::on_command(ClientState& c, const json& m, const std::string& typ
     throw RequestError("unknown_turtle", "/turtle: '" + tid + "' is no longer in the world (removed, crushed or out of an open arena)", "/turtle");
   if (s.owner != c.client->id)
     throw RequestError("not_claimed", "/turtle: claim '" + tid + "' first: {\"type\": \"claim\", \"turtle\": \"" + tid + "\"}", "/turtle");
-  if (cmd.kind == turtle::RemoteCommand::Kind::sense && i < scene_.programs.size()) {
-    // Refused here rather than faulting the turtle's program, as Turtle::scan would throw.
+  const bool camera = cmd.kind == turtle::RemoteCommand::Kind::camera;
+  if ((cmd.kind == turtle::RemoteCommand::Kind::sense || camera) && i < scene_.programs.size()) {
+    // Refused here rather than faulting the turtle's program, as Turtle::scan (camera) would throw.
     std::string names;
     bool found = false;
     for (const turtle::RangeSensor& r : scene_.programs[i].senses) {
+      if (camera && !r.camera) continue;
       found = found || r.name == cmd.sensor;
       names += (names.empty() ? "" : ", ") + r.name;
     }
     if (!found)
-      throw RequestError("bad_value", "/sensor: '" + tid + "' has no range sensor \"" + cmd.sensor + "\"" +
+      throw RequestError("bad_value", "/sensor: '" + tid + "' has no " + (camera ? "camera" : "range sensor") + " \"" +
+                                          cmd.sensor + "\"" +
                                           (names.empty() ? std::string("; declare it under the turtle's \"senses\" in the world file")
-                                                         : "; its senses: " + names),
+                                                         : (camera ? "; its cameras: " : "; its senses: ") + names),
                          "/sensor");
   }
   if (s.busy)

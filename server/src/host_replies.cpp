@@ -46,8 +46,11 @@ json WorldHost::sensors_json(std::size_t i) const {
 
 json WorldHost::senses_json(std::size_t i) const {
   json senses = json::array();  // range sensors: the viewer draws their rays (docs/viewer.md)
-  for (const turtle::RangeSensor& r : scene_.programs[i].senses)
-    senses.push_back({{"name", r.name}, {"bearings", r.bearings}, {"range", r.range}});
+  for (const turtle::RangeSensor& r : scene_.programs[i].senses) {
+    json s = {{"name", r.name}, {"bearings", r.bearings}, {"range", r.range}};
+    if (r.camera) s["camera"] = true;  // its pixels' bearings; read with the `camera` message
+    senses.push_back(std::move(s));
+  }
   return senses;
 }
 

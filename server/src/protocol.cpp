@@ -121,6 +121,11 @@ turtle::RemoteCommand read_command(const json& m, std::string_view type) {
     c.sensor = string_field(m, "sensor", R"({"type": "sense", "turtle": "t1", "sensor": "ir"})");
     return c;
   }
+  if (type == "camera") {
+    c.kind = K::camera;
+    c.sensor = string_field(m, "sensor", R"({"type": "camera", "turtle": "t1", "sensor": "cam"})");
+    return c;
+  }
   c.kind = *turtle::remote_command_kind(type);
   if (const auto keys = turtle::steer_keys(c.kind); !keys.empty()) {
     // arc, drive, wheels: named numbers, as Turtle::arc, drive and wheels take them.
@@ -245,8 +250,9 @@ std::string report_text(const turtle::RemoteReport& r, std::string_view turtle_i
         out += id.dump(-1, ' ', false, json::error_handler_t::replace);
         out += ',';
       }
-      if (r.command.kind == turtle::RemoteCommand::Kind::sense) {
+      if (r.command.kind == turtle::RemoteCommand::Kind::sense || r.command.kind == turtle::RemoteCommand::Kind::camera) {
         // Every ray, as Turtle::scan reads it: distance null past the range, what and kind then null too.
+        // A camera's pixels (Turtle::camera) also carry their colour, the background's past the range.
         append_key(out, "readings");
         out += '[';
         for (std::size_t k = 0; k < r.readings.size(); ++k) {
@@ -254,6 +260,10 @@ std::string report_text(const turtle::RemoteReport& r, std::string_view turtle_i
           if (k > 0) out += ',';
           out += "{\"bearing\":";
           append_double(out, rd.bearing);
+          if (!rd.colour.empty()) {
+            out += ",\"colour\":";
+            formats::append_json_string(out, rd.colour);
+          }
           out += ",\"distance\":";
           if (rd.hit()) append_double(out, rd.distance);
           else out += "null";

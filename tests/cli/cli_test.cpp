@@ -392,7 +392,7 @@ TEST_CASE("cli: turtle input errors exit with 2 and say why") {
                                                      : run(dir, {"check", w.string()});
       CHECK(r.code == 2);
       CHECK(contains(r.err, w.string() + ": /turtles/1/controller: controller 'wandr' is not registered; known: braitenberg, mirror, script, "
-                                         "spiral, square, tag_camera, tag_chaser, tag_evader, tag_random, wall_follower, wander; "
+                                         "spiral, square, tag_camera, tag_chaser, tag_evader, tag_random, tag_seeing, wall_follower, wander; "
                                          "did you mean 'wander'?"));
     }
   }

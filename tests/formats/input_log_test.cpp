@@ -40,6 +40,11 @@ TEST_CASE("input log: the header and every kind of line, byte for byte") {
   drive.steer = {-20, 45, 0.5};
   CHECK(formats::input_command_line(6, "t1", drive) ==
         "{\"step\": 6, \"turtle\": \"t1\", \"command\": \"drive\", \"v\": -20, \"omega\": 45, \"seconds\": 0.5}\n");
+  turtle::RemoteCommand camera;
+  camera.kind = turtle::RemoteCommand::Kind::camera;
+  camera.sensor = "eye";
+  CHECK(formats::input_command_line(8, "t1", camera) ==
+        "{\"step\": 8, \"turtle\": \"t1\", \"command\": \"camera\", \"sensor\": \"eye\"}\n");
   turtle::RemoteCommand yield;
   CHECK(formats::input_command_line(3, "t3", yield) == "{\"step\": 3, \"turtle\": \"t3\", \"command\": \"yield\"}\n");
 

@@ -155,6 +155,32 @@ class ProtocolTest(unittest.TestCase):
         self.assertEqual(kinds.count("touch"), 1)
         self.assertEqual(kinds.count("sense"), 2)
 
+    def test_camera(self):
+        # Two pixels over 20 degrees (bearings -5 and 5) see a red ball of radius 5 whose centre is
+        # 50 ahead: b - sqrt(r^2 - c^2) with b = 50 cos 5deg, c = 50 sin 5deg; a range sensor's
+        # readings have no colour.
+        room = {"format": "turtlegas-world/1", "arena": {"width": 200, "height": 200, "boundary": "walls"},
+                "balls": [{"id": "b", "pos": [150, 100], "radius": 5, "colour": "Red"}],
+                "turtles": [{"id": "t", "pos": [100, 100], "heading": 90,
+                             "senses": [{"name": "eye", "camera": {"pixels": 2, "fov": 20, "range": 500}},
+                                        {"name": "ir", "range": 500}]}]}
+        seen = {}
+
+        def program(t, p):
+            seen["eye"] = yield t.camera("eye")
+            seen["ir"] = yield t.scan("ir")
+
+        w = turtlegas.World.load(room, programs={"t": program})
+        w.run(1)
+        a = math.radians(5)
+        expected = 50 * math.cos(a) - math.sqrt(25 - (50 * math.sin(a)) ** 2)
+        self.assertEqual([r.bearing for r in seen["eye"]], [-5, 5])
+        for r in seen["eye"]:
+            self.assertEqual((r.what, r.kind, r.colour), ("b", "ball", "#ff0000"))
+            self.assertAlmostEqual(r.distance, expected, delta=1e-12)
+        self.assertEqual(seen["ir"][0].colour, "")
+        self.assertAlmostEqual(seen["ir"][0].distance, 45, delta=1e-12)
+
     def test_arcs_drive_and_wheels(self):
         seen = {}
 

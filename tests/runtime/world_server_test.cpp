@@ -79,7 +79,7 @@ TEST_CASE("the script controller's own errors (a script no loader checked) are f
   // built by hand is not, and the controller itself must say what is wrong.
   const std::pair<const char*, const char*> cases[] = {
       {R"({"commands": [["forward", 10], ["jump", 5]]})",
-       "params.commands[1]: unknown command 'jump'; known: forward, back, left, right, wait, pendown, penup, sense, arc, drive, wheels"},
+       "params.commands[1]: unknown command 'jump'; known: forward, back, left, right, wait, pendown, penup, sense, camera, arc, drive, wheels"},
       {R"({"commands": [["jump"]]})", "params.commands[0]: 'jump' needs one number, e.g. [\"jump\", 100]"},
       {R"({"commands": [["wait"]]})", "params.commands[0]: 'wait' needs one number, e.g. [\"wait\", 100]"},
       {R"({"commands": [["pendown", "crayon"]]})", "params.commands[0]: a pen mode is \"line\" or \"wall\", got \"crayon\""},

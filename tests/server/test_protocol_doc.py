@@ -20,7 +20,7 @@ from turtlegas_client import World, decode_binary_frame
 DOC = os.path.join(ROOT, "docs", "protocol.md")
 REQUESTS = {"hello", "subscribe", "unsubscribe", "snapshot", "pause", "resume", "step", "speed", "run_until",
             "claim", "release", "forward", "back", "left", "right", "wait", "yield", "pen", "add_wall", "save",
-            "load", "view_open", "view_change", "view_close", "ping", "stats", "spawn", "remove", "teleport", "sense",
+            "load", "view_open", "view_change", "view_close", "ping", "stats", "spawn", "remove", "teleport", "sense", "camera",
             "arc", "drive", "wheels"}
 REPLAY_REQUESTS = {"play", "seek", "reverse"}  # `turtlegas replay` only (test_replay_examples)
 

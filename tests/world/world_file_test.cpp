@@ -162,8 +162,8 @@ TEST_CASE("missing required keys are named") {
 TEST_CASE("unknown keys are errors with a suggestion") {
   CHECK_ERROR(world(R"(, "balsl": [])"), "/balsl", "unknown key \"balsl\" in the world; did you mean \"balls\"?");
   CHECK_ERROR(world(R"(, "arena": {"widht": 10})"), "/arena/widht", "did you mean \"width\"?");
-  CHECK_ERROR(world(R"(, "balls": [{"id": "b", "pos": [1, 2], "radius": 1, "colour": "red"}])"), "/balls/0/colour",
-              "unknown key \"colour\" in a ball");
+  CHECK_ERROR(world(R"(, "balls": [{"id": "b", "pos": [1, 2], "radius": 1, "color": "red"}])"), "/balls/0/color",
+              "unknown key \"color\" in a ball");
   CHECK_ERROR(world(R"(, "gas": [{"count": 1, "radius": 1, "speed": 1, "zzz": 1}])"), "/gas/0/zzz",
               "keys starting with x- are ignored");
   // JSON-pointer escaping of odd keys.

@@ -112,7 +112,7 @@ TEST_CASE("a script turtle's commands are checked at load time") {
   CHECK(s.programs[0].params.at("commands").size() == 7);
   const std::string c = "/turtles/0/params/commands";
   CHECK_ERROR(one(R"(, "params": {"commands": [["forward", 10], ["fowrard", 10]]})"), c + "/1/0",
-              "unknown command 'fowrard'; known: forward, back, left, right, wait, pendown, penup, sense, arc, drive, wheels");
+              "unknown command 'fowrard'; known: forward, back, left, right, wait, pendown, penup, sense, camera, arc, drive, wheels");
   CHECK_ERROR(one(R"(, "params": {"commands": [["forward"]]})"), c + "/0", "'forward' needs one number");
   CHECK_ERROR(one(R"(, "params": {"commands": [["forward", 1, 2]]})"), c + "/0", "'forward' needs one number");
   CHECK_ERROR(one(R"(, "params": {"commands": [["right", "ninety"]]})"), c + "/0/1", "expected a number, got a string");
@@ -153,7 +153,7 @@ TEST_CASE("an unregistered controller names the registered ones") {
   const tw::WorldFileError e = error_of(text);
   CHECK(std::string(e.what()) ==
         "w.json: /turtles/2/controller: controller 'wandr' is not registered; known: braitenberg, mirror, script, spiral, square, "
-        "tag_camera, tag_chaser, tag_evader, tag_random, wall_follower, wander; did you mean 'wander'?");
+        "tag_camera, tag_chaser, tag_evader, tag_random, tag_seeing, wall_follower, wander; did you mean 'wander'?");
   // Without a registry (load_world_file, parse_world: the bodies only) names are not checked.
   CHECK(tw::parse_world(text, "w.json").turtles.size() == 3);
   // A registry of one's own decides what is known.

@@ -86,8 +86,9 @@ class alignas(64) Agent {
   /// Tells the program its turtle has left the world (TurtleGone).
   [[noreturn, gnu::noinline, gnu::cold]] void throw_gone() const;
   /// Reads range sensor `name` now into out (senses.cpp); `mirrored`: each ray at bearing b looks
-  /// along 360 - b (a mirrored handle's view). Logs the `sense` event.
-  void sense(const std::string& name, bool mirrored, std::vector<Reading>& out);
+  /// along 360 - b (a mirrored handle's view); `camera_only`: throws unless it is a camera
+  /// (Turtle::camera). A camera's readings carry colours. Logs the `sense` event.
+  void sense(const std::string& name, bool mirrored, std::vector<Reading>& out, bool camera_only = false);
   /// Contact c as this turtle's program sees it now (server_impl.hpp).
   Touch make_touch(const sim::TurtleContact& c) const;
   /// Cache hint: the hot lines above (everything up to and including the generator's index).

@@ -197,7 +197,7 @@ Registry base_registry() {
   script.summary = "runs params.commands, a fixed list of [command, amount]";
   script.params.push_back({"commands", ParamSpec::Type::list, nullptr, -INFINITY, INFINITY, {},
                            "[[\"forward\", 100], [\"right\", 90], ...]: forward, back (units), left, right (degrees), "
-                           "wait (seconds), pendown, penup, [\"sense\", NAME], [\"arc\", radius, degrees], "
+                           "wait (seconds), pendown, penup, [\"sense\", NAME], [\"camera\", NAME], [\"arc\", radius, degrees], "
                            "[\"drive\", v, omega, seconds], [\"wheels\", left, right, seconds]"});
   // A script's place is its command index and the time: re-running it from the start replays it.
   script.restartable = true;

@@ -8,8 +8,9 @@
 namespace turtlegas::turtle {
 namespace {
 
-constexpr std::array<std::string_view, 12> kind_names = {"forward", "back",  "left",     "right", "wait",  "yield",
-                                                          "pen_up",  "pen_down", "sense", "arc",   "drive", "wheels"};
+constexpr std::array<std::string_view, 13> kind_names = {"forward", "back",  "left",  "right", "wait",
+                                                          "yield",   "pen_up", "pen_down", "sense", "arc",
+                                                          "drive",   "wheels", "camera"};
 constexpr std::array<std::string_view, 2> arc_keys = {"radius", "degrees"};
 constexpr std::array<std::string_view, 3> drive_keys = {"v", "omega", "seconds"};
 constexpr std::array<std::string_view, 3> wheels_keys = {"left", "right", "seconds"};

@@ -44,6 +44,7 @@ void remote_program(Agent& a) {
       case RemoteCommand::Kind::pen_up: t.pen_up(); break;
       case RemoteCommand::Kind::pen_down: t.pen_down(c.pen); break;  // a wall pen without builder throws, as in C++
       case RemoteCommand::Kind::sense: t.scan(c.sensor, readings); break;  // an unknown sensor throws, as in C++
+      case RemoteCommand::Kind::camera: t.camera(c.sensor, readings); break;
       case RemoteCommand::Kind::arc: result = t.arc(c.steer[0], c.steer[1]); break;
       case RemoteCommand::Kind::drive: result = t.drive(c.steer[0], c.steer[1], c.steer[2]); break;
       case RemoteCommand::Kind::wheels: result = t.wheels(c.steer[0], c.steer[1], c.steer[2]); break;

@@ -37,10 +37,13 @@ void script_controller(Turtle& t, const Params& p) {
     }
     if (command && op == Op::pendown) { t.pen_down(); continue; }
     if (command && op == Op::penup) { t.pen_up(); continue; }
-    if (command && op == Op::sense) {
+    if (command && (op == Op::sense || op == Op::camera)) {
       if (c.size() != 2 || !c[1].is_string())
-        throw std::invalid_argument(where + ": 'sense' needs a sensor's name, e.g. [\"sense\", \"front\"]");
-      t.scan(c[1].get<std::string>(), readings);  // logged as a `sense` event
+        throw std::invalid_argument(where + ": '" + name + "' needs a sensor's name, e.g. [\"" + name + "\", \"" +
+                                    (op == Op::sense ? "front" : "cam") + "\"]");
+      // Both logged as a `sense` event (a camera's with its colours).
+      if (op == Op::sense) t.scan(c[1].get<std::string>(), readings);
+      else t.camera(c[1].get<std::string>(), readings);
       continue;
     }
     if (command && command->steers()) {
@@ -71,6 +74,7 @@ void script_controller(Turtle& t, const Params& p) {
       case Op::pendown:
       case Op::penup:
       case Op::sense:
+      case Op::camera:
       case Op::arc:
       case Op::drive:
       case Op::wheels: break;  // handled above

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Range sensors (the world file's `"senses"`): each ray cast from the turtle's centre through the
 // engine's grid (sim::World::cast_ray), as the turtle's layers see the world, at the control
-// boundary the program runs at; every reading is logged as a `sense` event.
+// boundary the program runs at; every reading is logged as a `sense` event. A camera is a range
+// sensor whose readings also carry the colour of what each ray hit (WorldServer::colours).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -33,7 +34,7 @@ sim::EventKind contact_kind(sim::RayTarget t) {
 
 }  // namespace
 
-void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& out) {
+void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& out, bool camera_only) {
   const RangeSensor* sensor = nullptr;
   for (const RangeSensor& s : program.senses)
     if (s.name == name) sensor = &s;
@@ -44,6 +45,16 @@ void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& 
                                 (known.empty() ? std::string("; declare it under the turtle's \"senses\" in the world file")
                                                : "; its senses: " + sim::join_names(known)));
   }
+  if (camera_only && !sensor->camera) {
+    std::vector<std::string> cameras;
+    for (const RangeSensor& s : program.senses)
+      if (s.camera) cameras.push_back(s.name);
+    throw std::invalid_argument("turtle '" + id + "': sensor \"" + name + "\" is a range sensor, not a camera" +
+                                (cameras.empty() ? std::string("; declare one as {\"name\": \"cam\", \"camera\": {\"pixels\": 64, "
+                                                               "\"fov\": 60, \"range\": 200}} under the turtle's \"senses\"")
+                                                 : "; its cameras: " + sim::join_names(cameras)) +
+                                " (Turtle::scan reads any sensor's distances)");
+  }
   const sim::World& w = server->world;
   const sim::TurtleState st = w.turtle(index);
   sim::Ray ray;
@@ -53,7 +64,7 @@ void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& 
   ray.self = static_cast<std::uint32_t>(index);
   out.clear();
   out.reserve(sensor->bearings.size());
-  std::string ranges = "[", hits = "[";
+  std::string ranges = "[", hits = "[", colours = "[";
   for (std::size_t k = 0; k < sensor->bearings.size(); ++k) {
     const double b = sensor->bearings[k];
     // Behind a mirror the program's bearing b looks along 360 - b (Turtle::mirrored).
@@ -77,6 +88,7 @@ void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& 
     if (k > 0) {
       ranges += ", ";
       hits += ", ";
+      colours += ", ";
     }
     if (hit.hit()) {
       r.distance = hit.distance;
@@ -87,10 +99,13 @@ void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& 
                                                         : "turtle";
       ranges += sim::format_number(hit.distance);
       hits += nlohmann::json(r.what).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+      if (sensor->camera) r.colour = server->colours.of(r.kind, r.what);
     } else {
       ranges += "null";
       hits += "null";
+      if (sensor->camera) r.colour = sensor->background;
     }
+    if (sensor->camera) colours += nlohmann::json(r.colour).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     out.push_back(std::move(r));
   }
   LogEvent e;
@@ -98,7 +113,8 @@ void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& 
   e.kind = "sense";
   e.a = id;
   e.extra = "\"sensor\": " + nlohmann::json(name).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) +
-            ", \"range\": " + ranges + "], \"hit\": " + hits + "]";
+            ", \"range\": " + ranges + "], \"hit\": " + hits + "]" +
+            (sensor->camera ? ", \"colour\": " + colours + "]" : std::string());
   server->emit(std::move(e));
 }
 
@@ -111,6 +127,11 @@ Reading Turtle::range(const std::string& sensor) {
 void Turtle::scan(const std::string& sensor, std::vector<Reading>& out) {
   detail::Fiber::safe_point();
   agent_->sense(sensor, mirror_.on, out);
+}
+
+void Turtle::camera(const std::string& sensor, std::vector<Reading>& out) {
+  detail::Fiber::safe_point();
+  agent_->sense(sensor, mirror_.on, out, true);
 }
 
 }  // namespace turtlegas::turtle

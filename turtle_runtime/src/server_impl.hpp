@@ -39,6 +39,7 @@ class WorldServer::Impl : public GameHost {
   std::vector<RemoteReport> reports;  // the remote programs' reports, until flush_reports()
   std::vector<View> views;             // the open views (view.cpp), in opening order
   std::uint64_t views_revision = 0;
+  Colours colours;     // what cameras see (senses.cpp)
   Registry registry;  // a copy of the constructor's: the programs of turtles spawned later
 
   Impl(sim::WorldDef d, ServerOptions o) : def(std::move(d)), world(def, o.mode), options(std::move(o)) {}

@@ -81,6 +81,10 @@ void WorldServer::set_views(std::vector<View> views) {
   ++impl_->views_revision;
 }
 
+void WorldServer::set_colours(Colours colours) { impl_->colours = std::move(colours); }
+
+const Colours& WorldServer::colours() const { return impl_->colours; }
+
 void WorldServer::open_view(const View& v, const std::string& by) {
   check_view(*this, v);
   if (find_in(impl_->views, v.id) != impl_->views.end())

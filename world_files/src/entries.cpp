@@ -22,6 +22,10 @@ void read_alone(nlohmann::json entry, const std::string& section, const std::str
         throw WorldFileError(file, std::string("/") + key,
                              std::string("a spawned body is in the default collision category; leave \"") + key +
                                  "\" out (or put the body in the world file)");
+  if (entry.is_object() && entry.contains("colour"))
+    throw WorldFileError(file, "/colour",
+                         "a spawned body takes its kind's default colour (docs/worlds.md, \"Colours\"); leave \"colour\" "
+                         "out (or put the body in the world file)");
   try {
     read(nlohmann::json::array({std::move(entry)}));
   } catch (const WorldFileError& e) {

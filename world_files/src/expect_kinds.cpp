@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "turtlegas/sim/format.hpp"
+#include "turtlegas/turtle/colours.hpp"
 #include "turtlegas/turtle/game.hpp"
 #include "turtlegas/world/expect.hpp"
 #include "turtlegas/world/json_read.hpp"
@@ -572,8 +573,8 @@ std::shared_ptr<const Assertion> parse_wall(const json& e, const std::string& pa
   return std::make_shared<WallExistsAssertion>(std::move(id), exists);
 }
 
-// ---- range sensors: {"sense": NAME, "who": turtle, "reading": n, "range": [...], "hit": [...]} or
-// {"sense": NAME, "who": turtle, "min": d, "max": d}
+// ---- range sensors: {"sense": NAME, "who": turtle, "reading": n, "range": [...], "hit": [...],
+// "colour": [...]} (colour: a camera's) or {"sense": NAME, "who": turtle, "min": d, "max": d}
 
 class SenseAssertion final : public Assertion {
  public:
@@ -581,6 +582,7 @@ class SenseAssertion final : public Assertion {
     std::string sensor, who;
     std::size_t reading = 0;
     std::optional<json> range, hit;  // lists, an entry per ray (null: nothing within range)
+    std::optional<json> colour;      // a camera's: "#rrggbb" per pixel
     double within = 1e-9;
     std::optional<double> min, max;
   };
@@ -610,7 +612,7 @@ class SenseAssertion final : public Assertion {
             }
           }
         }
-        if (k != s.reading || !(s.range || s.hit)) return;
+        if (k != s.reading || !(s.range || s.hit || s.colour)) return;
         if (s.range) {
           bool ok = got_range.size() == s.range->size();
           for (std::size_t j = 0; ok && j < got_range.size(); ++j) {
@@ -622,10 +624,16 @@ class SenseAssertion final : public Assertion {
           if (!ok) failure = where + ": range " + got_range.dump() + ", wanted " + s.range->dump() + " within " + num(s.within);
         }
         if (!failure && s.hit && got_hit != *s.hit) failure = where + ": hit " + got_hit.dump() + ", wanted " + s.hit->dump();
+        if (!failure && s.colour) {
+          const json got_colour = r.contains("colour") ? r["colour"] : json();
+          if (got_colour != *s.colour)
+            failure = where + ": colour " + (got_colour.is_null() ? std::string("none (not a camera)") : got_colour.dump()) +
+                      ", wanted " + s.colour->dump();
+        }
       }
       std::optional<std::string> finish(const RunView& v) override {
         if (failure) return failure;
-        if ((s.range || s.hit) && seen <= s.reading)
+        if ((s.range || s.hit || s.colour) && seen <= s.reading)
           return "sense " + s.sensor + " of " + s.who + ": " + std::to_string(seen) + " readings by t = " + num(v.time()) +
                  ", wanted reading " + std::to_string(s.reading);
         if (seen == 0) return "sense " + s.sensor + " of " + s.who + ": no reading by t = " + num(v.time());
@@ -640,7 +648,7 @@ class SenseAssertion final : public Assertion {
 };
 
 std::shared_ptr<const Assertion> parse_sense(const json& e, const std::string& path, const ExpectParser& p) {
-  p.check_keys(e, path, "sense", {"who", "reading", "range", "hit", "within", "min", "max"});
+  p.check_keys(e, path, "sense", {"who", "reading", "range", "hit", "colour", "within", "min", "max"});
   SenseAssertion::Spec s;
   s.sensor = p.string(e.at("sense"), at(path, "sense"));
   if (!e.contains("who")) p.fail(path, "a sense expectation names its turtle: \"who\": \"t1\"");
@@ -660,11 +668,24 @@ std::shared_ptr<const Assertion> parse_sense(const json& e, const std::string& p
   };
   s.range = list("range", true);
   s.hit = list("hit", false);
+  if (auto it = e.find("colour"); it != e.end()) {
+    // A camera's pixels: colours as the world file writes them, compared as the camera reads them.
+    const std::string cp = at(path, "colour");
+    if (!it->is_array()) p.fail(cp, "colour must be a list with a colour per pixel, e.g. [\"#ffffff\", \"red\"]");
+    json colours = json::array();
+    for (std::size_t j = 0; j < it->size(); ++j) {
+      const json& x = (*it)[j];
+      const std::optional<std::string> c = x.is_string() ? turtle::parse_colour(x.get<std::string>()) : std::nullopt;
+      if (!c) p.fail(at(cp, j), "expected a colour, \"#rrggbb\" or a name such as \"red\", got " + x.dump());
+      colours.push_back(*c);
+    }
+    s.colour = std::move(colours);
+  }
   if (auto it = e.find("within"); it != e.end()) s.within = p.non_negative(*it, at(path, "within"));
   if (auto it = e.find("min"); it != e.end()) s.min = p.non_negative(*it, at(path, "min"));
   if (auto it = e.find("max"); it != e.end()) s.max = p.non_negative(*it, at(path, "max"));
-  if (!s.range && !s.hit && !s.min && !s.max)
-    p.fail(path, "a sense expectation checks \"range\" and/or \"hit\" of one reading, or bounds \"min\"/\"max\" on every ray");
+  if (!s.range && !s.hit && !s.colour && !s.min && !s.max)
+    p.fail(path, "a sense expectation checks \"range\", \"hit\" and/or \"colour\" of one reading, or bounds \"min\"/\"max\" on every ray");
   return std::make_shared<SenseAssertion>(std::move(s));
 }
 
@@ -687,7 +708,7 @@ const std::vector<AssertionKind>& assertion_kinds() {
       {"it", "the game's \"it\" is this turtle at the end (or at t)", parse_it},
       {"walls", "the number of walls (all, or drawn_by a turtle) at the end", parse_walls},
       {"wall", "a wall with this id exists (or, with \"exists\": false, does not) at the end", parse_wall},
-      {"sense", "a range sensor's reading (range, hit) or every reading's bounds (min, max)", parse_sense},
+      {"sense", "a range sensor's reading (range, hit; a camera's colour) or every reading's bounds (min, max)", parse_sense},
   };
   return kinds;
 }

@@ -77,6 +77,10 @@ class Reader : public JsonReader {
   std::vector<turtle::RangeSensor> read_senses(const json& v, const std::string& path) const;
   /// `senses`: the turtle's range sensors, which ["sense", NAME] must name.
   void check_script(const json& params, const std::string& path, const std::vector<turtle::RangeSensor>& senses) const;
+  /// A body's optional "colour" (docs/worlds.md, "Colours") into colours_ under its id.
+  void read_colour(const json& obj, const std::string& path, const std::string& body_id);
+  /// A colour: "#rrggbb" (either case) or a name (colour_names); returned as "#rrggbb", lower case.
+  std::string colour(const json& v, const std::string& path) const;
   std::vector<turtle::View> read_views(const json& v, const sim::WorldDef& def);
   std::vector<GasSpec> read_gases(const json& v, const sim::WorldDef& def);
   std::string path_of(const sim::DefProblem& p) const;
@@ -87,6 +91,7 @@ class Reader : public JsonReader {
   std::size_t explicit_balls_ = 0;
   std::vector<std::size_t> gas_first_;  // index in WorldDef::balls of each gas entry's first ball
   std::vector<std::string> wall_paths_;  // JSON path of each of WorldDef::walls (file walls, then drawn)
+  turtle::Colours colours_;  // the bodies' "colour" keys
   std::vector<std::string> categories_{std::string(default_category)};  // name of bit k
 };
 

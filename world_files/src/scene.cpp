@@ -13,6 +13,7 @@ std::unique_ptr<turtle::WorldServer> make_server(const Scene& scene, const turtl
   auto server = std::make_unique<turtle::WorldServer>(scene.def, scene.programs, registry, options);
   if (auto game = make_game(scene)) server->set_game(std::move(game));
   server->set_views(scene.views);
+  server->set_colours(scene.colours);
   return server;
 }
 

@@ -141,9 +141,10 @@ void Reader::read_walls(const json& v, std::vector<sim::WallDef>& walls) {
     const std::string p = at(path, i);
     const json& w = v[i];
     expect_object(w, p, "a wall");
-    check_keys(w, p, "a wall", {"id", "from", "to", "category", "collides_with", "keys", "visible"});
+    check_keys(w, p, "a wall", {"id", "from", "to", "category", "collides_with", "keys", "visible", "colour"});
     sim::WallDef def;
     def.id = id(w, p, "a wall");
+    read_colour(w, p, def.id);
     def.from = vec2(require(w, p, "from", "a wall"), at(p, "from"));
     def.to = vec2(require(w, p, "to", "a wall"), at(p, "to"));
     def.layers = layers(w, p);
@@ -215,7 +216,7 @@ void Reader::read_draw(const json& v, std::vector<sim::WallDef>& walls) {
       const std::string name = c[0].get<std::string>();
       if (std::find(commands_known.begin(), commands_known.end(), name) == commands_known.end())
         fail(at(kp, 0), "unknown command '" + name + "'; a draw builder knows: " + known +
-                            " (it runs at load time, so there is no wait, sense, arc, drive or wheels)");
+                            " (it runs at load time, so there is no wait, sense, camera, arc, drive or wheels)");
       if (name == "pendown" || name == "penup") {
         if (c.size() != 1) fail(kp, "'" + name + "' takes no amount: [\"" + name + "\"]");
         walker.pen_down = name == "pendown";
@@ -249,9 +250,10 @@ void Reader::read_balls(const json& v, std::vector<sim::BallDef>& balls) {
     const std::string p = at(path, i);
     const json& b = v[i];
     expect_object(b, p, "a ball");
-    check_keys(b, p, "a ball", {"id", "pos", "vel", "radius", "mass", "charge", "category", "collides_with"});
+    check_keys(b, p, "a ball", {"id", "pos", "vel", "radius", "mass", "charge", "category", "collides_with", "colour"});
     sim::BallDef def;
     def.id = id(b, p, "a ball");
+    read_colour(b, p, def.id);
     def.pos = vec2(require(b, p, "pos", "a ball"), at(p, "pos"));
     if (const json* x = find(b, "vel")) def.vel = vec2(*x, at(p, "vel"));
     def.radius = positive(require(b, p, "radius", "a ball"), at(p, "radius"), "radius");
@@ -281,6 +283,18 @@ std::string Reader::path_of(const sim::DefProblem& p) const {
     case Where::turtle: return with_field(at("/turtles", p.index));
   }
   return "";
+}
+
+std::string Reader::colour(const json& v, const std::string& path) const {
+  const std::string s = string(v, path);
+  if (std::optional<std::string> c = turtle::parse_colour(s)) return *c;
+  std::vector<std::string> names;
+  for (const auto& named : turtle::colour_names) names.emplace_back(named.first);
+  fail(path, "a colour is \"#rrggbb\" (e.g. \"#e15759\") or one of " + sim::join_names(names) + ", got \"" + s + "\"");
+}
+
+void Reader::read_colour(const json& obj, const std::string& path, const std::string& body_id) {
+  if (const json* x = find(obj, "colour")) colours_.by_id[body_id] = colour(*x, at(path, "colour"));
 }
 
 Scene Reader::read(const json& doc, std::string_view default_name) {
@@ -328,6 +342,7 @@ Scene Reader::read(const json& doc, std::string_view default_name) {
   if (const json* v = find(doc, "balls")) read_balls(*v, def.balls);
   explicit_balls_ = def.balls.size();
   if (const json* v = find(doc, "turtles")) read_turtles(*v, def.turtles, scene.programs);
+  scene.colours = colours_;
   if (def.arena.boundary == sim::Boundary::periodic) {
     // A ray in a periodic arena wraps on until its range: one that meets nothing walks every cell
     // it crosses (a range of 1e308 never ended). 1000 periods is far past any sensor's use.

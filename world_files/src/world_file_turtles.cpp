@@ -27,10 +27,11 @@ void Reader::read_turtles(const json& v, std::vector<sim::TurtleDef>& turtles,
     expect_object(t, p, "a turtle");
     check_keys(t, p, "a turtle",
                {"id", "pos", "heading", "radius", "speed", "turn_rate", "controller", "params", "sensors", "pen", "gps",
-                "bounce", "category", "collides_with", "builder", "senses", "axle"});
+                "bounce", "category", "collides_with", "builder", "senses", "axle", "colour"});
     sim::TurtleDef body;
     turtle::TurtleProgram program;
     body.id = id(t, p, "a turtle");
+    read_colour(t, p, body.id);
     body.pos = vec2(require(t, p, "pos", "a turtle"), at(p, "pos"));
     body.layers = layers(t, p);
     // Angles are degrees in the file and radians inside: converted here, once. The heading is
@@ -154,7 +155,7 @@ std::vector<turtle::RangeSensor> Reader::read_senses(const json& v, const std::s
   const std::string shape =
       "senses must be a list of range sensors, e.g. [{\"name\": \"front\", \"bearing\": 0, \"range\": 80}, "
       "{\"name\": \"ir\", \"ring\": 8, \"range\": 40}, {\"name\": \"lidar\", \"lidar\": {\"rays\": 360, "
-      "\"fov\": 270, \"range\": 100}}], got ";
+      "\"fov\": 270, \"range\": 100}}, {\"name\": \"cam\", \"camera\": {\"pixels\": 64, \"fov\": 60, \"range\": 200}}], got ";
   if (!v.is_array()) fail(path, shape + json_kind(v));
   std::vector<turtle::RangeSensor> out;
   std::set<std::string> names;
@@ -162,7 +163,7 @@ std::vector<turtle::RangeSensor> Reader::read_senses(const json& v, const std::s
     const std::string p = at(path, k);
     const json& s = v[k];
     expect_object(s, p, "a range sensor");
-    check_keys(s, p, "a range sensor", {"name", "bearing", "range", "ring", "lidar", "noise"});
+    check_keys(s, p, "a range sensor", {"name", "bearing", "range", "ring", "lidar", "camera", "noise"});
     turtle::RangeSensor sensor;
     sensor.name = string(require(s, p, "name", "a range sensor"), at(p, "name"));
     if (sensor.name.empty()) fail(at(p, "name"), "a sensor's name must not be empty");
@@ -180,10 +181,33 @@ std::vector<turtle::RangeSensor> Reader::read_senses(const json& v, const std::s
     }
     const json* ring = find(s, "ring");
     const json* lidar = find(s, "lidar");
-    if (ring && lidar) fail(p, "a range sensor is a ray (\"bearing\"), a \"ring\" or a \"lidar\": not both a ring and a lidar");
+    const json* camera = find(s, "camera");
+    if ((ring ? 1 : 0) + (lidar ? 1 : 0) + (camera ? 1 : 0) > 1) {
+      std::string kinds;
+      for (const auto& [given, kind] : {std::pair{ring, "a ring"}, {lidar, "a lidar"}, {camera, "a camera"}})
+        if (given) kinds += (kinds.empty() ? "" : " and ") + std::string(kind);
+      fail(p, "a range sensor is a ray (\"bearing\"), a \"ring\", a \"lidar\" or a \"camera\": not " + kinds + " at once");
+    }
     double bearing = 0.0;
     if (const json* x = find(s, "bearing")) bearing = number(*x, at(p, "bearing"));
-    if (lidar) {
+    if (camera) {
+      if (find(s, "range")) fail(at(p, "range"), "a camera's range goes inside it: \"camera\": {\"pixels\": 64, \"fov\": 60, \"range\": 200}");
+      const std::string cp = at(p, "camera");
+      expect_object(*camera, cp, "a camera");
+      check_keys(*camera, cp, "a camera", {"pixels", "fov", "range", "background"});
+      const std::uint64_t n = natural(require(*camera, cp, "pixels", "a camera"), at(cp, "pixels"));
+      if (n < 1 || n > max_rays)
+        fail(at(cp, "pixels"), "a camera has from 1 to " + std::to_string(max_rays) + " pixels (got " + std::to_string(n) + ")");
+      const double fov = positive(require(*camera, cp, "fov", "a camera"), at(cp, "fov"), "fov (degrees)");
+      if (fov > 360.0) fail(at(cp, "fov"), "a camera's fov is at most 360 degrees (got " + num(fov) + ")");
+      sensor.range = positive(require(*camera, cp, "range", "a camera"), at(cp, "range"), "range (units)");
+      if (const json* x = find(*camera, "background")) sensor.background = colour(*x, at(cp, "background"));
+      sensor.camera = true;
+      // Pixel k of n looks along the centre of its own slice of the fov, left to right:
+      // bearing - fov/2 + (k + 1/2) fov/n (docs/worlds.md, "Cameras"); no ray on the fov's edges.
+      for (std::uint64_t k = 0; k < n; ++k)
+        sensor.bearings.push_back(bearing - fov / 2.0 + (static_cast<double>(k) + 0.5) * fov / static_cast<double>(n));
+    } else if (lidar) {
       if (find(s, "range")) fail(at(p, "range"), "a lidar's range goes inside it: \"lidar\": {\"rays\": 360, \"fov\": 270, \"range\": 100}");
       const std::string lp = at(p, "lidar");
       expect_object(*lidar, lp, "a lidar");
@@ -238,15 +262,21 @@ void Reader::check_script(const json& params, const std::string& path,
         fail(at(p, 1), "a pen mode is \"line\" (draws the path) or \"wall\" (lays walls), got " + c[1].dump());
       continue;
     }
-    if (command->op == turtle::ScriptCommand::Op::sense) {
-      if (c.size() != 2 || !c[1].is_string()) fail(p, "'sense' needs a sensor's name, e.g. [\"sense\", \"front\"], got " + c.dump());
+    if (command->senses()) {
+      // ["sense", NAME] reads any range sensor, ["camera", NAME] only a camera.
+      const bool camera = command->op == turtle::ScriptCommand::Op::camera;
+      if (c.size() != 2 || !c[1].is_string())
+        fail(p, "'" + name + "' needs a sensor's name, e.g. [\"" + name + "\", \"" + (camera ? "cam" : "front") +
+                    "\"], got " + c.dump());
       const std::string sensor = c[1].get<std::string>();
       std::vector<std::string> known_senses;
-      for (const auto& s : senses) known_senses.push_back(s.name);
+      for (const auto& s : senses)
+        if (s.camera || !camera) known_senses.push_back(s.name);
       if (std::find(known_senses.begin(), known_senses.end(), sensor) == known_senses.end())
-        fail(at(p, 1), "this turtle has no range sensor \"" + sensor + "\"" +
+        fail(at(p, 1), "this turtle has no " + std::string(camera ? "camera" : "range sensor") + " \"" + sensor + "\"" +
                            (known_senses.empty() ? std::string("; declare it under the turtle's \"senses\"")
-                                                 : "; its senses: " + sim::join_names(known_senses)));
+                                                 : "; its " + std::string(camera ? "cameras" : "senses") + ": " +
+                                                       sim::join_names(known_senses)));
       continue;
     }
     if (command->steers()) {

@@ -36,21 +36,23 @@ inline constexpr std::string_view remote_controller_name = "remote";
 
 /// One command for a remote turtle: what its C++ twin would call on its Turtle.
 struct RemoteCommand {
-  enum class Kind { forward, back, left, right, wait, yield, pen_up, pen_down, sense, arc, drive, wheels };
+  enum class Kind { forward, back, left, right, wait, yield, pen_up, pen_down, sense, arc, drive, wheels, camera };
   Kind kind = Kind::yield;
   double amount = 0.0;          ///< forward/back: world units; left/right: degrees; wait: seconds
   /// arc: radius (units), degrees; drive: v (units/s), omega (degrees/s), seconds; wheels: left,
   /// right (units/s), seconds. Named as steer_keys(kind) names them.
   std::array<double, 3> steer{};
   PenMode pen = PenMode::line;  ///< pen_down's mode
-  std::string sensor{};         ///< sense: the range sensor to read (Turtle::scan); takes no time
+  /// sense: the range sensor to read (Turtle::scan); camera: the camera (Turtle::camera). Neither
+  /// takes time.
+  std::string sensor{};
   /// The sender's number for the command, echoed in its result; not part of the run (an input
   /// log does not record it).
   std::uint64_t tag = 0;
 };
 
 /// "forward", "back", "left", "right", "wait", "yield", "pen_up", "pen_down", "sense", "arc", "drive",
-/// "wheels".
+/// "wheels", "camera".
 std::string_view to_string(RemoteCommand::Kind kind);
 std::optional<RemoteCommand::Kind> remote_command_kind(std::string_view name);
 /// Whether the command takes an amount (forward, back, left, right, wait).
@@ -76,7 +78,7 @@ struct RemoteReport {
   double t = 0.0;          ///< seconds, the boundary's time
   RemoteCommand command;   ///< result: the command it answers (with its tag)
   Result result;           ///< result
-  std::vector<Reading> readings;  ///< result of a sense: every ray of the sensor, as Turtle::scan
+  std::vector<Reading> readings;  ///< result of a sense or camera: every ray (pixel), as Turtle::scan (camera)
   Touch touch;             ///< touch (its sensor_names live as long as the WorldServer)
   Message message;         ///< message
   std::string fault;       ///< fault

@@ -12,9 +12,9 @@ namespace turtlegas::turtle {
 
 /// One script command: its name in a world file and what its number measures.
 struct ScriptCommand {
-  enum class Op { forward, back, left, right, wait, pendown, penup, sense, arc, drive, wheels };
+  enum class Op { forward, back, left, right, wait, pendown, penup, sense, camera, arc, drive, wheels };
   /// What the command's amount is: none for pendown and penup (pendown may name a pen mode), the
-  /// name of a range sensor for sense; arc, drive and wheels take several numbers (numbers()).
+  /// name of a range sensor for sense (of a camera for camera); arc, drive and wheels take several numbers (numbers()).
   enum class Amount { none, units, degrees, seconds, sensor, arc, drive, wheels };
   std::string_view name;
   Op op;
@@ -22,7 +22,7 @@ struct ScriptCommand {
   /// Whether the command takes simulated time only (wait): a draw builder, which runs at load
   /// time, has no such command.
   bool timed_only() const { return amount == Amount::seconds; }
-  /// Whether the command reads the world (sense): a draw builder, which runs at load time, has none.
+  /// Whether the command reads the world (sense, camera): a draw builder, which runs at load time, has none.
   bool senses() const { return amount == Amount::sensor; }
   /// Whether the command drives on an arc (arc, drive, wheels): a draw builder has none.
   constexpr bool steers() const { return amount == Amount::arc || amount == Amount::drive || amount == Amount::wheels; }
@@ -50,7 +50,7 @@ struct ScriptCommand {
 };
 
 /// Every script command, in the order messages list them.
-inline constexpr std::array<ScriptCommand, 11> script_commands = {{
+inline constexpr std::array<ScriptCommand, 12> script_commands = {{
     {"forward", ScriptCommand::Op::forward, ScriptCommand::Amount::units},
     {"back", ScriptCommand::Op::back, ScriptCommand::Amount::units},
     {"left", ScriptCommand::Op::left, ScriptCommand::Amount::degrees},
@@ -59,6 +59,7 @@ inline constexpr std::array<ScriptCommand, 11> script_commands = {{
     {"pendown", ScriptCommand::Op::pendown, ScriptCommand::Amount::none},
     {"penup", ScriptCommand::Op::penup, ScriptCommand::Amount::none},
     {"sense", ScriptCommand::Op::sense, ScriptCommand::Amount::sensor},
+    {"camera", ScriptCommand::Op::camera, ScriptCommand::Amount::sensor},
     {"arc", ScriptCommand::Op::arc, ScriptCommand::Amount::arc},
     {"drive", ScriptCommand::Op::drive, ScriptCommand::Amount::drive},
     {"wheels", ScriptCommand::Op::wheels, ScriptCommand::Amount::wheels},

@@ -124,6 +124,9 @@ struct Reading {
   double bearing = 0.0;  ///< the ray's, degrees clockwise from the heading (as the program sees it)
   std::string what;      ///< id of the wall, ball or turtle hit; empty when nothing is
   std::string kind;      ///< "wall", "wall-end", "ball" or "turtle"; empty when nothing is hit
+  /// A camera's pixel (Turtle::camera): the colour of what was hit, "#rrggbb", or the camera's
+  /// background when nothing is within range; empty for a range sensor that is no camera.
+  std::string colour;
   bool hit() const { return !kind.empty(); }
 };
 
@@ -239,6 +242,10 @@ class Turtle {
   Reading range(const std::string& sensor);
   /// Every ray of the sensor, in its order, into `out` (cleared first; its capacity is reused).
   void scan(const std::string& sensor, std::vector<Reading>& out);
+  /// A line camera (a sense with `"camera"` in the world file), read now as scan() reads it: one
+  /// Reading per pixel, left to right, each with the colour of what its ray hit (Reading::colour;
+  /// the background when nothing). Throws std::invalid_argument for a sensor that is no camera.
+  void camera(const std::string& sensor, std::vector<Reading>& out);
 
   /// Odometry: distance driven in all (units) and heading (degrees, Logo convention).
   double odometer() const;

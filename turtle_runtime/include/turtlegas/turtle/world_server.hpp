@@ -39,6 +39,7 @@
 #include <nlohmann/json.hpp>
 
 #include "turtlegas/sim/world.hpp"
+#include "turtlegas/turtle/colours.hpp"
 #include "turtlegas/turtle/log_event.hpp"
 #include "turtlegas/turtle/registry.hpp"
 #include "turtlegas/turtle/turtle.hpp"
@@ -69,6 +70,10 @@ struct RangeSensor {
   /// Noise, drawn from the turtle's own seeded stream (Turtle::uniform's), so noisy runs repeat:
   double noise = 0.0;    ///< standard deviation of a Gaussian added to each hit's distance, units
   double dropout = 0.0;  ///< probability that a hit reads as nothing
+  /// A line camera (the world file's `"camera"`): its rays are pixels, and each reading also
+  /// gives the colour of what it hit (Colours), or `background` when nothing is within range.
+  bool camera = false;
+  std::string background = "#ffffff";  ///< a camera's colour for "nothing", "#rrggbb"
 };
 
 /// How a turtle's program is set up (the world file's turtle entry, beyond its body).
@@ -238,6 +243,9 @@ class WorldServer {
   // a follow that names no turtle.
   /// The world file's views, before the run starts: not logged (they are in the world file).
   void set_views(std::vector<View> views);
+  /// What cameras see (Colours), before the run starts; the defaults until then.
+  void set_colours(Colours colours);
+  const Colours& colours() const;
   void open_view(const View& v, const std::string& by = {});
   void change_view(const View& v, const std::string& by = {});
   void close_view(const std::string& id, const std::string& by = {});

@@ -21,6 +21,8 @@ struct Scene {
   std::vector<turtle::TurtleProgram> programs;
   /// The world's game (the `game` key): the tag rules, when the world plays tag.
   std::optional<turtle::TagRules> game;
+  /// What cameras see: the walls', balls' and turtles' "colour" keys (WorldServer::set_colours).
+  turtle::Colours colours;
   /// The `views` list (display windows, turtle/view.hpp); follows name turtles of def.
   std::vector<turtle::View> views;
   /// The `expect` list of a scripted test world (empty when the file has none).
