@@ -233,3 +233,40 @@ TEST_CASE("a row touched at an angle by another disc is not this rule (a cluster
     CHECK(w.stats().energy_rules() == 0.0);
   }
 }
+
+TEST_CASE("a row along a diagonal between two walls across it: jammed, the ledger exact", "[cluster][squeeze]") {
+  // Rows of 3 and 10 discs along (1, 1)/sqrt 2 between two walls across it (1e-12 of room per
+  // contact, within the overlap budget: placed exactly, round-off would overlap them); d0 moves at
+  // 2 along the row and 0.3 across it.
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    for (int n : {3, 10}) {
+      INFO("mode " << name(mode) << ", N = " << n);
+      const Vec2 u{1.0 / std::sqrt(2.0), 1.0 / std::sqrt(2.0)}, across{-u.y, u.x}, c{30.0, 30.0};
+      const double g = 1e-12;
+      WorldDef d = box(100, 100);
+      for (int k = 0; k < n; ++k)
+        d.balls.push_back(ball("d" + std::to_string(k), c + (2.0 + g) * k * u, k == 0 ? 2.0 * u - 0.3 * across : Vec2{}));
+      auto wall = [&](std::string id, double s) {
+        const Vec2 p = c + s * u;
+        return WallDef{std::move(id), p - 5.0 * across, p + 5.0 * across};
+      };
+      d.walls.push_back(wall("w0", -1.0 - g));
+      d.walls.push_back(wall("w1", (2.0 + g) * (n - 1) + 1.0 + g));
+      World w(d, mode);
+      const double e0 = w.energy();
+      const std::size_t events = run_logged(w, 3.0);
+      CHECK(events < 10u * static_cast<std::size_t>(n));
+      CHECK(w.stats().wedged == 1);
+      for (int k = 0; k < n; ++k) {
+        // Along the row: exactly what the rule leaves. Across: the room of 1e-12 lets d0 drift
+        // 0.3 x 5e-13 across before it meets d1, which tilts that collision's normal by 7.5e-14
+        // and passes 1.5e-13 of the speed 2 across (the exact physics of that room, not round-off).
+        CHECK(std::abs(dot(w.ball(k).vel, u)) <= 1e-15);
+        CHECK(dot(w.ball(k).vel, across) == Approx(k == 0 ? -0.3 : 0.0).margin(1e-12));
+      }
+      CHECK(e0 - w.energy() == Approx(w.stats().energy_rules()).epsilon(1e-12));
+      CHECK(w.stats().energy_rules() == Approx(2.0).epsilon(1e-12));
+      CHECK(w.max_contact_overlap().relative <= 1e-9);
+    }
+  }
+}
