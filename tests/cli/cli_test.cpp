@@ -545,6 +545,39 @@ TEST_CASE("cli: --stats and --stats-json report the energy the zero-time rules t
   CHECK(z.at("bodies").empty());
 }
 
+TEST_CASE("cli: a row of discs exactly filling a box runs to its end with a bounded event log (issue 28 item 3)") {
+  // worlds/tests/jammed_row.json: ten equal discs fill a box 20 wide, d0 moving. The impulse ran
+  // down the row and back at one instant for ever (a 4 GiB log cap was hit in 26 s); the row is
+  // jammed, so the run ends with a wedged event at t = 0 and the ledger books the energy along it.
+  TempDir dir;
+  for (const char* mode : {"exact", "step"}) {
+    INFO(mode);
+    const fs::path events = dir.path / "events.jsonl", stats = dir.path / "stats.json";
+    const Result r = run(dir, {"run", std::string(TURTLEGAS_SOURCE_DIR) + "/worlds/tests/jammed_row.json", "--until",
+                               "10", "--mode", mode, "--events", events.string(), "--stats-json", stats.string()});
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    CHECK(fs::file_size(events) < 4096);
+    std::ifstream in(events);
+    std::string line;
+    std::size_t n = 0, wedged = 0;
+    while (std::getline(in, line)) {
+      const json e = json::parse(line);
+      ++n;
+      if (e.at("kind") == "wedged") {
+        ++wedged;
+        CHECK(e.at("t").get<double>() == 0.0);
+      }
+    }
+    CHECK(n <= 11);  // nine collisions down the row, the wall, the wedged event
+    CHECK(wedged == 1);
+    const json st = json::parse(read(stats));
+    CHECK(st.at("energy_rules").at("wedged").get<double>() == Approx(2.0).epsilon(1e-12));
+    CHECK(st.at("energy_rules").at("total").get<double>() ==
+          Approx(st.at("energy_start").get<double>() - st.at("energy_end").get<double>()).epsilon(1e-12));
+  }
+}
+
 TEST_CASE("cli: --xyz writes an extended XYZ trajectory that reads back to the run's states") {
   // Parsed here as OVITO's and ASE's readers read extended XYZ: a count line, a comment line of
   // key=value pairs (Lattice, Properties, Time, pbc), then that many lines of the named columns.

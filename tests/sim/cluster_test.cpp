@@ -86,3 +86,187 @@ TEST_CASE("a row free at one end is not jammed: Newton's cradle against a wall, 
     CHECK(w.ball(5).vel.x == Approx(-3.0).epsilon(1e-12));
   }
 }
+
+namespace {
+
+const char* name(Mode mode) { return mode == Mode::exact ? "exact" : "step"; }
+
+/// N equal discs of radius 1 in a row at y = 50 exactly filling a box 2N wide (each touching the
+/// next, the ends touching both walls); disc `moving` has velocity v.
+WorldDef filled(int n, int moving, Vec2 v, double e) {
+  WorldDef d = box(2.0 * n, 100);
+  d.effects.restitution = e;
+  for (int k = 0; k < n; ++k)
+    d.balls.push_back(ball("d" + std::to_string(k), {1.0 + 2.0 * k, 50.0}, k == moving ? v : Vec2{}, 1.0));
+  return d;
+}
+
+/// Runs to `until` with an event limit and a log; the log's size.
+std::size_t run_logged(World& w, double until) {
+  w.set_event_limit(100000);  // it served events at one instant for ever
+  std::vector<Event> log;
+  w.set_event_log(&log);
+  w.advance_to(until);
+  return log.size();
+}
+
+}  // namespace
+
+TEST_CASE("rows of 2, 3 and 10 equal discs filling a box: the run ends, positions and the ledger exact",
+          "[cluster][squeeze]") {
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    for (int n : {2, 3, 10}) {
+      for (double e : {1.0, 0.5}) {
+        for (int moving : {0, n / 2, n - 1}) {
+          for (double dir : {1.0, -1.0}) {
+            INFO("mode " << name(mode) << ", N = " << n << ", e = " << e << ", disc " << moving << ", dir " << dir);
+            World w(filled(n, moving, {2.0 * dir, 0.5}, e), mode);
+            const double e0 = w.energy();
+            const std::size_t events = run_logged(w, 3.0);
+            CHECK(events < 10u * static_cast<std::size_t>(n));
+            CHECK(w.stats().wedged == 1);
+            for (int k = 0; k < n; ++k) {
+              CHECK(w.ball(k).pos.x == Approx(1.0 + 2.0 * k).margin(1e-12));  // positions unchanged
+              CHECK(w.ball(k).vel.x == 0.0);
+              CHECK(w.ball(k).vel.y == (k == moving ? 0.5 : 0.0));  // across the row: kept
+            }
+            // What the rule took is in the ledger: 1/2 m 2^2 at e = 1; at e < 1 the bounces before
+            // it took their share (restitution's, not booked).
+            const double taken = w.stats().energy_rules();
+            if (e == 1.0) CHECK(e0 - w.energy() == Approx(2.0).epsilon(1e-12));
+            if (e == 1.0) CHECK(taken == Approx(2.0).epsilon(1e-12));
+            CHECK(taken <= e0 - w.energy() + 1e-12);
+            CHECK(w.energy() == Approx(0.5 * 0.25).epsilon(1e-12));
+            CHECK(w.max_contact_overlap().relative <= 1e-9);
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("a row touching one wall only at e = 1 is not jammed: the far disc leaves with the mover's speed",
+          "[cluster]") {
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    for (int n : {2, 3, 10}) {
+      // The row touches the left wall of a box 4N wide; the mover is the first disc (at the wall,
+      // moving away from it) or the last (moving towards it).
+      for (int moving : {0, n - 1}) {
+        INFO("mode " << name(mode) << ", N = " << n << ", disc " << moving);
+        const double v = moving == 0 ? 3.0 : -3.0;
+        WorldDef d = filled(n, moving, {v, 0.0}, 1.0);
+        d.arena.width = 4.0 * n;
+        World w(d, mode);
+        const double e0 = w.energy();
+        const std::size_t events = run_logged(w, 0.25);
+        CHECK(events <= 2u * static_cast<std::size_t>(n));
+        CHECK(w.stats().wedged == 0);
+        CHECK(w.stats().energy_rules() == 0.0);
+        CHECK(w.energy() == Approx(e0).epsilon(1e-12));
+        // Momentum passed through the row (and off the wall): only the last disc moves, at 3.
+        for (int k = 0; k + 1 < n; ++k) CHECK(std::abs(w.ball(k).vel.x) <= 1e-12);
+        CHECK(w.ball(n - 1).vel.x == Approx(3.0).epsilon(1e-12));
+        CHECK(w.ball(n - 1).pos.x == Approx(2.0 * n - 1.0 + 0.75).epsilon(1e-12));
+      }
+    }
+  }
+}
+
+TEST_CASE("a row of unequal discs touching one wall only at e = 1: the sequence ends, energy kept", "[cluster]") {
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    INFO("mode " << name(mode));
+    WorldDef d = row(60.0, 0.0, 4, {-3.0, 0.0}, 1.0);  // masses 1..5 at the left wall, the heaviest moving
+    World w(d, mode);
+    const double e0 = w.energy();
+    const std::size_t events = run_logged(w, 1.0);
+    CHECK(events < 200u);
+    CHECK(w.stats().wedged == 0);
+    CHECK(w.stats().energy_rules() == 0.0);
+    CHECK(w.energy() == Approx(e0).epsilon(1e-12));
+    CHECK(w.max_contact_overlap().relative <= 1e-9);
+  }
+}
+
+TEST_CASE("a row between a wall and a standing turtle, or a wall's end, is jammed too", "[cluster][squeeze]") {
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    for (int end : {0, 1}) {
+      INFO("mode " << name(mode) << (end == 0 ? ", a turtle" : ", a wall's end"));
+      // Four discs of radius 1 from the left wall along y = 50; the fifth place is the far end.
+      WorldDef d = box(100, 100);
+      for (int k = 0; k < 4; ++k)
+        d.balls.push_back(ball("d" + std::to_string(k), {1.0 + 2.0 * k, 50.0}, k == 1 ? Vec2{-2.0, 0.25} : Vec2{}, 1.0,
+                               1.0 + k));
+      if (end == 0) d.turtles.push_back(turtle("t", {8.0 + 5.0, 50.0}, 0, 5));  // touches d3 at x = 8
+      else d.walls.push_back(WallDef{"shelf", {8.0, 50.0}, {30.0, 50.0}});  // its end at x = 8, in line
+      World w(d, mode);
+      const double e0 = w.energy();
+      const std::size_t events = run_logged(w, 3.0);
+      CHECK(events < 40u);
+      CHECK(w.stats().wedged == 1);
+      for (int k = 0; k < 4; ++k) {
+        CHECK(w.ball(k).pos.x == Approx(1.0 + 2.0 * k).margin(1e-12));
+        CHECK(w.ball(k).vel.x == 0.0);
+      }
+      CHECK(w.ball(1).vel.y == 0.25);
+      CHECK(e0 - w.energy() == Approx(w.stats().energy_rules()).epsilon(1e-12));
+      CHECK(w.stats().energy_wedged == Approx(0.5 * 2.0 * 4.0).epsilon(1e-12));
+      CHECK(w.max_contact_overlap().relative <= 1e-9);
+    }
+  }
+}
+
+TEST_CASE("a row touched at an angle by another disc is not this rule (a cluster it does not cover)",
+          "[cluster]") {
+  // Three discs filling a box 6 wide, a fourth resting in the groove on the middle two at 60
+  // degrees: the oblique contacts take part of the row's impulse, so the row's test (every other
+  // contact across the row) fails and the rule must not act. Its limit is the cluster's (not
+  // computed yet: docs/physics.md, "Clusters: a jammed chain"), so the zero-time sequence still
+  // runs one contact at a time; this pins that the row rule does not answer it with its own limit.
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    INFO("mode " << name(mode));
+    WorldDef d = filled(3, 0, {2.0, 0.0}, 1.0);
+    d.balls.push_back(ball("top", {4.0, 50.0 + std::sqrt(3.0) + 1e-14}, {}, 1.0));  // (1e-14: round-off)
+    World w(d, mode);
+    w.set_event_limit(20000);
+    CHECK_THROWS_WITH(w.advance_to(0.01), Catch::Contains("event limit"));
+    CHECK(w.stats().wedged == 0);
+    CHECK(w.stats().energy_rules() == 0.0);
+  }
+}
+
+TEST_CASE("a row along a diagonal between two walls across it: jammed, the ledger exact", "[cluster][squeeze]") {
+  // Rows of 3 and 10 discs along (1, 1)/sqrt 2 between two walls across it (1e-12 of room per
+  // contact, within the overlap budget: placed exactly, round-off would overlap them); d0 moves at
+  // 2 along the row and 0.3 across it.
+  for (Mode mode : {Mode::exact, Mode::step}) {
+    for (int n : {3, 10}) {
+      INFO("mode " << name(mode) << ", N = " << n);
+      const Vec2 u{1.0 / std::sqrt(2.0), 1.0 / std::sqrt(2.0)}, across{-u.y, u.x}, c{30.0, 30.0};
+      const double g = 1e-12;
+      WorldDef d = box(100, 100);
+      for (int k = 0; k < n; ++k)
+        d.balls.push_back(ball("d" + std::to_string(k), c + (2.0 + g) * k * u, k == 0 ? 2.0 * u - 0.3 * across : Vec2{}));
+      auto wall = [&](std::string id, double s) {
+        const Vec2 p = c + s * u;
+        return WallDef{std::move(id), p - 5.0 * across, p + 5.0 * across};
+      };
+      d.walls.push_back(wall("w0", -1.0 - g));
+      d.walls.push_back(wall("w1", (2.0 + g) * (n - 1) + 1.0 + g));
+      World w(d, mode);
+      const double e0 = w.energy();
+      const std::size_t events = run_logged(w, 3.0);
+      CHECK(events < 10u * static_cast<std::size_t>(n));
+      CHECK(w.stats().wedged == 1);
+      for (int k = 0; k < n; ++k) {
+        // Along the row: exactly what the rule leaves. Across: the room of 1e-12 lets d0 drift
+        // 0.3 x 5e-13 across before it meets d1, which tilts that collision's normal by 7.5e-14
+        // and passes 1.5e-13 of the speed 2 across (the exact physics of that room, not round-off).
+        CHECK(std::abs(dot(w.ball(k).vel, u)) <= 1e-15);
+        CHECK(dot(w.ball(k).vel, across) == Approx(k == 0 ? -0.3 : 0.0).margin(1e-12));
+      }
+      CHECK(e0 - w.energy() == Approx(w.stats().energy_rules()).epsilon(1e-12));
+      CHECK(w.stats().energy_rules() == Approx(2.0).epsilon(1e-12));
+      CHECK(w.max_contact_overlap().relative <= 1e-9);
+    }
+  }
+}

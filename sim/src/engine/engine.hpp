@@ -316,11 +316,13 @@ class Engine final : public EngineBase {
       }
     }
   }
-  /// The jammed chain (docs/physics.md, "Clusters: a jammed chain"): ball i has just met fixed
-  /// wall w after ball `before`; if it heads a straight chain of touching balls that ends on a
-  /// parallel fixed wall facing w, every ball's velocity along the chain is taken (the limit of the
-  /// zero-time sequence), and true is returned (contacts/resolve.hpp).
-  bool jammed_chain(std::uint32_t i, std::uint32_t w, LastPartner before);
+  /// The jammed chain (docs/physics.md, "Clusters: a jammed chain"): ball i has just met a standing
+  /// `obstacle` (a fixed wall or wall end, a turtle) after ball `before`; if it heads a straight
+  /// row of touching balls that ends on another standing obstacle in line, and nothing else
+  /// touches the row but across it, every ball's velocity along the row is taken (the limit of the
+  /// zero-time sequence), and true is returned (contacts/resolve.hpp). Out of line: it runs only
+  /// after a ball, and inlined it would change GCC's inlining of the engine's loop.
+  [[gnu::noinline]] bool jammed_chain(std::uint32_t i, LastPartner obstacle, LastPartner before);
   /// The squeeze rule (contacts/squeeze.hpp) for body i after its contact with bodies_.last[i]; `before`:
   /// its partner before that. Returns false when the body was crushed (and removed).
   bool squeezed(std::uint32_t i, LastPartner before);

@@ -37,6 +37,14 @@ void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
         auto before_of = [&](std::uint32_t k) { return k == i ? before : before_partner; };
         const bool keep_first = !is_turtle(c.second) || squeezed(c.first, before_of(c.first));
         const bool keep_second = squeezed(c.second, before_of(c.second));
+        // A ball that met a standing turtle right after a ball may head a jammed row (jammed_chain),
+        // whose answer predicts the row afresh.
+        const std::uint32_t o = is_turtle(i) ? p.partner : i, t = o == i ? p.partner : i;
+        if (!is_turtle(o) && (o == c.first ? keep_first : keep_second) && before_of(o).kind() == Partner::body &&
+            jammed_chain(o, LastPartner::of(Partner::body, t), before_of(o))) {
+          if (t == c.first ? keep_first : keep_second) repredict(t);
+          return;
+        }
         if (keep_first) repredict(c.first);
         if (keep_second) repredict(c.second);
       } else {
@@ -60,13 +68,15 @@ void Engine<F, kBallBall, kStep, kExtras>::collide(std::uint32_t i) {
         if (slide_landing(i, p.partner, before)) return;
       }
       const Changed c = apply_wall(parts(), i, p.partner);
-      if (squeezed(i, before) && !jammed_chain(i, p.partner, before)) served(c);
+      if (squeezed(i, before) && !(before.kind() == Partner::body && jammed_chain(i, LastPartner::of(Partner::wall, p.partner), before)))
+        served(c);
       return;
     }
     case Partner::end: {
       unslide(i);
       const Changed c = apply_end(parts(), i, p.partner);
-      if (squeezed(i, before)) served(c);
+      if (squeezed(i, before) && !(before.kind() == Partner::body && jammed_chain(i, LastPartner::of(Partner::end, p.partner), before)))
+        served(c);
       return;
     }
     case Partner::moving_end: {
@@ -134,89 +144,204 @@ bool Engine<F, kBallBall, kStep, kExtras>::slide_landing(std::uint32_t i, std::u
 }
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
-bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, std::uint32_t w, LastPartner before) {
-  // A row of balls exactly filling the room between two parallel fixed walls (docs/physics.md,
-  // "Clusters: a jammed chain"). Every velocity that opens none of its contacts has no component
-  // along the row (0 <= v_0 <= v_1 <= ... <= v_last <= 0 along it), and every collision's impulse
-  // is along the row: the part across it is kept, and the part along it can never reach that set
-  // at e = 1 (the energy along the row is kept by each collision), nor in finitely many steps at
-  // e < 1. So the zero-time sequence (the impulse running down the row and back for ever) does not
-  // end, and its only possible end, or limit, is the perfectly inelastic one: the row at rest
-  // along itself. Asked at a contact of ball i with a fixed wall just after a ball (the impulse
-  // arriving through the row): cheap unless i still touches that ball in line.
-  if (is_turtle(i) || before.kind() != Partner::body || is_turtle(before.index())) return false;
-  if (walls_.mover_of[w] != kNone) return false;
-  const Body& bi = bodies_.body[i];
-  const Segment& sw = walls_.segments[w];
-  const double dw = dot(arena_.rel_to_segment(bi.x, sw), sw.n);
-  const Vec2 n = dw >= 0.0 ? sw.n : -sw.n;  // from the wall along the row
-  constexpr double kParallel = 1e-9;  // as the squeeze rule's parallel walls
-  // The ball at `at` (radius ra) and ball k touch in line with the row, k further along it.
-  auto in_line = [&](Vec2 at, double ra, std::uint32_t k) {
-    const Body& bk = bodies_.body[k];
-    const Vec2 rel = arena_.min_image(motion_.pos(bk, k, now_ - bk.t) - at);
-    const double dist = norm(rel);
-    return dot(rel, n) > 0.0 && std::abs(sim::cross(rel, n)) <= kParallel * dist &&
-           touching(dist - (ra + bk.r), std::min(ra, bk.r), at);
-  };
-  if (!in_line(bi.x, bi.r, before.index())) return false;
-  // Walk the row: each ball touches exactly one ball further along it, until one touches a fixed
-  // wall facing w (parallel, on its far side). A branch, a gap or no such wall: not this rule.
-  std::vector<std::uint32_t> row{i};
-  std::vector<std::uint32_t> near;
-  std::uint32_t far = kNone;
-  for (std::uint32_t cur = i; row.size() <= bodies_.balls();) {
-    const Body& bc = bodies_.body[cur];
-    const Vec2 xc = motion_.pos(bc, cur, now_ - bc.t);
-    const double reach = bc.r + 2.0 * step_.rmax;
-    near.clear();
-    balls_in_rect(xc - Vec2{reach, reach}, xc + Vec2{reach, reach}, near);
-    std::uint32_t next = kNone;
-    for (std::uint32_t k : near) {
-      if (k == cur || is_turtle(k) || !in_line(xc, bc.r, k)) continue;
-      if (next != kNone) return false;  // a branch
-      next = k;
-    }
-    if (next != kNone) {
-      row.push_back(next);
-      cur = next;
-      continue;
-    }
-    for (std::uint32_t v = 0; v < walls_.segments.size(); ++v) {
-      if (v == w || walls_.mover_of[v] != kNone) continue;
-      if constexpr (kExtras)
-        if (!bodies_.layers[cur].collides_with(walls_.layers[v])) continue;
-      const Segment& sv = walls_.segments[v];
-      const Vec2 rel = arena_.rel_to_segment(xc, sv);
-      const double foot = dot(rel, sv.u), d = dot(rel, sv.n);
-      const Vec2 nv = d >= 0.0 ? sv.n : -sv.n;
-      if (foot < 0.0 || foot > sv.len || dot(nv, n) >= 0.0 || std::abs(sim::cross(nv, n)) > kParallel) continue;
-      if (touching(std::abs(d) - bc.r, bc.r, xc)) {
-        far = v;
+bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, LastPartner obstacle, LastPartner before) {
+  // A row of balls exactly filling the room between two standing obstacles (docs/physics.md,
+  // "Clusters: a jammed chain"): fixed walls, fixed wall ends, standing turtles. Take n along the
+  // row. The test, which proves the zero-time sequence does not end: every contact of every ball
+  // of the row is either a contact of the row (a ball or an end obstacle touching it in line with
+  // n) or has its normal across n. Then every impulse of the sequence is either along n (the
+  // row's) or across it, so the velocities along n evolve as in a one-dimensional row between
+  // two walls, where the only velocities that open none of its contacts have 0 <= v_0 . n <=
+  // v_1 . n <= ... <= v_last . n <= 0, none along the row at all. At e = 1 the row's energy along
+  // n is kept by each collision and is not zero (ball i approached the obstacle), so that set is
+  // never reached; at e < 1 it is reached only in the limit. The limit is that set's one member:
+  // every ball keeps its velocity across n and loses the one along it. A ball touching the row
+  // at any other angle could take part of the impulse away (the sequence may end): not this rule.
+  // Asked at ball i's contact with `obstacle` right after ball `before` (the impulse arriving
+  // through a row): cheap unless `before` still touches i in line.
+  if constexpr (!kBallBall) {
+    (void)i, (void)obstacle, (void)before;
+    return false;
+  } else {
+    if (is_turtle(i) || before.kind() != Partner::body || is_turtle(before.index())) return false;
+    const std::uint32_t nb = bodies_.balls();
+    constexpr double kParallel = 1e-9;  // as the squeeze rule's parallel walls
+    Parts<F, kStep, kExtras> pa = parts();
+    const Look<F, kExtras> lk = look();
+    // An obstacle touching a ball of the row: its normal towards the ball, and whether it stands
+    // along that normal (a fixed wall or end; a turtle neither carried nor receding: one driving
+    // onto the ball stops at the contact).
+    struct Touch {
+      LastPartner who;
+      Vec2 n;
+      bool standing = false;
+    };
+    auto turtle_touch = [&](std::uint32_t t, Vec2 x, double r, Touch& out) {
+      const Body& bt = bodies_.body[t];
+      if (bt.cell == kNone) return false;
+      const Vec2 d = arena_.min_image(x - (bt.x + (now_ - bt.t) * bt.v));
+      const double dist = norm(d);
+      if (!(dist > 0.0) || !touching(dist - r - bt.r, std::min(r, bt.r), x)) return false;
+      Vec2 vc;
+      const bool arcs = motion_.any_arcs() && motion_.arcs(t);
+      out = {LastPartner::of(Partner::body, t), d / dist, !arcs && !carried(pa, t, vc) && dot(bt.v, d) >= 0.0};
+      return true;
+    };
+    // Every obstacle touching the ball of radius r at x, through `f(Touch)`.
+    auto each_obstacle = [&](std::uint32_t k, Vec2 x, double r, auto&& f) {
+      const std::uint32_t walls = static_cast<std::uint32_t>(walls_.segments.size());
+      for (std::uint32_t v = 0; v < walls; ++v) {
+        if (!lk.meets_wall(k, v)) continue;
+        const std::uint32_t mi = walls_.mover_of[v];
+        const Segment seg = mi == kNone ? walls_.segments[v] : schedule_.movers[mi].segment_at(walls_.segments[v], now_);
+        const Vec2 rel = arena_.rel_to_segment(x, seg);
+        const double foot = dot(rel, seg.u);
+        const bool interior = foot > 0.0 && foot < seg.len;
+        if (mi == kNone && !interior) continue;  // a fixed wall's ends are the ends' (below)
+        const Vec2 off = rel - std::clamp(foot, 0.0, seg.len) * seg.u;
+        const double dist = norm(off);
+        if (!(dist > 0.0) || !touching(dist - r, r, x)) continue;
+        const Vec2 nc = interior ? (dot(rel, seg.n) >= 0.0 ? seg.n : -seg.n) : off / dist;
+        f(Touch{LastPartner::of(Partner::wall, v), nc, mi == kNone});
+      }
+      const std::uint32_t ends = static_cast<std::uint32_t>(walls_.ends.size());
+      for (std::uint32_t e = 0; e < ends; ++e) {
+        if (!lk.meets_end(k, e)) continue;
+        const Vec2 d = arena_.min_image(x - walls_.ends[e].p);
+        const double dist = norm(d);
+        if (!(dist > 0.0) || !touching(dist - r, r, x)) continue;
+        f(Touch{LastPartner::of(Partner::end, e), d / dist, true});
+      }
+      const std::uint32_t all = static_cast<std::uint32_t>(bodies_.body.size());
+      for (std::uint32_t t = nb; t < all; ++t)
+        if (Touch o; lk.meets(k, t) && turtle_touch(t, x, r, o)) f(o);
+    };
+    // The near end: the obstacle just met, standing along its normal n.
+    const Body& bi = bodies_.body[i];
+    Vec2 n;
+    switch (obstacle.kind()) {
+      case Partner::wall: {
+        const std::uint32_t w = obstacle.index();
+        if (walls_.mover_of[w] != kNone) return false;
+        const Segment& sw = walls_.segments[w];
+        const double dw = dot(arena_.rel_to_segment(bi.x, sw), sw.n);
+        n = dw >= 0.0 ? sw.n : -sw.n;  // from the wall along the row
         break;
       }
+      case Partner::end: {
+        const Vec2 d = arena_.min_image(bi.x - walls_.ends[obstacle.index()].p);
+        const double dist = norm(d);
+        if (!(dist > 0.0)) return false;
+        n = d / dist;
+        break;
+      }
+      case Partner::body: {
+        Touch o;
+        if (!is_turtle(obstacle.index()) || !turtle_touch(obstacle.index(), bi.x, bi.r, o) || !o.standing) return false;
+        n = o.n;
+        break;
+      }
+      default: return false;
     }
-    break;
+    // Ball k touches the ball at `at` (radius ra); `ahead` says on which side along n, `in_line`
+    // whether in line with n.
+    auto ball_touch = [&](Vec2 at, double ra, std::uint32_t k, bool& ahead, bool& in_line) {
+      const Body& bk = bodies_.body[k];
+      const Vec2 rel = arena_.min_image(motion_.pos(bk, k, now_ - bk.t) - at);
+      const double dist = norm(rel);
+      if (!touching(dist - (ra + bk.r), std::min(ra, bk.r), at)) return false;
+      ahead = dot(rel, n) > 0.0;
+      in_line = std::abs(sim::cross(rel, n)) <= kParallel * dist;
+      // (Across: |rel . n| <= kParallel dist, the caller's test.)
+      return true;
+    };
+    {
+      bool ahead = false, in_line = false;
+      if (!ball_touch(bi.x, bi.r, before.index(), ahead, in_line) || !ahead || !in_line) return false;
+    }
+    // Walk the row from i along n: each ball's touches are classified (the test above).
+    std::vector<std::uint32_t> row{i};
+    std::vector<std::uint32_t> near;
+    Touch far{};
+    bool found = false;
+    while (!found) {
+      if (row.size() > nb) return false;  // (a ring: a periodic row)
+      const std::uint32_t cur = row.back();
+      const Body& bc = bodies_.body[cur];
+      const Vec2 xc = motion_.pos(bc, cur, now_ - bc.t);
+      const double reach = bc.r + 2.0 * step_.rmax;
+      near.clear();
+      balls_in_rect(xc - Vec2{reach, reach}, xc + Vec2{reach, reach}, near);
+      std::uint32_t next = kNone;
+      for (const std::uint32_t k : near) {
+        if (k == cur || is_turtle(k) || !lk.meets(cur, k)) continue;
+        bool ahead = false, in_line = false;
+        if (!ball_touch(xc, bc.r, k, ahead, in_line)) continue;
+        if (in_line) {
+          if (!ahead) {
+            if (row.size() >= 2 && k == row[row.size() - 2]) continue;
+            return false;  // a ball behind the first ball, or a second one behind this one
+          }
+          if (next != kNone) return false;
+          next = k;
+          continue;
+        }
+        const Body& bk = bodies_.body[k];
+        const Vec2 rel = arena_.min_image(motion_.pos(bk, k, now_ - bk.t) - xc);
+        if (std::abs(dot(rel, n)) > kParallel * norm(rel)) return false;  // neither in line nor across
+      }
+      bool ok = true;
+      Touch ahead_obstacle{};
+      bool has_ahead = false;
+      each_obstacle(cur, xc, bc.r, [&](const Touch& o) {
+        if (std::abs(sim::cross(o.n, n)) <= kParallel) {
+          // In line: behind the first ball (the near end, standing) or ahead of this one (the far
+          // end, standing). Anything else in line (a moving wall) is not this rule.
+          if (!o.standing) ok = false;
+          else if (dot(o.n, n) > 0.0) {
+            if (row.size() != 1) ok = false;  // (behind the first ball: the near end)
+          } else {
+            ahead_obstacle = o;
+            has_ahead = true;
+          }
+        } else if (std::abs(dot(o.n, n)) > kParallel) {
+          ok = false;  // an obstacle at an angle: it could turn the impulse
+        }
+      });
+      if (!ok || (has_ahead && next != kNone)) return false;
+      if (next != kNone) {
+        row.push_back(next);
+        continue;
+      }
+      if (!has_ahead) return false;  // the row's far end is free: the sequence ends
+      far = ahead_obstacle;
+      found = true;
+    }
+    // Jammed: the limit. Each ball keeps its velocity across the row; the ledger books what it had
+    // along it (at e = 1 a rattle of zero amplitude would keep it: not tracked, reported instead).
+    for (const std::uint32_t k : row) sync(k);
+    for (const std::uint32_t k : row) {
+      Body& bk = bodies_.body[k];
+      const double vn = dot(bk.v, n);
+      const Vec2 v = bk.v - vn * n;
+      record_.take_energy(record_.stats.energy_wedged, k, 0.5 * bodies_.mass[k] * (norm2(bk.v) - norm2(v)));
+      bk.v = v;
+      pa.changed(k);
+      // Its contacts with the two ends are answered at this instant (the mark the squeeze rule
+      // leaves).
+      bodies_.hold(k, obstacle, far.who, now_, motion_.straight(k));
+    }
+    // The event names the ball and the two ends (a turtle by its index, an end by its wall).
+    auto name = [&](LastPartner o) {
+      return o.kind() == Partner::body ? o.index() - nb : o.kind() == Partner::end ? walls_.ends[o.index()].wall : o.index();
+    };
+    const std::uint8_t flags = static_cast<std::uint8_t>((obstacle.kind() == Partner::body ? kTurtleB : 0) |
+                                                         (far.who.kind() == Partner::body ? kTurtleC : 0));
+    record_.note(t_base_ + now_, EventKind::wedged, i, name(obstacle), name(far.who), flags);
+    ++record_.stats.wedged;
+    for (const std::uint32_t k : row) repredict(k);
+    return true;
   }
-  if (far == kNone) return false;
-  // Jammed: the limit. Each ball keeps its velocity across the row; the ledger books what it had
-  // along it (at e = 1 a rattle of zero amplitude would keep it: not tracked, reported instead).
-  for (std::uint32_t k : row) sync(k);
-  Parts<F, kStep, kExtras> pa = parts();
-  for (std::uint32_t k : row) {
-    Body& bk = bodies_.body[k];
-    const double vn = dot(bk.v, n);
-    const Vec2 v = bk.v - vn * n;
-    record_.take_energy(record_.stats.energy_wedged, k, 0.5 * bodies_.mass[k] * (norm2(bk.v) - norm2(v)));
-    bk.v = v;
-    pa.changed(k);
-    // Its contacts in the row are answered at this instant (the mark the squeeze rule leaves).
-    bodies_.hold(k, LastPartner::of(Partner::wall, w), LastPartner::of(Partner::wall, far), now_, motion_.straight(k));
-  }
-  record_.note(t_base_ + now_, EventKind::wedged, i, w, far, 0);
-  ++record_.stats.wedged;
-  for (std::uint32_t k : row) repredict(k);
-  return true;
 }
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
