@@ -67,6 +67,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <concepts>
 #include <cstdint>
@@ -319,8 +320,8 @@ class Engine final : public EngineBase {
   /// The jammed chain (docs/physics.md, "Clusters: a jammed chain"): ball i has just met a standing
   /// `obstacle` (a fixed wall or wall end, a turtle) after ball `before`; if it heads a straight
   /// row of touching balls that ends on another standing obstacle in line, and nothing else
-  /// touches the row but across it, every ball's velocity along the row is taken (the limit of the
-  /// zero-time sequence), and true is returned (contacts/resolve.hpp). Out of line: it runs only
+  /// touches the row but across it or out of its reach, every ball's velocity along the row is
+  /// taken (the limit of the zero-time sequence), and true is returned (contacts/resolve.hpp). Out of line: it runs only
   /// after a ball, and inlined it would change GCC's inlining of the engine's loop.
   [[gnu::noinline]] bool jammed_chain(std::uint32_t i, LastPartner obstacle, LastPartner before);
   /// The squeeze rule (contacts/squeeze.hpp) for body i after its contact with bodies_.last[i]; `before`:
@@ -376,6 +377,14 @@ class Engine final : public EngineBase {
   /// At next_check_: throws EventLimitReached or StopRequested, or sets the next check.
   [[gnu::cold, gnu::noinline]] void check_stop();
   StepState step_;  ///< step mode only
+  /// The jammed chain's states seen at one instant where a contact at an angle kept the rule out:
+  /// the velocities and last partners of the row and of what touches it at an angle, to see the
+  /// zero-time sequence come back to one of them (contacts/resolve.hpp). Empty but at such an
+  /// instant.
+  struct RowsSeen {
+    double t = 0.0;
+    std::vector<std::vector<std::uint64_t>> states;
+  } rows_seen_;
 
   EventRecord record_;
 };

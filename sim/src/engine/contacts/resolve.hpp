@@ -155,8 +155,9 @@ bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, LastPar
   // v_1 . n <= ... <= v_last . n <= 0, none along the row at all. At e = 1 the row's energy along
   // n is kept by each collision and is not zero (ball i approached the obstacle), so that set is
   // never reached; at e < 1 it is reached only in the limit. The limit is that set's one member:
-  // every ball keeps its velocity across n and loses the one along it. A ball touching the row
-  // at any other angle could take part of the impulse away (the sequence may end): not this rule.
+  // every ball keeps its velocity across n and loses the one along it. A contact at any other
+  // angle could take part of the impulse away (the sequence may end): the rule acts only when it
+  // is proven out of the row's reach (below).
   // Asked at ball i's contact with `obstacle` right after ball `before` (the impulse arriving
   // through a row): cheap unless `before` still touches i in line.
   if constexpr (!kBallBall) {
@@ -175,6 +176,7 @@ bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, LastPar
       LastPartner who;
       Vec2 n;
       bool standing = false;
+      double gap = 0.0;  ///< the distance between their surfaces (within the contact tolerance)
     };
     auto turtle_touch = [&](std::uint32_t t, Vec2 x, double r, Touch& out) {
       const Body& bt = bodies_.body[t];
@@ -184,7 +186,8 @@ bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, LastPar
       if (!(dist > 0.0) || !touching(dist - r - bt.r, std::min(r, bt.r), x)) return false;
       Vec2 vc;
       const bool arcs = motion_.any_arcs() && motion_.arcs(t);
-      out = {LastPartner::of(Partner::body, t), d / dist, !arcs && !carried(pa, t, vc) && dot(bt.v, d) >= 0.0};
+      out = {LastPartner::of(Partner::body, t), d / dist, !arcs && !carried(pa, t, vc) && dot(bt.v, d) >= 0.0,
+             dist - r - bt.r};
       return true;
     };
     // Every obstacle touching the ball of radius r at x, through `f(Touch)`.
@@ -202,7 +205,7 @@ bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, LastPar
         const double dist = norm(off);
         if (!(dist > 0.0) || !touching(dist - r, r, x)) continue;
         const Vec2 nc = interior ? (dot(rel, seg.n) >= 0.0 ? seg.n : -seg.n) : off / dist;
-        f(Touch{LastPartner::of(Partner::wall, v), nc, mi == kNone});
+        f(Touch{LastPartner::of(Partner::wall, v), nc, mi == kNone, dist - r});
       }
       const std::uint32_t ends = static_cast<std::uint32_t>(walls_.ends.size());
       for (std::uint32_t e = 0; e < ends; ++e) {
@@ -210,7 +213,7 @@ bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, LastPar
         const Vec2 d = arena_.min_image(x - walls_.ends[e].p);
         const double dist = norm(d);
         if (!(dist > 0.0) || !touching(dist - r, r, x)) continue;
-        f(Touch{LastPartner::of(Partner::end, e), d / dist, true});
+        f(Touch{LastPartner::of(Partner::end, e), d / dist, true, dist - r});
       }
       const std::uint32_t all = static_cast<std::uint32_t>(bodies_.body.size());
       for (std::uint32_t t = nb; t < all; ++t)
@@ -262,6 +265,14 @@ bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, LastPar
     // Walk the row from i along n: each ball's touches are classified (the test above).
     std::vector<std::uint32_t> row{i};
     std::vector<std::uint32_t> near;
+    // A contact of a row ball `ball` at an angle to the row, with a ball `other` (kNone: a fixed
+    // wall or end), m the unit normal from `ball` towards it, `gap` between their surfaces.
+    struct Oblique {
+      std::uint32_t ball, other;
+      Vec2 m;
+      double gap;
+    };
+    std::vector<Oblique> oblique;
     Touch far{};
     bool found = false;
     while (!found) {
@@ -288,7 +299,8 @@ bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, LastPar
         }
         const Body& bk = bodies_.body[k];
         const Vec2 rel = arena_.min_image(motion_.pos(bk, k, now_ - bk.t) - xc);
-        if (std::abs(dot(rel, n)) > kParallel * norm(rel)) return false;  // neither in line nor across
+        const double dist = norm(rel);
+        if (std::abs(dot(rel, n)) > kParallel * dist) oblique.push_back({cur, k, rel / dist, dist - bc.r - bk.r});
       }
       bool ok = true;
       Touch ahead_obstacle{};
@@ -305,7 +317,10 @@ bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, LastPar
             has_ahead = true;
           }
         } else if (std::abs(dot(o.n, n)) > kParallel) {
-          ok = false;  // an obstacle at an angle: it could turn the impulse
+          // An obstacle at an angle: a fixed wall or end is asked below whether the row can reach
+          // it; anything else (a turtle, a moving wall) could turn the impulse.
+          if (o.standing && o.who.kind() != Partner::body) oblique.push_back({cur, kNone, -o.n, o.gap});
+          else ok = false;
         }
       });
       if (!ok || (has_ahead && next != kNone)) return false;
@@ -317,9 +332,72 @@ bool Engine<F, kBallBall, kStep, kExtras>::jammed_chain(std::uint32_t i, LastPar
       far = ahead_obstacle;
       found = true;
     }
+    for (const std::uint32_t k : row) sync(k);
+    // Contacts at an angle to the row: the rule acts only if the row's own sequence can never close
+    // one (docs/physics.md, "Clusters: a jammed chain"). One with a gap > 0 cannot: the sequence
+    // takes no time and the speeds in it are bounded (below), so it is over before the gap is
+    // crossed (the row is answered first, then that contact, as the engine would serve them).
+    // For one in contact (gap <= 0): in the row's sequence every impulse is along n,
+    // so each row ball keeps its velocity w across n, the row's energy along n, K, never grows (its
+    // collisions are with each other and the standing ends, e <= 1), and |v . n| <= sqrt(2 K / m)
+    // for every ball of mass m in it; the other side of the contact keeps its velocity (a fixed
+    // obstacle, or a ball none of whose contacts with the row close). The contact's separating
+    // speed (v_other - v_ball) . m is then at least (v_other - w) . m - |n . m| sqrt(2 K / m_ball):
+    // positive, it stays open for the whole sequence, which is then the row's alone, with the
+    // limit below. Otherwise the sequence runs contact by contact, and this test is asked again at
+    // the row's next arrival (each impulse the oblique body takes opens it further).
+    bool open_for_ever = true;
+    if (!oblique.empty()) {
+      double K = 0.0;
+      for (const std::uint32_t k : row) {
+        const double a = dot(bodies_.body[k].v, n);
+        K += 0.5 * bodies_.mass[k] * a * a;
+      }
+      for (const Oblique& o : oblique) {
+        if (o.gap > 0.0) continue;
+        const Vec2 v = bodies_.body[o.ball].v, w = v - dot(v, n) * n;
+        Vec2 vo{};
+        if (o.other != kNone) {
+          const Body& bo = bodies_.body[o.other];
+          vo = motion_.vel(bo, o.other, now_ - bo.t);
+        }
+        const double open = dot(vo - w, o.m);
+        const double reach = std::abs(dot(n, o.m)) * std::sqrt(2.0 * K / bodies_.mass[o.ball]);
+        // (A margin of 1e-9 of the speeds for the round-off of the row's own collisions.)
+        if (!(open - reach > 1e-9 * (norm(vo - w) + reach))) open_for_ever = false;
+      }
+    }
+    if (!open_for_ever) {
+      // The bound cannot clear a contact at an angle, but the sequence the engine serves may still
+      // never close it (at e = 1 an impulse can pass a ball on before the ball's contact at the
+      // angle comes up: the queue serves equal times in the order of the bodies' ids). When the
+      // row and the bodies touching it at an angle come back, bit for bit, to velocities and last
+      // partners they had earlier at this instant, with no time passed, the engine (whose order
+      // depends on nothing else) would repeat that stretch for ever: the contacts at an angle took
+      // no impulse in it that they will not take again, and the row's limit is the sequence's.
+      // Otherwise the sequence runs on, and this is asked again at the row's next arrival.
+      std::vector<std::uint64_t> state;
+      std::vector<std::uint32_t> who(row);
+      for (const Oblique& o : oblique)
+        if (o.other != kNone && o.gap <= 0.0) who.push_back(o.other);
+      std::sort(who.begin(), who.end());
+      who.erase(std::unique(who.begin(), who.end()), who.end());
+      for (const std::uint32_t k : who) {
+        const Body& bk = bodies_.body[k];
+        const Vec2 v = motion_.vel(bk, k, now_ - bk.t);
+        state.insert(state.end(), {k, std::bit_cast<std::uint64_t>(v.x), std::bit_cast<std::uint64_t>(v.y),
+                                   bodies_.last[k].code()});
+      }
+      if (rows_seen_.t != now_ || rows_seen_.states.empty()) rows_seen_ = {now_, {}};
+      const bool again = std::find(rows_seen_.states.begin(), rows_seen_.states.end(), state) != rows_seen_.states.end();
+      if (!again) {
+        if (rows_seen_.states.size() < 64) rows_seen_.states.push_back(std::move(state));
+        return false;
+      }
+    }
+    rows_seen_.states.clear();
     // Jammed: the limit. Each ball keeps its velocity across the row; the ledger books what it had
     // along it (at e = 1 a rattle of zero amplitude would keep it: not tracked, reported instead).
-    for (const std::uint32_t k : row) sync(k);
     for (const std::uint32_t k : row) {
       Body& bk = bodies_.body[k];
       const double vn = dot(bk.v, n);
