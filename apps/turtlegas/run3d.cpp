@@ -147,11 +147,14 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
                        {"energy_end", world->energy()},
                        {"max_overlap", std::max(overlap, 0.0)},
                        {"max_contact_error", world->max_contact_error()}};
+  const bool moving = std::any_of(w.def.walls.begin(), w.def.walls.end(), [](const sim::Wall3Def& x) { return !x.keys.empty(); });
+  if (moving) stats["wall_work"] = world->wall_work();  // energy_end - energy_start at e = 1 (docs/physics.md)
   if (stats_file) stats_file->stream() << stats.dump(1) + "\n";
   if (opt.stats)
     std::printf("3-D %s run to t = %g: %llu collisions, %llu events, energy %.15g -> %.15g, max overlap %.3g r, %.3f s\n",
                 std::string(sim::to_string(w.def.mode)).c_str(), world->time(), static_cast<unsigned long long>(world->collisions()),
                 static_cast<unsigned long long>(world->events()), e0, world->energy(), std::max(overlap, 0.0), wall);
+  if (opt.stats && moving) std::printf("  moving walls gave the spheres %.15g of energy (wall_work)\n", world->wall_work());
   if (observe_file) {
     observe_file->stream() << observer->result().dump(1) << '\n';
     observe_file->commit();
@@ -208,7 +211,8 @@ int render3d(const std::string& file, double at, const std::string& out, double 
     text += "<g transform=\"translate(0 " + fmt(size.y) + ") scale(1 -1)\">\n";
     for (std::size_t k = 0; k < w.def.walls.size(); ++k) {
       text += "<polygon points=\"";
-      for (const sim::Vec3& c : w.def.walls[k].corners) text += fmt(c.x) + "," + fmt(c.y) + " ";
+      const sim::Vec3 shift = world->wall_shift(k);  // a moving wall where it is at t
+      for (const sim::Vec3& c : w.def.walls[k].corners) text += fmt(c.x + shift.x) + "," + fmt(c.y + shift.y) + " ";
       std::snprintf(b, sizeof b, "\" fill=\"#c8b070\" fill-opacity=\"0.35\" stroke=\"#806020\" stroke-width=\"%g\"/>\n", 1.0 / scale);
       text += b;
     }
@@ -231,9 +235,11 @@ int render3d(const std::string& file, double at, const std::string& out, double 
     cairo_paint(cr);
     cairo_translate(cr, 0, H);
     cairo_scale(cr, scale, -scale);
-    for (const sim::Wall3Def& wall : w.def.walls) {
+    for (std::size_t n = 0; n < w.def.walls.size(); ++n) {
+      const sim::Wall3Def& wall = w.def.walls[n];
+      const sim::Vec3 shift = world->wall_shift(n);  // a moving wall where it is at t
       for (std::size_t k = 0; k < wall.corners.size(); ++k)
-        (k == 0 ? cairo_move_to : cairo_line_to)(cr, wall.corners[k].x, wall.corners[k].y);
+        (k == 0 ? cairo_move_to : cairo_line_to)(cr, wall.corners[k].x + shift.x, wall.corners[k].y + shift.y);
       cairo_close_path(cr);
       cairo_set_source_rgba(cr, 0.78, 0.69, 0.44, 0.35);
       cairo_fill_preserve(cr);

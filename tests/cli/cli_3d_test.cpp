@@ -42,6 +42,19 @@ TEST_CASE("run of a 3-D world: an edge contact at its closed-form time, named by
   CHECK(st["energy_start"] == st["energy_end"]);
 }
 
+TEST_CASE("run of a 3-D world with a moving wall: struck at rest, the sphere leaves at 2u; wall_work in the stats") {
+  TempDir dir;
+  const auto r = run(dir, {"run", "worlds/tests/moving_wall3d.json", "--until", "1.4", "--state-out",
+                           (dir.path / "s.json").string(), "--stats-json", (dir.path / "st.json").string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const auto s = nlohmann::json::parse(read(dir.path / "s.json"));
+  CHECK(std::abs(s["balls"][0]["vel"][0].get<double>() + 20.0) < 1e-12);
+  const auto st = nlohmann::json::parse(read(dir.path / "st.json"));
+  CHECK(std::abs(st["wall_work"].get<double>() - 400.0) < 1e-9);  // m/2 (2u)^2, m = 2, u = -10
+  CHECK(std::abs(st["energy_end"].get<double>() - st["energy_start"].get<double>() - 400.0) < 1e-9);
+}
+
 TEST_CASE("run of a 3-D world with restitution: the scene's e, a ball's own, a wall's, in closed form") {
   TempDir dir;
   // Sphere a (the scene's e = 0.5) falls onto the shelf (e = 0.8) with normal speed 2: it leaves
@@ -137,6 +150,19 @@ TEST_CASE("3-D world file errors name the JSON path and the fix, exit 2") {
        "sphere 0 overlaps wall 0"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10, "boundary": "walls"}, "balls": [{"id": "a", "pos": [0.5, 5, 5], "radius": 1}]})",
        "overlaps the arena's walls"},
+      // Moving walls' keys (docs/worlds.md, "Moving walls in 3-D").
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 1, "corners": [[1, 1, 4], [9, 1, 4], [5, 9, 3]]}]}]})",
+       "/walls/0/keys/0/corners/2: a 3-D wall may only translate"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 2, "corners": [[1, 1, 4], [9, 1, 4], [5, 9, 4]]}, {"t": 1, "corners": [[1, 1, 3], [9, 1, 3], [5, 9, 3]]}]}]})",
+       "/walls/0/keys/1/t: key times must increase"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 1, "corners": [[1, 1, 4], [9, 1, 4]]}]}]})",
+       "/walls/0/keys/0/corners: a key lists the wall's 3 corners"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 1, "corners": [[1, 1, 12], [9, 1, 12], [5, 9, 12]]}]}]})",
+       "/walls/0/keys/0/corners/0: the wall leaves the arena"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10, "boundary": "periodic"}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 1, "corners": [[1, 1, 4], [9, 1, 4], [5, 9, 4]]}]}]})",
+       "/walls/0/keys: moving walls are not supported in a periodic arena"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 0, "corners": [[1, 1, 4], [9, 1, 4], [5, 9, 4]]}]}]})",
+       "/walls/0/keys/0/t"},
   };
   for (const Case& c : cases) {
     const auto world = dir.write("bad.json", c.text);

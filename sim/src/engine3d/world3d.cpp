@@ -157,6 +157,19 @@ std::string check_world3(const World3Def& def) {
     double scale = 0.0;
     for (std::size_t k = 0; k < c.size(); ++k) scale = std::max(scale, norm(c[(k + 1) % c.size()] - c[k]));
     if (!(an > 1e-12 * scale * scale)) return at + "corners are collinear, or not in order around the polygon (no plane)";
+    const auto& keys = def.walls[w].keys;
+    if (!keys.empty() && def.boundary == Boundary3::periodic)
+      return at + "moving walls are not supported in a periodic arena (use \"boundary\": \"walls\" or \"none\")";
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+      const std::string key = at + "key " + std::to_string(k) + ": ";
+      if (!std::isfinite(keys[k].t) || !(keys[k].t > (k == 0 ? 0.0 : keys[k - 1].t)))
+        return key + "times must be finite, > 0 and increasing";
+      if (!is_finite(keys[k].shift)) return key + "the pose must be finite";
+      for (const Vec3& p : c)
+        for (int a = 0; a < 3; ++a)
+          if (p[a] + keys[k].shift[a] < 0.0 || p[a] + keys[k].shift[a] > def.size[a])
+            return key + "the wall leaves the arena (every pose's corners must lie in it)";
+    }
     const Vec3 n = (1.0 / an) * area;
     for (std::size_t k = 0; k < c.size(); ++k) {
       if (std::abs(dot(c[k] - c[0], n)) > 1e-9 * scale) return at + "corners are not in one plane";
@@ -191,6 +204,19 @@ struct World3::Impl {
   double contact_error = 0.0;
   double virial = 0.0;
   std::vector<double> wall_push;  // per wall: sum of m Δv . n over its contacts (World3::wall_push)
+  // Moving walls (docs/physics.md, "3-D: moving walls"): per wall, its translation `shift_ref`
+  // at time `key_t` and its velocity since, with the keys still ahead. A standing wall has all
+  // zero and no keys, and its formulas below are bit for bit those without motion (x - 0 == x).
+  struct Motion {
+    Vec3 shift_ref, u;
+    double t_ref = 0.0;
+    std::vector<Wall3Key> keys;
+    std::size_t next = 0;  // the key it is heading for (keys.size(): it has stopped)
+    Vec3 shift_at(double t) const { return shift_ref + (t - t_ref) * u; }
+  };
+  std::vector<Motion> motion;  // per wall; empty when no wall moves
+  double next_key = kNever;    // the earliest key ahead of any wall
+  double wall_work = 0.0;      // World3::wall_work
   std::vector<Event3>* log = nullptr;
   // Restitution (docs/physics.md, "3-D: restitution"): kept beside the records, and only when
   // some e < 1, so that an elastic gas's record and loop are unchanged.
@@ -236,7 +262,8 @@ struct World3::Impl {
   explicit Impl(const World3Def& def) : boundary(def.boundary), size(def.size) {
     double r_max = 0.0;
     for (const auto& s : def.spheres) r_max = std::max(r_max, s.radius);
-    const double cell = def.cell > 0.0 ? def.cell : 2.0 * r_max * (1.0 + 0x1p-20);
+    // Without spheres (a world of walls only) one cell per axis.
+    const double cell = def.cell > 0.0 ? def.cell : r_max > 0.0 ? 2.0 * r_max * (1.0 + 0x1p-20) : std::max({size.x, size.y, size.z});
     for (int a = 0; a < 3; ++a) {
       n[a] = std::max(1, static_cast<int>(std::min(1024.0, std::floor(size[a] / std::max(cell, 1e-300)))));
       if (boundary == Boundary3::periodic && n[a] < 3)
@@ -263,16 +290,34 @@ struct World3::Impl {
       walls.emplace_back(std::vector<Vec3>{{0, 0, Z}, {0, Y, Z}, {X, Y, Z}, {X, 0, Z}});
     }
     wall_push.assign(walls.size(), 0.0);
+    bool any_moves = false;
+    for (const auto& wd : def.walls) any_moves = any_moves || !wd.keys.empty();
+    if (any_moves) {
+      motion.resize(walls.size());
+      for (std::size_t k = 0; k < def.walls.size(); ++k) {
+        motion[k].keys = def.walls[k].keys;
+        aim(motion[k]);
+      }
+      next_key = earliest_key();
+    }
     const std::size_t cells = static_cast<std::size_t>(n[0]) * n[1] * n[2];
     head.assign(cells, kNone);
     cell_walls.assign(cells, {});
     // A wall is listed in every cell within r_max of its bounding box: a sphere whose centre
-    // is in the cell can touch it only then.
+    // is in the cell can touch it only then. A moving wall's box is the one around all its
+    // poses: it translates in straight lines between them, so it never leaves that box.
     for (std::uint32_t k = 0; k < walls.size(); ++k) {
+      Vec3 box_lo = walls[k].lo, box_hi = walls[k].hi;
+      if (k < def.walls.size())
+        for (const Wall3Key& key : def.walls[k].keys)
+          for (int a = 0; a < 3; ++a) {
+            box_lo[a] = std::min(box_lo[a], walls[k].lo[a] + key.shift[a]);
+            box_hi[a] = std::max(box_hi[a], walls[k].hi[a] + key.shift[a]);
+          }
       int lo[3], hi[3];
       for (int a = 0; a < 3; ++a) {
-        lo[a] = std::clamp(static_cast<int>(std::floor((walls[k].lo[a] - r_max) / w[a])), 0, n[a] - 1);
-        hi[a] = std::clamp(static_cast<int>(std::floor((walls[k].hi[a] + r_max) / w[a])), 0, n[a] - 1);
+        lo[a] = std::clamp(static_cast<int>(std::floor((box_lo[a] - r_max) / w[a])), 0, n[a] - 1);
+        hi[a] = std::clamp(static_cast<int>(std::floor((box_hi[a] + r_max) / w[a])), 0, n[a] - 1);
       }
       for (int z = lo[2]; z <= hi[2]; ++z)
         for (int y = lo[1]; y <= hi[1]; ++y)
@@ -299,7 +344,7 @@ struct World3::Impl {
       dt = def.dt;
       for (Record& b : rec) b.a = {};
     }
-    queue.reset(&rec[0].node, sizeof(Record), rec.size());
+    queue.reset(rec.empty() ? nullptr : &rec[0].node, sizeof(Record), rec.size());
     for (std::uint32_t i = 0; i < rec.size(); ++i) predict(i);
   }
 
@@ -319,6 +364,44 @@ struct World3::Impl {
     }
   }
   double step_end(std::uint64_t k) const { return static_cast<double>(k) * dt; }
+
+  // A wall's velocity towards its next key from the pose it has taken (the previous key's, or no
+  // shift at t = 0): the chord (shift_next - shift_ref) / (t_next - t_ref); 0 after the last.
+  static void aim(Motion& m) {
+    if (m.next >= m.keys.size()) {
+      m.u = {};
+      return;
+    }
+    const Wall3Key& k = m.keys[m.next];
+    m.u = (1.0 / (k.t - m.t_ref)) * (k.shift - m.shift_ref);
+  }
+  double earliest_key() const {
+    double t = kNever;
+    for (const Motion& m : motion)
+      if (m.next < m.keys.size()) t = std::min(t, m.keys[m.next].t);
+    return t;
+  }
+  // The keyframe at t (== next_key): the walls due take their poses exactly and aim at their next;
+  // then every sphere predicts again (a key changes a wall's velocity, so every contact predicted
+  // with it is void; O(N), and keys are rare).
+  void take_keys(double t) {
+    now = t;
+    for (Motion& m : motion)
+      if (m.next < m.keys.size() && m.keys[m.next].t == t) {
+        m.shift_ref = m.keys[m.next].shift;
+        m.t_ref = t;
+        ++m.next;
+        aim(m);
+      }
+    next_key = earliest_key();
+  }
+  void predict_all() {
+    for (Record& b : rec) ++b.count;  // every pending pair event of the old predictions goes stale
+    for (std::uint32_t i = 0; i < rec.size(); ++i)
+      if (rec[i].alive) predict(i);
+  }
+  Vec3 shift_of(std::uint32_t k) const { return k < motion.size() ? motion[k].shift_at(now) : Vec3{}; }
+  Vec3 velocity_of(std::uint32_t k) const { return k < motion.size() ? motion[k].u : Vec3{}; }
 
   // The earliest cell exit of body b (at now) over the three axes.
   double cell_exit(const Record& b, std::uint8_t& axis, std::int8_t& dir) const {
@@ -352,17 +435,20 @@ struct World3::Impl {
     const double before = best;
     const Polygon3& p = walls[k];
     const double tol = 1e-12 * p.scale;
-    const Vec3 d = b.x - p.corners[0];
+    // In the wall's frame (it translates at u, shifted by o from its t = 0 corners) the sphere
+    // flies x - o, v - u, a: the same family of flights, against the wall's t = 0 corners.
+    const Vec3 x = b.x - shift_of(k), v = b.v - velocity_of(k);
+    const Vec3 d = x - p.corners[0];
     double c[5], times[4];
     // The face: the memo's plane formula, both sides (s = r falling, s = -r rising).
     {
-      const double s0 = dot(d, p.normal), s1 = dot(b.v, p.normal), s2 = 0.5 * dot(b.a, p.normal);
+      const double s0 = dot(d, p.normal), s1 = dot(v, p.normal), s2 = 0.5 * dot(b.a, p.normal);
       for (int side = -1; side <= 1; side += 2) {
         c[0] = side * s0 - b.r; c[1] = side * s1; c[2] = side * s2;
         const int m = approach_times(c, 2, best, 1e-9 * b.r, times);
         for (int q = 0; q < m; ++q) {
           if (!(times[q] < best)) break;
-          if (p.covers(fly(b.x, b.v, b.a, times[q]), tol)) {
+          if (p.covers(fly(x, v, b.a, times[q]), tol)) {
             best = times[q];
             b.kind = Pending::face; b.partner = k; b.partner_count = 0;
             break;
@@ -374,13 +460,13 @@ struct World3::Impl {
     for (std::size_t e = 0; e < nc; ++e) {
       // The edge: the cylinder of radius r around its line, where the foot is on the segment.
       const Vec3 u = p.along[e];
-      const Vec3 de = b.x - p.corners[e];
-      const Vec3 dp = de - dot(de, u) * u, vp = b.v - dot(b.v, u) * u, ap = b.a - dot(b.a, u) * u;
+      const Vec3 de = x - p.corners[e];
+      const Vec3 dp = de - dot(de, u) * u, vp = v - dot(v, u) * u, ap = b.a - dot(b.a, u) * u;
       squared_gap(dp, vp, ap, b.r, c);
       const int m = approach_times(c, 4, best, 1e-9 * b.r * b.r, times);
       for (int q = 0; q < m; ++q) {
         if (!(times[q] < best)) break;
-        const double s = dot(fly(de, b.v, b.a, times[q]), u);
+        const double s = dot(fly(de, v, b.a, times[q]), u);
         if (s >= -tol && s <= p.length[e] + tol) {
           best = times[q];
           b.kind = Pending::edge; b.partner = k; b.partner_count = static_cast<std::uint32_t>(e);
@@ -388,7 +474,7 @@ struct World3::Impl {
         }
       }
       // The corner: the memo's wall-end formula.
-      squared_gap(de, b.v, b.a, b.r, c);
+      squared_gap(de, v, b.a, b.r, c);
       const int mc = approach_times(c, 4, best, 1e-9 * b.r * b.r, times);
       if (mc > 0 && times[0] < best) {
         best = times[0];
@@ -570,11 +656,12 @@ struct World3::Impl {
         const Polygon3& p = walls[b.partner];
         Vec3 normal;
         Event3Kind kind;
-        const Vec3 d = b.x - p.corners[b.partner_count];
+        const Vec3 x = b.x - shift_of(b.partner);  // in the wall's frame, against its t = 0 corners
+        const Vec3 d = x - p.corners[b.partner_count];
         if (b.kind == Pending::face) {
-          normal = dot(b.x - p.corners[0], p.normal) >= 0.0 ? p.normal : -p.normal;  // towards the sphere
+          normal = dot(x - p.corners[0], p.normal) >= 0.0 ? p.normal : -p.normal;  // towards the sphere
           kind = Event3Kind::ball_wall;
-          contact_error = std::max(contact_error, std::abs(std::abs(dot(b.x - p.corners[0], normal)) - b.r) / b.r);
+          contact_error = std::max(contact_error, std::abs(std::abs(dot(x - p.corners[0], normal)) - b.r) / b.r);
         } else if (b.kind == Pending::edge) {
           const Vec3 u = p.along[b.partner_count];
           normal = d - dot(d, u) * u;
@@ -586,8 +673,16 @@ struct World3::Impl {
           contact_error = std::max(contact_error, std::abs(norm(normal) - b.r) / b.r);
         }
         const Vec3 v_before = b.v;
+        // The bounce in the wall's frame: v' = u + bounce(v - u) (u = 0 for a standing wall).
+        const bool moves = !motion.empty();  // else bit for bit the standing walls' bounce
+        const Vec3 u = velocity_of(b.partner);
+        if (moves) b.v -= u;
         if (inelastic) bounce_inelastic(i, b, normal, b.partner);
         else reflect(b, normal);
+        if (moves) {
+          b.v += u;
+          wall_work += 0.5 * b.m * (norm2(b.v) - norm2(v_before));
+        }
         wall_push[b.partner] += b.m * dot(b.v - v_before, normal) / norm(normal);
         note(kind, i, b.partner, b.partner_count);
         predict(i);
@@ -630,12 +725,18 @@ struct World3::Impl {
   }
 
   void advance_to(double t) {
-    // Step mode: the contacts of a step (up to and at its end), then the kick.
-    if (!field_a.empty())
-      while (step_end(steps + 1) <= t) {
-        serve_until(step_end(steps + 1));
-        kick(step_end(++steps));
-      }
+    // Step mode: the contacts of a step (up to and at its end), then the kick. A moving wall's
+    // key: the contacts up to and at it, then the walls' new courses and every sphere predicted
+    // again (by the kick, when a step ends at the same instant).
+    for (;;) {
+      const double step = field_a.empty() ? kNever : step_end(steps + 1);
+      const double stop = std::min(step, next_key);
+      if (!(stop <= t)) break;
+      serve_until(stop);
+      if (stop == next_key) take_keys(stop);
+      if (stop == step) kick(step_end(++steps));
+      else predict_all();
+    }
     serve_until(t);
     now = t;
   }
@@ -693,6 +794,8 @@ std::uint64_t World3::events() const { return impl_->events; }
 double World3::max_contact_error() const { return impl_->contact_error; }
 double World3::virial_sum() const { return impl_->virial; }
 double World3::wall_push(std::size_t w) const { return impl_->wall_push.at(w); }
+Vec3 World3::wall_shift(std::size_t w) const { return impl_->shift_of(static_cast<std::uint32_t>(w)); }
+double World3::wall_work() const { return impl_->wall_work; }
 double World3::wall_area(std::size_t w) const {
   const std::vector<Vec3>& c = impl_->walls.at(w).corners;
   Vec3 twice;  // Newell's: twice the area along the normal, for any planar polygon
@@ -715,7 +818,8 @@ double World3::max_overlap_now() const {
       const double gap = m.rec[i].r + m.rec[j].r - norm(d);
       worst = std::max(worst, gap / std::min(m.rec[i].r, m.rec[j].r));
     }
-    for (const Polygon3& p : m.walls) worst = std::max(worst, (m.rec[i].r - p.distance(xi)) / m.rec[i].r);
+    for (std::uint32_t k = 0; k < m.walls.size(); ++k)
+      worst = std::max(worst, (m.rec[i].r - m.walls[k].distance(xi - m.shift_of(k))) / m.rec[i].r);
   }
   return worst;
 }

@@ -30,10 +30,20 @@ struct Sphere3Def {
   double restitution = 1.0;
 };
 
+/// A moving wall's pose at a keyframe: its translation from its corners at t = 0.
+struct Wall3Key {
+  double t = 0.0;  ///< seconds, > 0, increasing along a wall's keys
+  Vec3 shift;      ///< world units: every corner at time t is its t = 0 corner plus shift
+};
+
 /// A convex planar polygon, corners in order (3 or more, not collinear).
 struct Wall3Def {
-  std::vector<Vec3> corners;
+  std::vector<Vec3> corners;  ///< at t = 0
   double restitution = 1.0;  ///< in [0, 1]; a contact takes this times the sphere's e
+  /// A translating wall (docs/physics.md, "3-D: moving walls"): between two keys (and from t = 0
+  /// and no shift to the first) it moves at constant velocity; after the last it stays. Empty:
+  /// it stands. Not in a periodic arena.
+  std::vector<Wall3Key> keys = {};
 };
 
 struct World3Def {
@@ -117,6 +127,12 @@ class World3 {
   /// over wall_area(w) is the pressure on the wall (docs/observables.md).
   double wall_push(std::size_t w) const;
   double wall_area(std::size_t w) const;  ///< the polygon's area
+  /// The translation of wall w from its t = 0 corners, at time(); zero for a standing wall.
+  Vec3 wall_shift(std::size_t w) const;
+  /// The kinetic energy moving walls have given the spheres since the start (negative: taken),
+  /// booked at each bounce off a moving wall as m/2 (|v'|^2 - |v|^2). With every e = 1,
+  /// energy() - its start equals it to round-off (docs/physics.md, "3-D: moving walls").
+  double wall_work() const;
 
  private:
   struct Impl;
