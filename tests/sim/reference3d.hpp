@@ -8,7 +8,9 @@
 // where the nearest point lies. O(N^2 + N W) per step: small scenes only. Restitution as
 // docs/physics.md "3-D: restitution" states it, written from that text: a pair's e the larger of
 // its spheres' (1 for one that changed course less than tc ago), a wall's the product, normal
-// speeds leaving at 2^-40 of the speeds at least, and at |a_n| tc / 2 where pressed.
+// speeds leaving at 2^-40 of the speeds at least, and at |a_n| tc / 2 where pressed. Moving walls
+// as "3-D: moving walls" states them: the shift interpolated between keys, distances to the
+// shifted corners, steps that never pass a key, the bounce on the velocity relative to the wall.
 #pragma once
 
 #include <algorithm>
@@ -62,6 +64,7 @@ struct Reference3 {
   std::vector<Ball> balls;
   std::vector<std::vector<Vec3>> walls;
   std::vector<double> wall_e;
+  std::vector<std::vector<sim::Wall3Key>> wall_keys;
   double tc = 0.0;
   double t = 0.0;
 
@@ -72,7 +75,39 @@ struct Reference3 {
     for (const auto& w : def.walls) {
       walls.push_back(w.corners);
       wall_e.push_back(w.restitution);
+      wall_keys.push_back(w.keys);
     }
+  }
+
+  // Wall k's velocity and shift at t: the chord between the keys around t (at a key, the next).
+  Vec3 wall_u(std::size_t k) const {
+    const auto& keys = wall_keys[k];
+    double t0 = 0.0;
+    Vec3 s0;
+    for (const sim::Wall3Key& key : keys) {
+      if (key.t > t) return (1.0 / (key.t - t0)) * (key.shift - s0);
+      t0 = key.t;
+      s0 = key.shift;
+    }
+    return {};
+  }
+  Vec3 wall_shift(std::size_t k) const {
+    const auto& keys = wall_keys[k];
+    double t0 = 0.0;
+    Vec3 s0;
+    for (const sim::Wall3Key& key : keys) {
+      if (key.t > t) return s0 + ((t - t0) / (key.t - t0)) * (key.shift - s0);
+      t0 = key.t;
+      s0 = key.shift;
+    }
+    return s0;
+  }
+  double next_key() const {
+    double next = 1e300;
+    for (const auto& keys : wall_keys)
+      for (const sim::Wall3Key& key : keys)
+        if (key.t > t) next = std::min(next, key.t);
+    return next;
   }
 
   double e_of(const Ball& b) const { return t - b.last < tc ? 1.0 : b.e; }
@@ -92,7 +127,8 @@ struct Reference3 {
   /// Runs to t_end, appending events (ball_ball a < b; walls as the engine names them).
   void run(double t_end, std::vector<sim::Event3>& out, std::size_t max_events) {
     for (long steps = 0; steps < 50'000'000 && t < t_end && out.size() < max_events; ++steps) {
-      double step = t_end - t;
+      const double key = next_key();
+      double step = std::min(t_end, key) - t;
       bool served = false;
       for (std::size_t i = 0; i < balls.size() && !served; ++i) {
         for (std::size_t j = i + 1; j < balls.size() && !served; ++j) {
@@ -116,17 +152,18 @@ struct Reference3 {
           }
         }
         for (std::size_t k = 0; k < walls.size() && !served; ++k) {
-          const Nearest nw = nearest_on_polygon(walls[k], balls[i].x);
-          const Vec3 d = balls[i].x - nw.point;
+          const Vec3 u = wall_u(k), q = balls[i].x - wall_shift(k), rel = balls[i].v - u;
+          const Nearest nw = nearest_on_polygon(walls[k], q);
+          const Vec3 d = q - nw.point;
           const double g = nw.dist - balls[i].r;
-          const double closing = -sim::dot(d, balls[i].v) / nw.dist;
+          const double closing = -sim::dot(d, rel) / nw.dist;
           const double b = sim::norm(balls[i].a);
           if (g < 1e-12 * balls[i].r && closing > 0.0) {
             const Vec3 nn = (1.0 / nw.dist) * d;
-            const double e = balls[i].e * wall_e[k], s_in = -sim::dot(balls[i].v, nn);
+            const double e = balls[i].e * wall_e[k], s_in = -sim::dot(rel, nn);
             double s_out = s_in;
             if (e != 1.0) {
-              s_out = std::max(e * s_in, 0x1p-40 * sim::norm(balls[i].v));
+              s_out = std::max(e * s_in, 0x1p-40 * sim::norm(rel));
               if (sim::dot(balls[i].a, nn) < 0.0) s_out = std::max(s_out, -sim::dot(balls[i].a, nn) * tc / 2.0);
             }
             balls[i].v = balls[i].v + (s_in + s_out) * nn;
@@ -134,7 +171,7 @@ struct Reference3 {
             out.push_back({t, nw.kind, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k), nw.feature});
             served = true;
           } else if (closing > 0.0 || b > 0.0) {
-            step = std::min(step, g < 1e-9 * balls[i].r && closing <= 0.0 ? -closing / b : safe(g, sim::norm(balls[i].v), b));
+            step = std::min(step, g < 1e-9 * balls[i].r && closing <= 0.0 ? -closing / b : safe(g, sim::norm(rel), b));
           }
         }
       }
@@ -142,6 +179,7 @@ struct Reference3 {
       step = std::max(step, 1e-300);
       fly_all(std::min(step, t_end - t));
       t = std::min(t + step, t_end);
+      if (t >= key) t = key;  // a key is reached exactly: the walls turn there
     }
   }
 };
