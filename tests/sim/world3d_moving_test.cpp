@@ -24,10 +24,18 @@ TEST_CASE("a sphere between a standing wall and an approaching one: every bounce
   // The walls are planes x = 1 (standing) and x = 11 - U t until t = 40, then x = 7. Each leg is
   // straight: towards the mover it meets x + s tau = 11 - U (t + tau) - r, tau = (11 - U t - r -
   // x) / (s + U), and leaves at -(s + 2U) (v' = 2u - v, u = -U); towards the standing wall at
-  // tau = (x - 1 - r) / -s, leaving at -s.
+  // tau = (x - 1 - r) / -s, leaving at -s. The same in step mode (dt = 1/32: the key at 40 falls on
+  // a step's end, where the key is taken before the kick), and under a weak gravity along z, which
+  // leaves the motion along x alone in both modes.
+  const int variant = GENERATE(0, 1, 2, 3);
+  const bool step = variant & 1, gravity = variant & 2;
+  INFO((step ? "step mode" : "exact mode") << (gravity ? ", gravity along z" : ""));
   const double U = 0.1, r = 0.5, t_key = 40.0, t_end = 60.0;
   World3Def def;
   def.size = {20, 20, 20};
+  if (step) def.mode = Mode::step;
+  def.dt = 1.0 / 32.0;
+  if (gravity) def.gravity = {0, 0, -0.001};  // 1.8 down in 60 s: the sphere stays between the squares
   def.spheres.push_back({{6, 10, 10}, {5, 0, 0}, r, 2.0, 0.0});
   def.walls.push_back({square_x(1)});
   Wall3Def piston{square_x(11)};
@@ -73,7 +81,7 @@ TEST_CASE("a sphere between a standing wall and an approaching one: every bounce
   CHECK(w.wall_shift(1).x == -4.0);
   // The mover gave the sphere every joule it gained: m/2 (s^2 - 25), booked bounce by bounce.
   CHECK(w.wall_work() == Approx(0.5 * 2.0 * (s * s - 25.0)).epsilon(1e-12));
-  CHECK(w.energy() - e0 == Approx(w.wall_work()).epsilon(1e-12));
+  if (!(step && gravity)) CHECK(w.energy() - e0 == Approx(w.wall_work()).epsilon(1e-12));  // step mode's kicks do work of their own
   CHECK(w.max_contact_error() < 1e-12);
   CHECK(w.max_overlap_now() <= 1e-9);
 }
