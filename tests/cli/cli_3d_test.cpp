@@ -302,4 +302,8 @@ TEST_CASE("render of a 3-D world: seen along -z, the nearer sphere drawn last an
   CHECK(read(png).substr(1, 3) == "PNG");
   r = run(dir, {"render", world.string(), "--frames", (dir.path / "f").string(), "--from", "0", "--to", "1"});
   CHECK(r.code == 2);
+  // A moving wall is drawn where it is: moving_wall3d.json's square at x = 18 - 10 t, at t = 1 at 8.
+  r = run(dir, {"render", "worlds/tests/moving_wall3d.json", "--at", "1", "--out", svg.string()});
+  REQUIRE(r.code == 0);
+  CHECK(contains(read(svg), R"(<polygon points="8,5 8,15 8,15 8,5 ")"));
 }
