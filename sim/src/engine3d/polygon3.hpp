@@ -49,6 +49,20 @@ struct Polygon3 {
       if (dot(q - corners[k], inward[k]) < -tol) return false;
     return true;
   }
+  /// The point of the polygon nearest q: q's foot on the plane where it falls inside, else the
+  /// nearest point of the nearest edge.
+  Vec3 nearest(Vec3 q) const {
+    if (covers(q, 0.0)) return q - dot(q - corners[0], normal) * normal;
+    Vec3 best;
+    double best_d = kNever;
+    for (std::size_t e = 0; e < corners.size(); ++e) {
+      const Vec3 de = q - corners[e];
+      const Vec3 p = corners[e] + std::clamp(dot(de, along[e]), 0.0, length[e]) * along[e];
+      const double d = norm(q - p);
+      if (d < best_d) { best_d = d; best = p; }
+    }
+    return best;
+  }
   /// The distance from q to the polygon: to its plane where q's foot falls inside, else to the
   /// nearest edge.
   double distance(Vec3 q) const {

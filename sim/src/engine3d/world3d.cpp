@@ -15,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -229,7 +230,23 @@ struct World3::Impl {
   std::vector<Vec3> field_a;
   double dt = 0.0;
   std::uint64_t steps = 0;
+  // The wedge rule's figures (World3::wedged, energy_wedged).
+  std::uint64_t wedged = 0;
+  double energy_wedged = 0.0;
+  // Stops (World3::set_event_limit, set_stop_poll): looked at when `events` reaches next_check.
+  std::uint64_t event_limit = ~std::uint64_t{0};
+  std::function<bool()> stop_poll;
+  std::uint64_t poll_every = 4096;
+  std::uint64_t next_check = ~std::uint64_t{0};
+  void arm_check() { next_check = stop_poll ? std::min(event_limit, events + poll_every) : event_limit; }
+  [[gnu::cold]] void check_stop() {
+    if (events >= event_limit)
+      throw EventLimitReached("the event limit (" + std::to_string(event_limit) + ") was reached at t = " + std::to_string(now));
+    if (stop_poll && stop_poll()) throw StopRequested("stopped at t = " + std::to_string(now));
+    arm_check();
+  }
 
+  int n_cells(int a) const { return n[a]; }
   std::uint32_t cell_index(int cx, int cy, int cz) const {
     return static_cast<std::uint32_t>((cz * n[1] + cy) * n[0] + cx);
   }
@@ -672,6 +689,7 @@ struct World3::Impl {
           kind = Event3Kind::ball_wall_corner;
           contact_error = std::max(contact_error, std::abs(norm(normal) - b.r) / b.r);
         }
+        if (motion.empty() && wedge(i, b, b.partner, (1.0 / norm(normal)) * normal)) return;
         const Vec3 v_before = b.v;
         // The bounce in the wall's frame: v' = u + bounce(v - u) (u = 0 for a standing wall).
         const bool moves = !motion.empty();  // else bit for bit the standing walls' bounce
@@ -690,6 +708,82 @@ struct World3::Impl {
       }
       case Pending::cell: break;
     }
+  }
+
+  // The wedge (docs/physics.md, "3-D: wedged spheres"): sphere i (at now) meets standing wall k
+  // along n (the unit normal towards it) while touching a standing wall on the other side, -n.
+  // If every other contact it has is across n or out of reach, the zero-time sequence of its
+  // bounces between the two never ends (a bounce at e > 0 leaves the pair's relative speed e
+  // times what it was, never 0, and 0 is the only speed along n that opens both), and its limit
+  // is the sphere's velocity without its part along n: taken, booked, logged `wedged`. Out of
+  // reach: in that sequence the sphere keeps w, its velocity across n, and |v . n| never grows, so
+  // a contact along m (from the sphere) with something of velocity u (a standing wall: 0; a
+  // sphere: its own, which nothing else changes in zero time) opens at least at (u - w) . m -
+  // |n . m| |v . n|: positive (beyond 1e-9 of the speeds), it never closes. Moving walls: not
+  // asked (the caller's test). False, and the bounce is served as usual, otherwise.
+  bool wedge(std::uint32_t i, Record& b, std::uint32_t k, Vec3 n) {
+    const double touch = 1e-9 * b.r;  // the overlap budget
+    const double a = dot(b.v, n);
+    const Vec3 w = b.v - a * n;
+    const double margin = 1e-9 * (norm(w) + std::abs(a));
+    constexpr double kParallel = 1e-9;
+    std::uint32_t other = kNone;
+    bool reach_ok = true;
+    // A contact along m (unit, from the sphere) with something moving at u; `standing`: a wall.
+    auto asks = [&](Vec3 m, Vec3 u, bool standing) {
+      const double c = dot(n, m);
+      if (std::abs(c) <= kParallel) return;  // across
+      if (std::abs(c) >= 1.0 - kParallel) {
+        // In line: a standing wall on either side is the pair's; a sphere in line is a row (2-D's
+        // jammed chain), not this rule.
+        if (!standing) reach_ok = false;
+        return;
+      }
+      if (!(dot(u - w, m) - std::abs(c) * std::abs(a) > margin)) reach_ok = false;
+    };
+    for (const std::uint32_t q : cell_walls[b.cell]) {
+      if (q == k) continue;
+      const Vec3 d = walls[q].nearest(b.x) - b.x;
+      const double dist = norm(d);
+      if (!(dist > 0.0) || dist - b.r > touch) continue;
+      const Vec3 m = (1.0 / dist) * d;
+      if (dot(n, m) >= 1.0 - kParallel && other == kNone) other = q;  // on the far side
+      asks(m, Vec3{}, true);
+    }
+    if (other == kNone || !reach_ok) return false;
+    int c[3];
+    coords(b.cell, c);
+    for (int dz = -1; dz <= 1 && reach_ok; ++dz)
+      for (int dy = -1; dy <= 1 && reach_ok; ++dy)
+        for (int dx = -1; dx <= 1 && reach_ok; ++dx) {
+          int q[3] = {c[0] + dx, c[1] + dy, c[2] + dz};
+          Vec3 shift;
+          bool skip = false;
+          for (int ax = 0; ax < 3; ++ax) {
+            if (q[ax] >= 0 && q[ax] < n_cells(ax)) continue;
+            if (boundary != Boundary3::periodic) skip = true;
+            shift[ax] = q[ax] < 0 ? -size[ax] : size[ax];
+            q[ax] = (q[ax] + n_cells(ax)) % n_cells(ax);
+          }
+          if (skip) continue;
+          for (std::uint32_t j = head[cell_index(q[0], q[1], q[2])]; j != kNone; j = rec[j].next) {
+            if (j == i) continue;
+            const Record& o = rec[j];
+            const double dt = now - o.t;
+            const Vec3 d = fly(o.x, o.v, o.a, dt) + shift - b.x;
+            const double dist = norm(d);
+            if (!(dist > 0.0) || dist - (b.r + o.r) > touch) continue;
+            asks((1.0 / dist) * d, o.v + dt * o.a, false);
+          }
+        }
+    if (!reach_ok) return false;
+    energy_wedged += 0.5 * b.m * a * a;
+    ++wedged;
+    b.v = w;
+    ++b.count;
+    note(Event3Kind::wedged, i, k, other);
+    predict(i);
+    return true;
   }
 
   void cross(std::uint32_t i) {
@@ -718,6 +812,7 @@ struct World3::Impl {
 
   void serve_until(double t) {
     while (!queue.empty() && queue.top_key() <= t) {
+      if (events >= next_check) check_stop();
       const std::uint32_t i = queue.top_id();
       now = queue.top_key();
       serve(i);
@@ -745,6 +840,18 @@ struct World3::Impl {
   Vec3 accel(std::size_t i) const { return field_a.empty() ? rec[i].a : field_a[i]; }
 };
 
+void World3::set_event_limit(std::uint64_t limit) {
+  impl_->event_limit = limit;
+  impl_->arm_check();
+}
+void World3::set_stop_poll(std::function<bool()> poll, std::uint64_t every) {
+  impl_->stop_poll = std::move(poll);
+  impl_->poll_every = std::max<std::uint64_t>(1, every);
+  impl_->arm_check();
+}
+std::uint64_t World3::wedged() const { return impl_->wedged; }
+double World3::energy_wedged() const { return impl_->energy_wedged; }
+
 World3::World3(const World3Def& def) {
   const std::string problem = check_world3(def);
   if (!problem.empty()) throw std::invalid_argument(problem);
@@ -756,7 +863,12 @@ World3& World3::operator=(World3&&) noexcept = default;
 
 void World3::advance_to(double t, std::vector<Event3>* log) {
   impl_->log = log;
-  impl_->advance_to(std::max(t, impl_->now));
+  try {
+    impl_->advance_to(std::max(t, impl_->now));
+  } catch (...) {
+    impl_->log = nullptr;
+    throw;
+  }
   impl_->log = nullptr;
 }
 double World3::time() const { return impl_->now; }

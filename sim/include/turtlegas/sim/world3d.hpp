@@ -5,10 +5,12 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "turtlegas/sim/stops.hpp"
 #include "turtlegas/sim/vec3.hpp"
 #include "turtlegas/sim/world_def.hpp"
 
@@ -73,6 +75,10 @@ enum class Event3Kind : std::uint8_t {
   ball_wall_edge,    ///< a sphere, b wall index, c the edge (from corner c to corner c + 1)
   ball_wall_corner,  ///< a sphere, b wall index, c the corner
   exit,              ///< a left an open arena
+  /// a sphere touching two standing walls on opposite sides lost its velocity between them (the
+  /// limit of its zero-time bounces, docs/physics.md "3-D: wedged spheres"): b the wall it met,
+  /// c the wall on the other side
+  wedged,
 };
 
 struct Event3 {
@@ -98,8 +104,15 @@ class World3 {
   World3(World3&&) noexcept;
   World3& operator=(World3&&) noexcept;
 
-  /// Serves every event up to time t (seconds, >= time()); appends them to log if given.
+  /// Serves every event up to time t (seconds, >= time()); appends them to log if given. Throws
+  /// EventLimitReached or StopRequested (below) with the world consistent at its last event
+  /// (time() says when), which the run cannot go on from.
   void advance_to(double t, std::vector<Event3>* log = nullptr);
+  /// A bound on the events served (events(), from construction), as World::set_event_limit.
+  void set_event_limit(std::uint64_t limit);
+  /// `poll` is called after every `every` events served; when it returns true advance_to throws
+  /// StopRequested (a signal, a wall clock: the caller's). nullptr removes it.
+  void set_stop_poll(std::function<bool()> poll, std::uint64_t every = 4096);
   double time() const;
 
   std::size_t sphere_count() const;  ///< including removed ones
@@ -127,6 +140,10 @@ class World3 {
   /// over wall_area(w) is the pressure on the wall (docs/observables.md).
   double wall_push(std::size_t w) const;
   double wall_area(std::size_t w) const;  ///< the polygon's area
+  /// The wedge rule's count and the kinetic energy it took (docs/physics.md, "3-D: wedged
+  /// spheres"): 0 unless a sphere touched two standing walls on opposite sides at once.
+  std::uint64_t wedged() const;
+  double energy_wedged() const;
   /// The translation of wall w from its t = 0 corners, at time(); zero for a standing wall.
   Vec3 wall_shift(std::size_t w) const;
   /// The kinetic energy moving walls have given the spheres since the start (negative: taken),
