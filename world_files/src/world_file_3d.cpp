@@ -115,8 +115,11 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
     rd.check_keys(*e, "/effects", "effects", {"gravity", "electric", "magnetic", "restitution", "tc", "ball_ball"});
     if (const json* g = rd.find(*e, "gravity")) def.gravity = vec3(rd, *g, "/effects/gravity");
     if (const json* g = rd.find(*e, "electric")) def.electric = vec3(rd, *g, "/effects/electric");
-    if (const json* m = rd.find(*e, "magnetic"); m && !(m->is_number() && m->get<double>() == 0.0))
-      rd.fail("/effects/magnetic", "a magnetic field is not simulated in 3-D yet (helices); remove it or set 0");
+    if (const json* m = rd.find(*e, "magnetic"); m && !(m->is_number() && m->get<double>() == 0.0)) {
+      if (m->is_number())
+        rd.fail("/effects/magnetic", "in 3-D the magnetic field is a vector, [Bx, By, Bz] (got " + m->dump() + ")");
+      def.magnetic = vec3(rd, *m, "/effects/magnetic");
+    }
     if (const json* r = rd.find(*e, "restitution")) scene_e = restitution(*r, "/effects/restitution");
     if (const json* t = rd.find(*e, "tc")) def.tc = rd.non_negative(*t, "/effects/tc");
     if (const json* b = rd.find(*e, "ball_ball"); b && !rd.boolean(*b, "/effects/ball_ball"))

@@ -51,6 +51,9 @@ struct World3Def {
   Boundary3 boundary = Boundary3::none;
   Vec3 gravity;   ///< units / s^2, on every sphere
   Vec3 electric;  ///< acceleration charge / mass * electric on each sphere
+  /// Uniform B, any direction: a sphere of charge q and mass m feels dv/dt = (q/m) v x B, and flies
+  /// a helix (docs/physics.md, "3-D: magnetic fields"). Exact mode only.
+  Vec3 magnetic;
   double cell = 0.0;  ///< the grid's smallest cell side; 0: the largest diameter (times 1 + 2^-20)
   /// Inelastic-collapse threshold t_c in seconds (2-D's effects.tc, docs/physics.md "3-D:
   /// restitution"): used only when some e < 1. A pair one of whose spheres changed course less
