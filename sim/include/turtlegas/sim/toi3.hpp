@@ -2,7 +2,8 @@
 // Times of impact in 3-D, pure functions (docs/physics.md, "3-D"). Every flight is
 // x(t) = x + v t + a t^2 / 2 (a uniform acceleration: gravity, a uniform electric field). A
 // contact is a gap polynomial g(t) that goes from > 0 to < 0 (an approach); g is a quadratic for
-// straight relative flights and a quartic under a relative acceleration.
+// straight relative flights and a quartic under a relative acceleration. Under a magnetic field
+// a flight is a helix (Helix3) and contacts come from conservative advancement (first_touch).
 #pragma once
 
 #include "turtlegas/sim/roots.hpp"

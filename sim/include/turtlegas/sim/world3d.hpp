@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The 3-D gas (docs/architecture.md, "The 3-D room"; docs/physics.md, "3-D"): spheres, convex
-// polygon walls with their faces, edges and corners, uniform gravity and electric fields, exact
-// and event-driven. The order of work of one event is written at the top of world3d.cpp.
+// polygon walls with their faces, edges and corners (standing or translating), uniform gravity,
+// electric and magnetic fields, exact and event-driven. The order of work of one event is written at the top of world3d.cpp.
 #pragma once
 
 #include <cstdint>
