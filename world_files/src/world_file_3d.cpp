@@ -182,10 +182,11 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
       const std::string path = "/gas/" + std::to_string(k);
       const json& g = (*gs)[k];
       rd.expect_object(g, path, "a gas");
-      rd.check_keys(g, path, "a 3-D gas", {"count", "radius", "mass", "speed", "region", "seed", "id_prefix", "restitution"});
+      rd.check_keys(g, path, "a 3-D gas", {"count", "radius", "mass", "charge", "speed", "region", "seed", "id_prefix", "restitution"});
       const std::uint64_t count = rd.natural(rd.require(g, path, "count", "a gas"), path + "/count");
       const double r = rd.positive(rd.require(g, path, "radius", "a gas"), path + "/radius", "radius");
       const double mass = rd.find(g, "mass") ? rd.positive(g["mass"], path + "/mass", "mass") : 1.0;
+      const double charge = rd.find(g, "charge") ? rd.number(g["charge"], path + "/charge") : 0.0;
       const double speed = rd.find(g, "speed") ? rd.non_negative(g["speed"], path + "/speed") : 0.0;
       const double ge = rd.find(g, "restitution") ? restitution(g["restitution"], path + "/restitution") : scene_e;
       sim::Vec3 lo{0, 0, 0}, hi = def.size;
@@ -211,7 +212,7 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
             ok = sim::distance_to_polygon(x, def.walls[w].corners) > r;
           if (!ok) continue;
           const double cz = u(-1, 1), phi = u(0, 6.283185307179586), sz = std::sqrt(1 - cz * cz);
-          def.spheres.push_back({x, {speed * sz * std::cos(phi), speed * sz * std::sin(phi), speed * cz}, r, mass, 0.0, ge});
+          def.spheres.push_back({x, {speed * sz * std::cos(phi), speed * sz * std::sin(phi), speed * cz}, r, mass, charge, ge});
           placed = true;
         }
         if (!placed)
