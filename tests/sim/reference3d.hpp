@@ -19,6 +19,7 @@
 #include <random>
 #include <vector>
 
+#include "turtlegas/sim/toi3.hpp"
 #include "turtlegas/sim/vec3.hpp"
 #include "turtlegas/sim/world3d.hpp"
 
@@ -60,7 +61,7 @@ inline Nearest nearest_on_polygon(const std::vector<Vec3>& c, Vec3 q) {
 }
 
 struct Reference3 {
-  struct Ball { Vec3 x, v, a; double r, m, e, last; };
+  struct Ball { Vec3 x, v, a; double r, m, e, last; Vec3 omega; };
   std::vector<Ball> balls;
   std::vector<std::vector<Vec3>> walls;
   std::vector<double> wall_e;
@@ -71,7 +72,7 @@ struct Reference3 {
   explicit Reference3(const sim::World3Def& def) : tc(def.tc) {
     for (const auto& s : def.spheres)
       balls.push_back({s.pos, s.vel, def.gravity + (s.charge / s.mass) * def.electric, s.radius, s.mass,
-                       s.restitution, -1e300});
+                       s.restitution, -1e300, (s.charge / s.mass) * def.magnetic});
     for (const auto& w : def.walls) {
       walls.push_back(w.corners);
       wall_e.push_back(w.restitution);
@@ -117,8 +118,20 @@ struct Reference3 {
     return 2.0 * g / (w + std::sqrt(w * w + 2.0 * b * g));
   }
 
+  // A magnetic field turns a charged ball's flight into a helix (sim::Helix3, checked against its
+  // closed form in world3d_magnetic_test); |x''| bounds how fast its gaps can bend.
+  static bool gyrates(const Ball& b) { return !(b.omega == Vec3{}); }
+  static double accel_of(const Ball& b) {
+    return gyrates(b) ? sim::Helix3(b.v, b.a, b.omega).accel() : sim::norm(b.a);
+  }
   void fly_all(double dt) {
     for (Ball& b : balls) {
+      if (gyrates(b)) {
+        const sim::Helix3 h(b.v, b.a, b.omega);
+        b.x = b.x + h.displacement(dt);
+        b.v = h.velocity(dt);
+        continue;
+      }
       b.x = b.x + dt * b.v + (0.5 * dt * dt) * b.a;
       b.v = b.v + dt * b.a;
     }
@@ -135,7 +148,8 @@ struct Reference3 {
           const Vec3 d = balls[j].x - balls[i].x, w = balls[j].v - balls[i].v;
           const double g = sim::norm(d) - balls[i].r - balls[j].r;
           const double closing = -sim::dot(d, w) / sim::norm(d);
-          const double b = sim::norm(balls[j].a - balls[i].a);
+          const double b = gyrates(balls[i]) || gyrates(balls[j]) ? accel_of(balls[i]) + accel_of(balls[j])
+                                                                   : sim::norm(balls[j].a - balls[i].a);
           if (g < 1e-12 * balls[i].r && closing > 0.0) {
             const Vec3 nn = (1.0 / sim::norm(d)) * d;
             const double mu = balls[i].m * balls[j].m / (balls[i].m + balls[j].m);
@@ -157,7 +171,7 @@ struct Reference3 {
           const Vec3 d = q - nw.point;
           const double g = nw.dist - balls[i].r;
           const double closing = -sim::dot(d, rel) / nw.dist;
-          const double b = sim::norm(balls[i].a);
+          const double b = accel_of(balls[i]);
           if (g < 1e-12 * balls[i].r && closing > 0.0) {
             const Vec3 nn = (1.0 / nw.dist) * d;
             const double e = balls[i].e * wall_e[k], s_in = -sim::dot(rel, nn);
@@ -186,7 +200,7 @@ struct Reference3 {
 
 /// 8 spheres or so in a closed box of six polygons of our own (so the reference sees them), with a
 /// slanted triangle and a slanted quad; gravity and an electric field on random charges optional.
-inline sim::World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool electric = false) {
+inline sim::World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool electric = false, bool magnetic = false) {
   std::mt19937_64 gen(seed);
   auto u = [&](double lo, double hi) { return lo + (hi - lo) * static_cast<double>(gen() >> 11) * 0x1.0p-53; };
   sim::World3Def def;
@@ -194,6 +208,7 @@ inline sim::World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool
   def.boundary = sim::Boundary3::none;
   if (gravity) def.gravity = {0.3, -0.5, -2.0};
   if (electric) def.electric = {0.8, 1.5, -1.0};
+  if (magnetic) def.magnetic = {0.6, -0.9, 1.2};
   // A closed box of our own walls (so the reference sees them too), and two slanted polygons.
   const double L = 12;
   def.walls.push_back({{{0, 0, 0}, {0, L, 0}, {0, L, L}, {0, 0, L}}});
@@ -210,7 +225,7 @@ inline sim::World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool
     bool ok = true;
     for (const auto& s : def.spheres) ok = ok && sim::norm(s.pos - x) > s.radius + r + 0.05;
     for (const auto& wd : def.walls) ok = ok && nearest_on_polygon(wd.corners, x).dist > r + 0.05;
-    if (ok) def.spheres.push_back({x, {u(-2, 2), u(-2, 2), u(-2, 2)}, r, u(0.5, 2.0), electric ? u(-1.5, 1.5) : 0.0});
+    if (ok) def.spheres.push_back({x, {u(-2, 2), u(-2, 2), u(-2, 2)}, r, u(0.5, 2.0), electric || magnetic ? u(-1.5, 1.5) : 0.0});
   }
   return def;
 }

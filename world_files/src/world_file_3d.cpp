@@ -115,8 +115,11 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
     rd.check_keys(*e, "/effects", "effects", {"gravity", "electric", "magnetic", "restitution", "tc", "ball_ball"});
     if (const json* g = rd.find(*e, "gravity")) def.gravity = vec3(rd, *g, "/effects/gravity");
     if (const json* g = rd.find(*e, "electric")) def.electric = vec3(rd, *g, "/effects/electric");
-    if (const json* m = rd.find(*e, "magnetic"); m && !(m->is_number() && m->get<double>() == 0.0))
-      rd.fail("/effects/magnetic", "a magnetic field is not simulated in 3-D yet (helices); remove it or set 0");
+    if (const json* m = rd.find(*e, "magnetic"); m && !(m->is_number() && m->get<double>() == 0.0)) {
+      if (m->is_number())
+        rd.fail("/effects/magnetic", "in 3-D the magnetic field is a vector, [Bx, By, Bz] (got " + m->dump() + ")");
+      def.magnetic = vec3(rd, *m, "/effects/magnetic");
+    }
     if (const json* r = rd.find(*e, "restitution")) scene_e = restitution(*r, "/effects/restitution");
     if (const json* t = rd.find(*e, "tc")) def.tc = rd.non_negative(*t, "/effects/tc");
     if (const json* b = rd.find(*e, "ball_ball"); b && !rd.boolean(*b, "/effects/ball_ball"))
@@ -179,10 +182,11 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
       const std::string path = "/gas/" + std::to_string(k);
       const json& g = (*gs)[k];
       rd.expect_object(g, path, "a gas");
-      rd.check_keys(g, path, "a 3-D gas", {"count", "radius", "mass", "speed", "region", "seed", "id_prefix", "restitution"});
+      rd.check_keys(g, path, "a 3-D gas", {"count", "radius", "mass", "charge", "speed", "region", "seed", "id_prefix", "restitution"});
       const std::uint64_t count = rd.natural(rd.require(g, path, "count", "a gas"), path + "/count");
       const double r = rd.positive(rd.require(g, path, "radius", "a gas"), path + "/radius", "radius");
       const double mass = rd.find(g, "mass") ? rd.positive(g["mass"], path + "/mass", "mass") : 1.0;
+      const double charge = rd.find(g, "charge") ? rd.number(g["charge"], path + "/charge") : 0.0;
       const double speed = rd.find(g, "speed") ? rd.non_negative(g["speed"], path + "/speed") : 0.0;
       const double ge = rd.find(g, "restitution") ? restitution(g["restitution"], path + "/restitution") : scene_e;
       sim::Vec3 lo{0, 0, 0}, hi = def.size;
@@ -208,7 +212,7 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
             ok = sim::distance_to_polygon(x, def.walls[w].corners) > r;
           if (!ok) continue;
           const double cz = u(-1, 1), phi = u(0, 6.283185307179586), sz = std::sqrt(1 - cz * cz);
-          def.spheres.push_back({x, {speed * sz * std::cos(phi), speed * sz * std::sin(phi), speed * cz}, r, mass, 0.0, ge});
+          def.spheres.push_back({x, {speed * sz * std::cos(phi), speed * sz * std::sin(phi), speed * cz}, r, mass, charge, ge});
           placed = true;
         }
         if (!placed)

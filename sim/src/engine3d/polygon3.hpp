@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "turtlegas/sim/toi3.hpp"
@@ -49,17 +50,28 @@ struct Polygon3 {
       if (dot(q - corners[k], inward[k]) < -tol) return false;
     return true;
   }
-  /// The point of the polygon nearest q: q's foot on the plane where it falls inside, else the
-  /// nearest point of the nearest edge.
-  Vec3 nearest(Vec3 q) const {
-    if (covers(q, 0.0)) return q - dot(q - corners[0], normal) * normal;
-    Vec3 best;
-    double best_d = kNever;
-    for (std::size_t e = 0; e < corners.size(); ++e) {
+  /// The nearest point of the polygon to q and its feature: 0 the face (q's foot inside), 1 an
+  /// edge (index: from corner index to the next), 2 a corner.
+  struct Nearest {
+    Vec3 point;
+    int kind = 0;
+    std::uint32_t index = 0;
+  };
+  Nearest nearest(Vec3 q) const {
+    if (covers(q, 0.0)) return {q - dot(q - corners[0], normal) * normal, 0, 0};
+    Nearest best;
+    double dist = kNever;
+    const std::size_t n = corners.size();
+    for (std::size_t e = 0; e < n; ++e) {
       const Vec3 de = q - corners[e];
-      const Vec3 p = corners[e] + std::clamp(dot(de, along[e]), 0.0, length[e]) * along[e];
+      const double s = std::clamp(dot(de, along[e]), 0.0, length[e]);
+      const Vec3 p = corners[e] + s * along[e];
       const double d = norm(q - p);
-      if (d < best_d) { best_d = d; best = p; }
+      if (d < dist) {
+        dist = d;
+        if (s > 0.0 && s < length[e]) best = {p, 1, static_cast<std::uint32_t>(e)};
+        else best = {p, 2, static_cast<std::uint32_t>(s == 0.0 ? e : (e + 1) % n)};
+      }
     }
     return best;
   }

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -123,7 +124,10 @@ std::string first_sphere_overlap(const World3Def& def) {
 std::string check_world3(const World3Def& def) {
   for (int a = 0; a < 3; ++a)
     if (!(def.size[a] > 0.0) || !std::isfinite(def.size[a])) return "the arena's width, height and depth must be finite and > 0";
-  if (!is_finite(def.gravity) || !is_finite(def.electric)) return "gravity and electric must be finite";
+  if (!is_finite(def.gravity) || !is_finite(def.electric) || !is_finite(def.magnetic))
+    return "gravity, electric and magnetic must be finite";
+  if (def.mode == Mode::step && !(def.magnetic == Vec3{}))
+    return "a magnetic field is simulated in exact mode only in 3-D (step mode's kicks do not turn velocities yet)";
   if (!(def.tc >= 0.0) || !std::isfinite(def.tc)) return "tc must be finite and >= 0";
   if (def.mode == Mode::step && !(def.dt > 0.0 && std::isfinite(def.dt))) return "step mode's dt must be finite and > 0";
   for (std::size_t i = 0; i < def.spheres.size(); ++i) {
@@ -218,6 +222,52 @@ struct World3::Impl {
   std::vector<Motion> motion;  // per wall; empty when no wall moves
   double next_key = kNever;    // the earliest key ahead of any wall
   double wall_work = 0.0;      // World3::wall_work
+  // A magnetic field (docs/physics.md, "3-D: magnetic fields"): per sphere omega = (q/m) B, kept
+  // only when B != 0. A sphere with omega != 0 flies a helix and every contact of it is found by
+  // conservative advancement (first_touch), up to a horizon of at most `cap` (one turn of the
+  // fastest-turning sphere): at the horizon it predicts again. In such a scene every crossing
+  // predicts in full (pairs are searched only up to each sphere's horizon).
+  std::vector<Vec3> omega;
+  double cap = kNever;
+  double limit = kNever;  // during a prediction: how far every search so far is proven
+  // A contact is found within 1e-12 r plus this: 2^-44 of the arena, some 500 times the round-off
+  // of a helix's position anywhere in it, so first_touch's margin (half the tolerance) holds.
+  double round_off = 0.0;
+  bool gyrates(std::uint32_t i) const { return !omega.empty() && !(omega[i] == Vec3{}); }
+  Vec3 pos_at(const Record& b, double dt) const {
+    const std::uint32_t i = index_of(b);
+    return gyrates(i) ? b.x + Helix3(b.v, b.a, omega[i]).displacement(dt) : fly(b.x, b.v, b.a, dt);
+  }
+  Vec3 vel_at(const Record& b, double dt) const {
+    const std::uint32_t i = index_of(b);
+    return gyrates(i) ? Helix3(b.v, b.a, omega[i]).velocity(dt) : b.v + dt * b.a;
+  }
+  std::uint32_t index_of(const Record& b) const { return static_cast<std::uint32_t>(&b - rec.data()); }
+  // A sphere's flight as seen by a search: position and velocity at s after `now`, and |x''|.
+  struct Path {
+    Vec3 x, v, a;
+    std::optional<Helix3> helix;
+    Vec3 pos(double s) const { return helix ? x + helix->displacement(s) : fly(x, v, a, s); }
+    Vec3 vel(double s) const { return helix ? helix->velocity(s) : v + s * a; }
+    double accel() const { return helix ? helix->accel() : norm(a); }
+  };
+  Path path_of(std::uint32_t i) const {
+    const Record& b = rec[i];
+    Path p{pos_at(b, now - b.t), vel_at(b, now - b.t), b.a, std::nullopt};
+    if (gyrates(i)) p.helix.emplace(p.v, b.a, omega[i]);
+    return p;
+  }
+  static constexpr int kMaxSteps = 20000;
+  // Conservative advancement (first_touch) with the prediction's running limit.
+  template <class Eval>
+  double touch(Eval eval, double accel, double horizon, double tol) {
+    horizon = std::min(horizon, limit);
+    if (!(horizon > 0.0)) return kNever;
+    double reached = 0.0;
+    const double t = first_touch(eval, accel, horizon, tol, kMaxSteps, reached);
+    if (t == kNever && reached < horizon) limit = reached;  // stopped early: predict again there
+    return t;
+  }
   std::vector<Event3>* log = nullptr;
   // Restitution (docs/physics.md, "3-D: restitution"): kept beside the records, and only when
   // some e < 1, so that an elastic gas's record and loop are unchanged.
@@ -271,8 +321,14 @@ struct World3::Impl {
   void bring(Record& b, double t) {
     const double dt = t - b.t;
     if (dt == 0.0) return;
-    b.x = fly(b.x, b.v, b.a, dt);
-    b.v += dt * b.a;
+    if (gyrates(index_of(b))) {
+      const Vec3 x = pos_at(b, dt);
+      b.v = vel_at(b, dt);
+      b.x = x;
+    } else {
+      b.x = fly(b.x, b.v, b.a, dt);
+      b.v += dt * b.a;
+    }
     b.t = t;
   }
 
@@ -360,6 +416,17 @@ struct World3::Impl {
     if (!field_a.empty()) {
       dt = def.dt;
       for (Record& b : rec) b.a = {};
+    }
+    if (!(def.magnetic == Vec3{})) {
+      omega.resize(def.spheres.size());
+      double w_max = 0.0;
+      for (std::size_t i = 0; i < def.spheres.size(); ++i) {
+        omega[i] = (def.spheres[i].charge / def.spheres[i].mass) * def.magnetic;
+        w_max = std::max(w_max, norm(omega[i]));
+      }
+      if (w_max > 0.0) cap = 6.283185307179586 / w_max;
+      else omega.clear();
+      round_off = 0x1p-44 * std::max({size.x, size.y, size.z});
     }
     queue.reset(rec.empty() ? nullptr : &rec[0].node, sizeof(Record), rec.size());
     for (std::uint32_t i = 0; i < rec.size(); ++i) predict(i);
@@ -536,6 +603,10 @@ struct World3::Impl {
   void predict(std::uint32_t i) {
     Record& b = rec[i];
     bring(b, now);
+    if (!omega.empty()) {
+      predict_magnetic(i);
+      return;
+    }
     const double exit = cell_exit(b, b.axis, b.dir);
     double cand = kNever;
     b.kind = Pending::none;
@@ -546,6 +617,127 @@ struct World3::Impl {
         for (int ox = -1; ox <= 1; ++ox) scan_cell(i, b, k[0] + ox, k[1] + oy, k[2] + oz, cand);
     for (std::uint32_t wk : cell_walls[b.cell]) predict_wall(b, wk, cand, exit);
     schedule(i, b, cand, exit);
+  }
+
+  // A prediction in a scene with a magnetic field: every search is bounded by the horizon
+  // (the cell exit, at most `cap` ahead, less where a search stopped early); a sphere that reaches
+  // it without event predicts again (axis 3: no crossing).
+  void predict_magnetic(std::uint32_t i) {
+    Record& b = rec[i];
+    limit = cap;
+    const Path me = path_of(i);
+    double exit = me.helix ? helix_exit(b, me) : cell_exit(b, b.axis, b.dir);
+    double cand = kNever;
+    b.kind = Pending::none;
+    int k[3];
+    coords(b.cell, k);
+    for (int oz = -1; oz <= 1; ++oz)
+      for (int oy = -1; oy <= 1; ++oy)
+        for (int ox = -1; ox <= 1; ++ox) scan_cell_magnetic(i, me, k[0] + ox, k[1] + oy, k[2] + oz, cand, exit);
+    for (std::uint32_t wk : cell_walls[b.cell]) {
+      if (me.helix) predict_wall_helix(b, me, wk, cand, std::min(exit, limit));
+      else predict_wall(b, wk, cand, std::min(exit, limit));
+    }
+    if (limit < exit) {  // the horizon (cap, or where a search stopped) comes before the exit
+      exit = limit;
+      b.axis = 3;
+    }
+    if (cand > exit) b.kind = Pending::none;
+    schedule(i, b, cand, exit);
+  }
+
+  // The cell exit of a helix: each of the six faces' distance is linear in the position, so
+  // conservative advancement with |x''| finds its crossing (within tol inside the cell).
+  double helix_exit(Record& b, const Path& me) {
+    int k[3];
+    coords(b.cell, k);
+    double best = kNever;
+    b.axis = 3;
+    b.dir = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = k[a] * w[a], hi = (k[a] + 1 == n[a]) ? size[a] : lo + w[a];
+      const double tol = 1e-12 * w[a] + round_off;
+      for (int dir = -1; dir <= 1; dir += 2) {
+        const double t = touch(
+            [&](double s, double& g, double& gd) {
+              const double x = me.pos(s)[a];
+              const double v = me.vel(s)[a];
+              g = dir > 0 ? hi - x : x - lo;
+              gd = dir > 0 ? -v : v;
+            },
+            me.accel(), std::min(best, cap), tol);
+        if (t < best) {
+          best = t;
+          b.axis = static_cast<std::uint8_t>(a);
+          b.dir = static_cast<std::int8_t>(dir);
+        }
+      }
+    }
+    return best;
+  }
+
+  // Wall k against a helix: the distance to the polygon (a convex set, so convex in position) in
+  // the wall's frame; the feature is where the nearest point lies at the contact.
+  void predict_wall_helix(Record& b, const Path& me, std::uint32_t k, double& cand, double exit) {
+    const Polygon3& p = walls[k];
+    const Vec3 o = shift_of(k), u = velocity_of(k);
+    auto eval = [&](double s, double& g, double& gd) {
+      const Vec3 q = me.pos(s) - (o + s * u);
+      const Vec3 d = q - p.nearest(q).point;
+      const double dist = norm(d);
+      g = dist - b.r;
+      gd = dist > 0.0 ? dot(d, me.vel(s) - u) / dist : -1.0;
+    };
+    const double t = touch(eval, me.accel(), std::min(cand, exit), 1e-12 * b.r + round_off);
+    if (t < cand) {
+      cand = t;
+      const Polygon3::Nearest nf = p.nearest(me.pos(t) - (o + t * u));
+      b.kind = nf.kind == 0 ? Pending::face : nf.kind == 1 ? Pending::edge : Pending::corner;
+      b.partner = k;
+      b.partner_count = nf.kind == 0 ? 0 : nf.index;
+    }
+  }
+
+  // The spheres of one cell against sphere i in a magnetic scene: a pair neither of which
+  // gyrates by the closed forms (up to the horizon), else conservative advancement on the
+  // distance of centres.
+  void scan_cell_magnetic(std::uint32_t i, const Path& me, int cx, int cy, int cz, double& cand, double exit) {
+    Record& b = rec[i];
+    Vec3 shift;
+    int k[3] = {cx, cy, cz};
+    for (int a = 0; a < 3; ++a) {
+      if (k[a] >= 0 && k[a] < n[a]) continue;
+      if (boundary != Boundary3::periodic) return;
+      shift[a] = k[a] < 0 ? -size[a] : size[a];
+      k[a] = (k[a] + n[a]) % n[a];
+    }
+    for (std::uint32_t j = head[cell_index(k[0], k[1], k[2])]; j != kNone; j = rec[j].next) {
+      if (j == i) continue;
+      const Record& o = rec[j];
+      const double horizon = std::min({cand, exit, limit});
+      double t;
+      if (!me.helix && !gyrates(j)) {
+        const double dt = now - o.t;
+        const Vec3 xo = fly(o.x, o.v, o.a, dt) + shift, vo = o.v + dt * o.a;
+        t = toi_sphere_sphere(xo - b.x, vo - b.v, o.a - b.a, b.r + o.r, horizon);
+      } else {
+        Path other = path_of(j);
+        other.x += shift;
+        const double sigma = b.r + o.r;
+        t = touch(
+            [&](double s, double& g, double& gd) {
+              const Vec3 d = other.pos(s) - me.pos(s);
+              const double dist = norm(d);
+              g = dist - sigma;
+              gd = dot(d, other.vel(s) - me.vel(s)) / dist;
+            },
+            me.accel() + other.accel(), horizon, 1e-12 * std::min(b.r, o.r) + round_off);
+      }
+      if (t < cand) {
+        cand = t;
+        b.kind = Pending::pair; b.partner = j; b.partner_count = o.count;
+      }
+    }
   }
 
   // After a crossing along `axis` by `dir`: the kept contact candidate (still a true time of
@@ -743,7 +935,7 @@ struct World3::Impl {
     };
     for (const std::uint32_t q : cell_walls[b.cell]) {
       if (q == k) continue;
-      const Vec3 d = walls[q].nearest(b.x) - b.x;
+      const Vec3 d = walls[q].nearest(b.x).point - b.x;
       const double dist = norm(d);
       if (!(dist > 0.0) || dist - b.r > touch) continue;
       const Vec3 m = (1.0 / dist) * d;
@@ -770,10 +962,10 @@ struct World3::Impl {
             if (j == i) continue;
             const Record& o = rec[j];
             const double dt = now - o.t;
-            const Vec3 d = fly(o.x, o.v, o.a, dt) + shift - b.x;
+            const Vec3 d = pos_at(o, dt) + shift - b.x;
             const double dist = norm(d);
             if (!(dist > 0.0) || dist - (b.r + o.r) > touch) continue;
-            asks((1.0 / dist) * d, o.v + dt * o.a, false);
+            asks((1.0 / dist) * d, vel_at(o, dt), false);
           }
         }
     if (!reach_ok) return false;
@@ -789,6 +981,10 @@ struct World3::Impl {
   void cross(std::uint32_t i) {
     Record& b = rec[i];
     bring(b, now);
+    if (b.axis == 3) {  // a magnetic scene's horizon: predict again, no crossing
+      predict(i);
+      return;
+    }
     int k[3];
     coords(b.cell, k);
     const int a = b.axis, dir = b.dir;
@@ -807,7 +1003,8 @@ struct World3::Impl {
     }
     unlink(i);
     link(i, cell_index(k[0], k[1], k[2]));
-    predict_strip(i, a, dir);
+    if (!omega.empty()) predict(i);  // searches are bounded there: the whole neighbourhood again
+    else predict_strip(i, a, dir);
   }
 
   void serve_until(double t) {
@@ -876,11 +1073,11 @@ std::size_t World3::sphere_count() const { return impl_->rec.size(); }
 bool World3::alive(std::size_t i) const { return impl_->rec[i].alive; }
 Vec3 World3::position(std::size_t i) const {
   const Record& b = impl_->rec[i];
-  return fly(b.x, b.v, b.a, impl_->now - b.t);
+  return impl_->pos_at(b, impl_->now - b.t);
 }
 Vec3 World3::velocity(std::size_t i) const {
   const Record& b = impl_->rec[i];
-  return b.v + (impl_->now - b.t) * b.a;
+  return impl_->vel_at(b, impl_->now - b.t);
 }
 std::size_t World3::wall_count() const { return impl_->walls.size(); }
 double World3::kinetic_energy() const {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The 3-D gas (docs/architecture.md, "The 3-D room"; docs/physics.md, "3-D"): spheres, convex
-// polygon walls with their faces, edges and corners, uniform gravity and electric fields, exact
-// and event-driven. The order of work of one event is written at the top of world3d.cpp.
+// polygon walls with their faces, edges and corners (standing or translating), uniform gravity,
+// electric and magnetic fields, exact and event-driven. The order of work of one event is written at the top of world3d.cpp.
 #pragma once
 
 #include <cstdint>
@@ -53,6 +53,9 @@ struct World3Def {
   Boundary3 boundary = Boundary3::none;
   Vec3 gravity;   ///< units / s^2, on every sphere
   Vec3 electric;  ///< acceleration charge / mass * electric on each sphere
+  /// Uniform B, any direction: a sphere of charge q and mass m feels dv/dt = (q/m) v x B, and flies
+  /// a helix (docs/physics.md, "3-D: magnetic fields"). Exact mode only.
+  Vec3 magnetic;
   double cell = 0.0;  ///< the grid's smallest cell side; 0: the largest diameter (times 1 + 2^-20)
   /// Inelastic-collapse threshold t_c in seconds (2-D's effects.tc, docs/physics.md "3-D:
   /// restitution"): used only when some e < 1. A pair one of whose spheres changed course less
