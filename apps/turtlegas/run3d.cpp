@@ -191,7 +191,7 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
                 static_cast<unsigned long long>(world->events()), e0, world->energy(), std::max(overlap, 0.0), wall);
   if (opt.stats && moving) std::printf("  moving walls gave the spheres %.15g of energy (wall_work)\n", world->wall_work());
   if (opt.stats && world->wedged() > 0)
-    std::printf("  wedged %llu times, taking %.15g of energy (docs/physics.md, \"3-D: wedged spheres\")\n",
+    std::printf("  squeezed %llu wedged, taking %.15g of energy (docs/physics.md, \"3-D: wedged spheres\")\n",
                 static_cast<unsigned long long>(world->wedged()), world->energy_wedged());
   if (observe_file) {
     observe_file->stream() << observer->result().dump(1) << '\n';

@@ -309,3 +309,40 @@ TEST_CASE("render of a 3-D world: seen along -z, the nearer sphere drawn last an
   REQUIRE(r.code == 0);
   CHECK(contains(read(svg), R"(<polygon points="8,5 8,15 8,15 8,5 ")"));
 }
+
+TEST_CASE("run of a 3-D sphere in a slot exactly its width: wedged, logged, booked; a runaway stops at --max-events") {
+  TempDir dir;
+  // Before the wedge rule the slot bounced at t = 0 for ever and run never returned.
+  const auto slot = dir.write("slot.json", R"({"format": "turtlegas-world/1", "dimensions": 3, "name": "slot",
+    "arena": {"width": 20, "height": 10, "depth": 2, "boundary": "walls"},
+    "balls": [{"id": "s", "pos": [5, 5, 1], "vel": [1, 0.5, 0.3], "radius": 1}]})");
+  const auto r = run(dir, {"run", slot.string(), "--until", "1", "--events", (dir.path / "e.jsonl").string(),
+                           "--stats-json", (dir.path / "st.json").string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  std::istringstream lines(read(dir.path / "e.jsonl"));
+  std::string line;
+  REQUIRE(std::getline(lines, line));
+  const auto e = nlohmann::json::parse(line);
+  CHECK(e["kind"] == "wedged");
+  CHECK(e["a"] == "s");
+  CHECK(e["t"] == 0.0);
+  CHECK(((e["b"] == "arena-z1" && e["c"] == "arena-z0") || (e["b"] == "arena-z0" && e["c"] == "arena-z1")));
+  const auto st = nlohmann::json::parse(read(dir.path / "st.json"));
+  CHECK(st["wedged"] == 1);
+  CHECK(std::abs(st["energy_wedged"].get<double>() - 0.045) < 1e-15);
+  CHECK(!st.contains("stopped"));
+  // Two spheres filling a box along x (a jammed row, not covered in 3-D) run at t = 0 for ever:
+  // --max-events stops the run inside its first chunk, outputs written, exit 3.
+  const auto row = dir.write("row.json", R"({"format": "turtlegas-world/1", "dimensions": 3, "name": "row",
+    "arena": {"width": 4, "height": 10, "depth": 10, "boundary": "walls"},
+    "balls": [{"id": "a", "pos": [1, 5, 5], "vel": [1, 0, 0], "radius": 1}, {"id": "b", "pos": [3, 5, 5], "radius": 1}]})");
+  const auto stopped = run(dir, {"run", row.string(), "--until", "1", "--max-events", "20000", "--stats-json",
+                                 (dir.path / "row.json.stats").string()});
+  INFO(stopped.err);
+  CHECK(stopped.code == 3);
+  CHECK(stopped.err.find("stopped at t = 0 s of 1 (max-events)") != std::string::npos);
+  const auto rs = nlohmann::json::parse(read(dir.path / "row.json.stats"));
+  CHECK(rs["stopped"] == "max-events");
+  CHECK(rs["events"] == 20000);
+}
