@@ -12,9 +12,12 @@
 
 #include <cairo.h>
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
 #include "cli_common.hpp"
 #include "output_file.hpp"
+#include "run_loop.hpp"
+#include "signals.hpp"
 #include "turtlegas/formats/observables.hpp"
 #include "turtlegas/sim/mode_names.hpp"
 #include "turtlegas/world/file_error.hpp"
@@ -29,6 +32,7 @@ const char* kind_name(sim::Event3Kind k) {
     case sim::Event3Kind::ball_wall_edge: return "ball-wall-edge";
     case sim::Event3Kind::ball_wall_corner: return "ball-wall-corner";
     case sim::Event3Kind::exit: return "exit";
+    case sim::Event3Kind::wedged: return "wedged";
   }
   return "?";
 }
@@ -107,15 +111,41 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
   if (!opt.stats_json.empty()) stats_file.emplace(opt.stats_json, "--stats-json");
   const double e0 = world->energy();
   std::vector<sim::Event3> log;
+  // Stops as 2-D's run has them (run_loop.hpp): a signal or --max-wall-seconds seen between chunks
+  // and, every 4096 events, inside one (with the progress line, so that a chunk that does not end
+  // still shows its events), --max-events as the engine's limit.
+  install_stop_signals();
+  Progress progress(opt.until);
+  world->set_stop_poll([&, wall = opt.max_wall_seconds] {
+    progress.update(world->time(), world->events(), "");
+    return stop_signal() != 0 || (wall && seconds_since(start) >= *wall);
+  });
+  if (opt.max_events) world->set_event_limit(*opt.max_events);
+  Stopped end{Stop::until, 0};
   // Chunks of at most 10^5 events' worth of time would need a rate; a chunk of simulated time
   // that shrinks when the log grows large keeps memory bounded instead.
   double chunk = std::max(opt.until / 1000.0, 1e-9);
-  while (world->time() < opt.until) {
+  while (world->time() < opt.until && end.first == Stop::until) {
+    if (const int sig = stop_signal()) {
+      end = {Stop::signal, sig};
+      break;
+    }
+    if (opt.max_wall_seconds && seconds_since(start) >= *opt.max_wall_seconds) {
+      end = {Stop::max_wall_seconds, 0};
+      break;
+    }
     const double t = std::min(opt.until, world->time() + chunk);
     log.clear();
-    if (observer) observer->advance_to(t);  // stops at its sample times on the way
-    else world->advance_to(t, events_file ? &log : nullptr);
-    if (opt.max_events && world->events() >= *opt.max_events) break;
+    try {
+      if (observer) observer->advance_to(t);  // stops at its sample times on the way
+      else world->advance_to(t, events_file ? &log : nullptr);
+    } catch (const sim::StopRequested&) {
+      const int sig = stop_signal();
+      end = sig ? Stopped{Stop::signal, sig} : Stopped{Stop::max_wall_seconds, 0};
+    } catch (const sim::EventLimitReached&) {
+      end = {Stop::max_events, 0};
+    }
+    progress.update(world->time(), world->events(), "");
     if (events_file) {
       std::string text;
       for (const sim::Event3& e : log) {
@@ -124,12 +154,14 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
         else if (e.kind != sim::Event3Kind::exit) line["b"] = w.wall_ids[e.b];
         if (e.kind == sim::Event3Kind::ball_wall_edge) line["edge"] = e.c;
         if (e.kind == sim::Event3Kind::ball_wall_corner) line["corner"] = e.c;
+        if (e.kind == sim::Event3Kind::wedged) line["c"] = w.wall_ids[e.c];
         text += line.dump() + "\n";
       }
       events_file->stream() << text;
       if (log.size() > 100000) chunk *= 0.5;
     }
   }
+  progress.clear();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (state_file) {
     nlohmann::json balls = nlohmann::json::array();
@@ -146,12 +178,21 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
                        {"energy_start", e0},
                        {"energy_end", world->energy()},
                        {"max_overlap", std::max(overlap, 0.0)},
-                       {"max_contact_error", world->max_contact_error()}};
+                       {"max_contact_error", world->max_contact_error()},
+                       {"wedged", world->wedged()},
+                       {"energy_wedged", world->energy_wedged()}};
+  if (end.first != Stop::until) stats["stopped"] = stop_name(end);
+  const bool moving = std::any_of(w.def.walls.begin(), w.def.walls.end(), [](const sim::Wall3Def& x) { return !x.keys.empty(); });
+  if (moving) stats["wall_work"] = world->wall_work();  // energy_end - energy_start at e = 1 (docs/physics.md)
   if (stats_file) stats_file->stream() << stats.dump(1) + "\n";
   if (opt.stats)
     std::printf("3-D %s run to t = %g: %llu collisions, %llu events, energy %.15g -> %.15g, max overlap %.3g r, %.3f s\n",
                 std::string(sim::to_string(w.def.mode)).c_str(), world->time(), static_cast<unsigned long long>(world->collisions()),
                 static_cast<unsigned long long>(world->events()), e0, world->energy(), std::max(overlap, 0.0), wall);
+  if (opt.stats && moving) std::printf("  moving walls gave the spheres %.15g of energy (wall_work)\n", world->wall_work());
+  if (opt.stats && world->wedged() > 0)
+    std::printf("  squeezed %llu wedged, taking %.15g of energy (docs/physics.md, \"3-D: wedged spheres\")\n",
+                static_cast<unsigned long long>(world->wedged()), world->energy_wedged());
   if (observe_file) {
     observe_file->stream() << observer->result().dump(1) << '\n';
     observe_file->commit();
@@ -159,7 +200,10 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
   if (events_file) events_file->commit();
   if (state_file) state_file->commit();
   if (stats_file) stats_file->commit();
-  return exit_ok;
+  if (end.first == Stop::until) return exit_ok;
+  spdlog::warn("{}: stopped at t = {} s of {} ({}); the outputs are written up to there", opt.world, fmt(world->time()),
+               fmt(opt.until), stop_name(end));
+  return exit_code_for(end);
 }
 
 namespace {
@@ -208,7 +252,8 @@ int render3d(const std::string& file, double at, const std::string& out, double 
     text += "<g transform=\"translate(0 " + fmt(size.y) + ") scale(1 -1)\">\n";
     for (std::size_t k = 0; k < w.def.walls.size(); ++k) {
       text += "<polygon points=\"";
-      for (const sim::Vec3& c : w.def.walls[k].corners) text += fmt(c.x) + "," + fmt(c.y) + " ";
+      const sim::Vec3 shift = world->wall_shift(k);  // a moving wall where it is at t
+      for (const sim::Vec3& c : w.def.walls[k].corners) text += fmt(c.x + shift.x) + "," + fmt(c.y + shift.y) + " ";
       std::snprintf(b, sizeof b, "\" fill=\"#c8b070\" fill-opacity=\"0.35\" stroke=\"#806020\" stroke-width=\"%g\"/>\n", 1.0 / scale);
       text += b;
     }
@@ -231,9 +276,11 @@ int render3d(const std::string& file, double at, const std::string& out, double 
     cairo_paint(cr);
     cairo_translate(cr, 0, H);
     cairo_scale(cr, scale, -scale);
-    for (const sim::Wall3Def& wall : w.def.walls) {
+    for (std::size_t n = 0; n < w.def.walls.size(); ++n) {
+      const sim::Wall3Def& wall = w.def.walls[n];
+      const sim::Vec3 shift = world->wall_shift(n);  // a moving wall where it is at t
       for (std::size_t k = 0; k < wall.corners.size(); ++k)
-        (k == 0 ? cairo_move_to : cairo_line_to)(cr, wall.corners[k].x, wall.corners[k].y);
+        (k == 0 ? cairo_move_to : cairo_line_to)(cr, wall.corners[k].x + shift.x, wall.corners[k].y + shift.y);
       cairo_close_path(cr);
       cairo_set_source_rgba(cr, 0.78, 0.69, 0.44, 0.35);
       cairo_fill_preserve(cr);

@@ -42,6 +42,19 @@ TEST_CASE("run of a 3-D world: an edge contact at its closed-form time, named by
   CHECK(st["energy_start"] == st["energy_end"]);
 }
 
+TEST_CASE("run of a 3-D world with a moving wall: struck at rest, the sphere leaves at 2u; wall_work in the stats") {
+  TempDir dir;
+  const auto r = run(dir, {"run", "worlds/tests/moving_wall3d.json", "--until", "1.4", "--state-out",
+                           (dir.path / "s.json").string(), "--stats-json", (dir.path / "st.json").string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const auto s = nlohmann::json::parse(read(dir.path / "s.json"));
+  CHECK(std::abs(s["balls"][0]["vel"][0].get<double>() + 20.0) < 1e-12);
+  const auto st = nlohmann::json::parse(read(dir.path / "st.json"));
+  CHECK(std::abs(st["wall_work"].get<double>() - 400.0) < 1e-9);  // m/2 (2u)^2, m = 2, u = -10
+  CHECK(std::abs(st["energy_end"].get<double>() - st["energy_start"].get<double>() - 400.0) < 1e-9);
+}
+
 TEST_CASE("run of a 3-D world with restitution: the scene's e, a ball's own, a wall's, in closed form") {
   TempDir dir;
   // Sphere a (the scene's e = 0.5) falls onto the shelf (e = 0.8) with normal speed 2: it leaves
@@ -123,7 +136,9 @@ TEST_CASE("3-D world file errors name the JSON path and the fix, exit 2") {
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 1], [5, 1, 1], [2, 2, 1], [1, 5, 1]]}]})",
        "not convex"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "turtles": []})", "turtles stay in the plane"},
-      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "effects": {"magnetic": 1}})", "/effects/magnetic"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "effects": {"magnetic": 1}})", "/effects/magnetic: in 3-D the magnetic field is a vector"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "effects": {"magnetic": [0, 1]}})",
+       "/effects/magnetic: expected [x, y, z]"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "effects": {"restitution": 1.5}})",
        "/effects/restitution: restitution must be in [0, 1]"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "balls": [{"id": "a", "pos": [5, 5, 5], "radius": 1, "restitution": -0.1}]})",
@@ -137,6 +152,19 @@ TEST_CASE("3-D world file errors name the JSON path and the fix, exit 2") {
        "sphere 0 overlaps wall 0"},
       {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10, "boundary": "walls"}, "balls": [{"id": "a", "pos": [0.5, 5, 5], "radius": 1}]})",
        "overlaps the arena's walls"},
+      // Moving walls' keys (docs/worlds.md, "Moving walls in 3-D").
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 1, "corners": [[1, 1, 4], [9, 1, 4], [5, 9, 3]]}]}]})",
+       "/walls/0/keys/0/corners/2: a 3-D wall may only translate"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 2, "corners": [[1, 1, 4], [9, 1, 4], [5, 9, 4]]}, {"t": 1, "corners": [[1, 1, 3], [9, 1, 3], [5, 9, 3]]}]}]})",
+       "/walls/0/keys/1/t: key times must increase"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 1, "corners": [[1, 1, 4], [9, 1, 4]]}]}]})",
+       "/walls/0/keys/0/corners: a key lists the wall's 3 corners"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 1, "corners": [[1, 1, 12], [9, 1, 12], [5, 9, 12]]}]}]})",
+       "/walls/0/keys/0/corners/0: the wall leaves the arena"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10, "boundary": "periodic"}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 1, "corners": [[1, 1, 4], [9, 1, 4], [5, 9, 4]]}]}]})",
+       "/walls/0/keys: moving walls are not supported in a periodic arena"},
+      {R"({"dimensions": 3, "arena": {"width": 10, "height": 10, "depth": 10}, "walls": [{"id": "w", "corners": [[1, 1, 5], [9, 1, 5], [5, 9, 5]], "keys": [{"t": 0, "corners": [[1, 1, 4], [9, 1, 4], [5, 9, 4]]}]}]})",
+       "/walls/0/keys/0/t"},
   };
   for (const Case& c : cases) {
     const auto world = dir.write("bad.json", c.text);
@@ -276,4 +304,45 @@ TEST_CASE("render of a 3-D world: seen along -z, the nearer sphere drawn last an
   CHECK(read(png).substr(1, 3) == "PNG");
   r = run(dir, {"render", world.string(), "--frames", (dir.path / "f").string(), "--from", "0", "--to", "1"});
   CHECK(r.code == 2);
+  // A moving wall is drawn where it is: moving_wall3d.json's square at x = 18 - 10 t, at t = 1 at 8.
+  r = run(dir, {"render", "worlds/tests/moving_wall3d.json", "--at", "1", "--out", svg.string()});
+  REQUIRE(r.code == 0);
+  CHECK(contains(read(svg), R"(<polygon points="8,5 8,15 8,15 8,5 ")"));
+}
+
+TEST_CASE("run of a 3-D sphere in a slot exactly its width: wedged, logged, booked; a runaway stops at --max-events") {
+  TempDir dir;
+  // Before the wedge rule the slot bounced at t = 0 for ever and run never returned.
+  const auto slot = dir.write("slot.json", R"({"format": "turtlegas-world/1", "dimensions": 3, "name": "slot",
+    "arena": {"width": 20, "height": 10, "depth": 2, "boundary": "walls"},
+    "balls": [{"id": "s", "pos": [5, 5, 1], "vel": [1, 0.5, 0.3], "radius": 1}]})");
+  const auto r = run(dir, {"run", slot.string(), "--until", "1", "--events", (dir.path / "e.jsonl").string(),
+                           "--stats-json", (dir.path / "st.json").string()});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  std::istringstream lines(read(dir.path / "e.jsonl"));
+  std::string line;
+  REQUIRE(std::getline(lines, line));
+  const auto e = nlohmann::json::parse(line);
+  CHECK(e["kind"] == "wedged");
+  CHECK(e["a"] == "s");
+  CHECK(e["t"] == 0.0);
+  CHECK(((e["b"] == "arena-z1" && e["c"] == "arena-z0") || (e["b"] == "arena-z0" && e["c"] == "arena-z1")));
+  const auto st = nlohmann::json::parse(read(dir.path / "st.json"));
+  CHECK(st["wedged"] == 1);
+  CHECK(std::abs(st["energy_wedged"].get<double>() - 0.045) < 1e-15);
+  CHECK(!st.contains("stopped"));
+  // Two spheres filling a box along x (a jammed row, not covered in 3-D) run at t = 0 for ever:
+  // --max-events stops the run inside its first chunk, outputs written, exit 3.
+  const auto row = dir.write("row.json", R"({"format": "turtlegas-world/1", "dimensions": 3, "name": "row",
+    "arena": {"width": 4, "height": 10, "depth": 10, "boundary": "walls"},
+    "balls": [{"id": "a", "pos": [1, 5, 5], "vel": [1, 0, 0], "radius": 1}, {"id": "b", "pos": [3, 5, 5], "radius": 1}]})");
+  const auto stopped = run(dir, {"run", row.string(), "--until", "1", "--max-events", "20000", "--stats-json",
+                                 (dir.path / "row.json.stats").string()});
+  INFO(stopped.err);
+  CHECK(stopped.code == 3);
+  CHECK(stopped.err.find("stopped at t = 0 s of 1 (max-events)") != std::string::npos);
+  const auto rs = nlohmann::json::parse(read(dir.path / "row.json.stats"));
+  CHECK(rs["stopped"] == "max-events");
+  CHECK(rs["events"] == 20000);
 }

@@ -8,7 +8,9 @@
 // where the nearest point lies. O(N^2 + N W) per step: small scenes only. Restitution as
 // docs/physics.md "3-D: restitution" states it, written from that text: a pair's e the larger of
 // its spheres' (1 for one that changed course less than tc ago), a wall's the product, normal
-// speeds leaving at 2^-40 of the speeds at least, and at |a_n| tc / 2 where pressed.
+// speeds leaving at 2^-40 of the speeds at least, and at |a_n| tc / 2 where pressed. Moving walls
+// as "3-D: moving walls" states them: the shift interpolated between keys, distances to the
+// shifted corners, steps that never pass a key, the bounce on the velocity relative to the wall.
 #pragma once
 
 #include <algorithm>
@@ -17,6 +19,7 @@
 #include <random>
 #include <vector>
 
+#include "turtlegas/sim/toi3.hpp"
 #include "turtlegas/sim/vec3.hpp"
 #include "turtlegas/sim/world3d.hpp"
 
@@ -58,21 +61,54 @@ inline Nearest nearest_on_polygon(const std::vector<Vec3>& c, Vec3 q) {
 }
 
 struct Reference3 {
-  struct Ball { Vec3 x, v, a; double r, m, e, last; };
+  struct Ball { Vec3 x, v, a; double r, m, e, last; Vec3 omega; };
   std::vector<Ball> balls;
   std::vector<std::vector<Vec3>> walls;
   std::vector<double> wall_e;
+  std::vector<std::vector<sim::Wall3Key>> wall_keys;
   double tc = 0.0;
   double t = 0.0;
 
   explicit Reference3(const sim::World3Def& def) : tc(def.tc) {
     for (const auto& s : def.spheres)
       balls.push_back({s.pos, s.vel, def.gravity + (s.charge / s.mass) * def.electric, s.radius, s.mass,
-                       s.restitution, -1e300});
+                       s.restitution, -1e300, (s.charge / s.mass) * def.magnetic});
     for (const auto& w : def.walls) {
       walls.push_back(w.corners);
       wall_e.push_back(w.restitution);
+      wall_keys.push_back(w.keys);
     }
+  }
+
+  // Wall k's velocity and shift at t: the chord between the keys around t (at a key, the next).
+  Vec3 wall_u(std::size_t k) const {
+    const auto& keys = wall_keys[k];
+    double t0 = 0.0;
+    Vec3 s0;
+    for (const sim::Wall3Key& key : keys) {
+      if (key.t > t) return (1.0 / (key.t - t0)) * (key.shift - s0);
+      t0 = key.t;
+      s0 = key.shift;
+    }
+    return {};
+  }
+  Vec3 wall_shift(std::size_t k) const {
+    const auto& keys = wall_keys[k];
+    double t0 = 0.0;
+    Vec3 s0;
+    for (const sim::Wall3Key& key : keys) {
+      if (key.t > t) return s0 + ((t - t0) / (key.t - t0)) * (key.shift - s0);
+      t0 = key.t;
+      s0 = key.shift;
+    }
+    return s0;
+  }
+  double next_key() const {
+    double next = 1e300;
+    for (const auto& keys : wall_keys)
+      for (const sim::Wall3Key& key : keys)
+        if (key.t > t) next = std::min(next, key.t);
+    return next;
   }
 
   double e_of(const Ball& b) const { return t - b.last < tc ? 1.0 : b.e; }
@@ -82,8 +118,20 @@ struct Reference3 {
     return 2.0 * g / (w + std::sqrt(w * w + 2.0 * b * g));
   }
 
+  // A magnetic field turns a charged ball's flight into a helix (sim::Helix3, checked against its
+  // closed form in world3d_magnetic_test); |x''| bounds how fast its gaps can bend.
+  static bool gyrates(const Ball& b) { return !(b.omega == Vec3{}); }
+  static double accel_of(const Ball& b) {
+    return gyrates(b) ? sim::Helix3(b.v, b.a, b.omega).accel() : sim::norm(b.a);
+  }
   void fly_all(double dt) {
     for (Ball& b : balls) {
+      if (gyrates(b)) {
+        const sim::Helix3 h(b.v, b.a, b.omega);
+        b.x = b.x + h.displacement(dt);
+        b.v = h.velocity(dt);
+        continue;
+      }
       b.x = b.x + dt * b.v + (0.5 * dt * dt) * b.a;
       b.v = b.v + dt * b.a;
     }
@@ -92,14 +140,16 @@ struct Reference3 {
   /// Runs to t_end, appending events (ball_ball a < b; walls as the engine names them).
   void run(double t_end, std::vector<sim::Event3>& out, std::size_t max_events) {
     for (long steps = 0; steps < 50'000'000 && t < t_end && out.size() < max_events; ++steps) {
-      double step = t_end - t;
+      const double key = next_key();
+      double step = std::min(t_end, key) - t;
       bool served = false;
       for (std::size_t i = 0; i < balls.size() && !served; ++i) {
         for (std::size_t j = i + 1; j < balls.size() && !served; ++j) {
           const Vec3 d = balls[j].x - balls[i].x, w = balls[j].v - balls[i].v;
           const double g = sim::norm(d) - balls[i].r - balls[j].r;
           const double closing = -sim::dot(d, w) / sim::norm(d);
-          const double b = sim::norm(balls[j].a - balls[i].a);
+          const double b = gyrates(balls[i]) || gyrates(balls[j]) ? accel_of(balls[i]) + accel_of(balls[j])
+                                                                   : sim::norm(balls[j].a - balls[i].a);
           if (g < 1e-12 * balls[i].r && closing > 0.0) {
             const Vec3 nn = (1.0 / sim::norm(d)) * d;
             const double mu = balls[i].m * balls[j].m / (balls[i].m + balls[j].m);
@@ -116,17 +166,18 @@ struct Reference3 {
           }
         }
         for (std::size_t k = 0; k < walls.size() && !served; ++k) {
-          const Nearest nw = nearest_on_polygon(walls[k], balls[i].x);
-          const Vec3 d = balls[i].x - nw.point;
+          const Vec3 u = wall_u(k), q = balls[i].x - wall_shift(k), rel = balls[i].v - u;
+          const Nearest nw = nearest_on_polygon(walls[k], q);
+          const Vec3 d = q - nw.point;
           const double g = nw.dist - balls[i].r;
-          const double closing = -sim::dot(d, balls[i].v) / nw.dist;
-          const double b = sim::norm(balls[i].a);
+          const double closing = -sim::dot(d, rel) / nw.dist;
+          const double b = accel_of(balls[i]);
           if (g < 1e-12 * balls[i].r && closing > 0.0) {
             const Vec3 nn = (1.0 / nw.dist) * d;
-            const double e = balls[i].e * wall_e[k], s_in = -sim::dot(balls[i].v, nn);
+            const double e = balls[i].e * wall_e[k], s_in = -sim::dot(rel, nn);
             double s_out = s_in;
             if (e != 1.0) {
-              s_out = std::max(e * s_in, 0x1p-40 * sim::norm(balls[i].v));
+              s_out = std::max(e * s_in, 0x1p-40 * sim::norm(rel));
               if (sim::dot(balls[i].a, nn) < 0.0) s_out = std::max(s_out, -sim::dot(balls[i].a, nn) * tc / 2.0);
             }
             balls[i].v = balls[i].v + (s_in + s_out) * nn;
@@ -134,7 +185,7 @@ struct Reference3 {
             out.push_back({t, nw.kind, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k), nw.feature});
             served = true;
           } else if (closing > 0.0 || b > 0.0) {
-            step = std::min(step, g < 1e-9 * balls[i].r && closing <= 0.0 ? -closing / b : safe(g, sim::norm(balls[i].v), b));
+            step = std::min(step, g < 1e-9 * balls[i].r && closing <= 0.0 ? -closing / b : safe(g, sim::norm(rel), b));
           }
         }
       }
@@ -142,13 +193,14 @@ struct Reference3 {
       step = std::max(step, 1e-300);
       fly_all(std::min(step, t_end - t));
       t = std::min(t + step, t_end);
+      if (t >= key) t = key;  // a key is reached exactly: the walls turn there
     }
   }
 };
 
 /// 8 spheres or so in a closed box of six polygons of our own (so the reference sees them), with a
 /// slanted triangle and a slanted quad; gravity and an electric field on random charges optional.
-inline sim::World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool electric = false) {
+inline sim::World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool electric = false, bool magnetic = false) {
   std::mt19937_64 gen(seed);
   auto u = [&](double lo, double hi) { return lo + (hi - lo) * static_cast<double>(gen() >> 11) * 0x1.0p-53; };
   sim::World3Def def;
@@ -156,6 +208,7 @@ inline sim::World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool
   def.boundary = sim::Boundary3::none;
   if (gravity) def.gravity = {0.3, -0.5, -2.0};
   if (electric) def.electric = {0.8, 1.5, -1.0};
+  if (magnetic) def.magnetic = {0.6, -0.9, 1.2};
   // A closed box of our own walls (so the reference sees them too), and two slanted polygons.
   const double L = 12;
   def.walls.push_back({{{0, 0, 0}, {0, L, 0}, {0, L, L}, {0, 0, L}}});
@@ -172,7 +225,7 @@ inline sim::World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool
     bool ok = true;
     for (const auto& s : def.spheres) ok = ok && sim::norm(s.pos - x) > s.radius + r + 0.05;
     for (const auto& wd : def.walls) ok = ok && nearest_on_polygon(wd.corners, x).dist > r + 0.05;
-    if (ok) def.spheres.push_back({x, {u(-2, 2), u(-2, 2), u(-2, 2)}, r, u(0.5, 2.0), electric ? u(-1.5, 1.5) : 0.0});
+    if (ok) def.spheres.push_back({x, {u(-2, 2), u(-2, 2), u(-2, 2)}, r, u(0.5, 2.0), electric || magnetic ? u(-1.5, 1.5) : 0.0});
   }
   return def;
 }

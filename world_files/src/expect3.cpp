@@ -125,11 +125,12 @@ struct Filter {
     static const std::map<std::string, sim::Event3Kind> kinds = {
         {"ball-ball", sim::Event3Kind::ball_ball}, {"ball-wall", sim::Event3Kind::ball_wall},
         {"ball-wall-edge", sim::Event3Kind::ball_wall_edge}, {"ball-wall-corner", sim::Event3Kind::ball_wall_corner},
+        {"wedged", sim::Event3Kind::wedged},
         {"exit", sim::Event3Kind::exit}};
     const auto it = kinds.find(k);
     if (it == kinds.end())
       p.fail(path + "/" + std::string(key), "\"" + k + "\" is not an event of a 3-D world (one of: ball-ball, "
-                                              "ball-wall, ball-wall-edge, ball-wall-corner, exit)");
+                                              "ball-wall, ball-wall-edge, ball-wall-corner, wedged, exit)");
     f.kind = it->second;
     f.text = k;
     if (const json* v = p.rd().find(e, "a")) {

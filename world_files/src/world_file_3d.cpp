@@ -3,6 +3,7 @@
 // with three numbers per vector, `arena.depth`, walls as convex polygons, and no turtles.
 #include "turtlegas/world/world_file_3d.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
@@ -20,6 +21,43 @@ using nlohmann::json;
 sim::Vec3 vec3(const JsonReader& rd, const json& v, const std::string& path) {
   if (!v.is_array() || v.size() != 3) rd.fail(path, "expected [x, y, z], three numbers, got " + rd.got(v));
   return {rd.number(v[0], path + "/0"), rd.number(v[1], path + "/1"), rd.number(v[2], path + "/2")};
+}
+
+// A moving wall's keys (docs/worlds.md, "Moving walls in 3-D"): [{"t": T, "corners": [...]}, ...],
+// each pose the wall's corners translated, times > 0 and increasing, every pose in the arena.
+void read_keys(const JsonReader& rd, const json& ks, const std::string& path, const sim::World3Def& def, sim::Wall3Def& wd) {
+  rd.expect_array(ks, path, "keys");
+  if (def.boundary == sim::Boundary3::periodic)
+    rd.fail(path, "moving walls are not supported in a periodic arena (use \"boundary\": \"walls\" or \"none\")");
+  double scale = 0.0;
+  for (std::size_t c = 0; c < wd.corners.size(); ++c)
+    scale = std::max(scale, sim::norm(wd.corners[(c + 1) % wd.corners.size()] - wd.corners[c]));
+  for (std::size_t k = 0; k < ks.size(); ++k) {
+    const std::string at = path + "/" + std::to_string(k);
+    const json& key = ks[k];
+    rd.expect_object(key, at, "a key");
+    rd.check_keys(key, at, "a 3-D wall's key", {"t", "corners"});
+    const double t = rd.positive(rd.require(key, at, "t", "a key"), at + "/t", "t");
+    if (k > 0 && !(t > wd.keys.back().t))
+      rd.fail(at + "/t", "key times must increase (got " + key["t"].dump() + " after " + std::to_string(wd.keys.back().t) + ")");
+    const json& cs = rd.require(key, at, "corners", "a key (the wall's corners at t, [[x, y, z], ...])");
+    rd.expect_array(cs, at + "/corners", "corners");
+    if (cs.size() != wd.corners.size())
+      rd.fail(at + "/corners", "a key lists the wall's " + std::to_string(wd.corners.size()) + " corners, in the same order (got " +
+                                   std::to_string(cs.size()) + ")");
+    sim::Vec3 shift;
+    for (std::size_t c = 0; c < cs.size(); ++c) {
+      const std::string cp = at + "/corners/" + std::to_string(c);
+      const sim::Vec3 p = vec3(rd, cs[c], cp);
+      for (int a = 0; a < 3; ++a)
+        if (p[a] < 0.0 || p[a] > def.size[a]) rd.fail(cp, "the wall leaves the arena here (every pose's corners must lie in it)");
+      if (c == 0) shift = p - wd.corners[0];
+      else if (sim::norm(p - wd.corners[c] - shift) > 1e-9 * scale)
+        rd.fail(cp, "a 3-D wall may only translate: every corner must move by corner 0's shift [" + std::to_string(shift.x) +
+                        ", " + std::to_string(shift.y) + ", " + std::to_string(shift.z) + "] (turning or stretching is not simulated)");
+    }
+    wd.keys.push_back({t, shift});
+  }
 }
 
 }  // namespace
@@ -77,8 +115,11 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
     rd.check_keys(*e, "/effects", "effects", {"gravity", "electric", "magnetic", "restitution", "tc", "ball_ball"});
     if (const json* g = rd.find(*e, "gravity")) def.gravity = vec3(rd, *g, "/effects/gravity");
     if (const json* g = rd.find(*e, "electric")) def.electric = vec3(rd, *g, "/effects/electric");
-    if (const json* m = rd.find(*e, "magnetic"); m && !(m->is_number() && m->get<double>() == 0.0))
-      rd.fail("/effects/magnetic", "a magnetic field is not simulated in 3-D yet (helices); remove it or set 0");
+    if (const json* m = rd.find(*e, "magnetic"); m && !(m->is_number() && m->get<double>() == 0.0)) {
+      if (m->is_number())
+        rd.fail("/effects/magnetic", "in 3-D the magnetic field is a vector, [Bx, By, Bz] (got " + m->dump() + ")");
+      def.magnetic = vec3(rd, *m, "/effects/magnetic");
+    }
     if (const json* r = rd.find(*e, "restitution")) scene_e = restitution(*r, "/effects/restitution");
     if (const json* t = rd.find(*e, "tc")) def.tc = rd.non_negative(*t, "/effects/tc");
     if (const json* b = rd.find(*e, "ball_ball"); b && !rd.boolean(*b, "/effects/ball_ball"))
@@ -96,16 +137,18 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
       const std::string path = "/walls/" + std::to_string(k);
       const json& w = (*ws)[k];
       rd.expect_object(w, path, "a wall");
-      rd.check_keys(w, path, "a 3-D wall", {"id", "corners", "restitution"});
+      rd.check_keys(w, path, "a 3-D wall", {"id", "corners", "restitution", "keys"});
       out.wall_ids.push_back(take_id(w, path, "a wall"));
       const json& cs = rd.require(w, path, "corners", "a 3-D wall (its corners, [[x, y, z], ...], in order)");
       rd.expect_array(cs, path + "/corners", "corners");
       sim::Wall3Def wd;
       if (const json* r = rd.find(w, "restitution")) wd.restitution = restitution(*r, path + "/restitution");
       for (std::size_t c = 0; c < cs.size(); ++c) wd.corners.push_back(vec3(rd, cs[c], path + "/corners/" + std::to_string(c)));
+      if (const json* ks = rd.find(w, "keys")) read_keys(rd, *ks, path + "/keys", def, wd);
       def.walls.push_back(wd);
       sim::World3Def one;
       one.size = def.size;
+      one.boundary = def.boundary;
       one.walls.push_back(wd);
       if (const std::string bad = sim::check_world3(one); !bad.empty()) rd.fail(path, bad.substr(bad.find(": ") + 2));
     }
@@ -139,10 +182,11 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
       const std::string path = "/gas/" + std::to_string(k);
       const json& g = (*gs)[k];
       rd.expect_object(g, path, "a gas");
-      rd.check_keys(g, path, "a 3-D gas", {"count", "radius", "mass", "speed", "region", "seed", "id_prefix", "restitution"});
+      rd.check_keys(g, path, "a 3-D gas", {"count", "radius", "mass", "charge", "speed", "region", "seed", "id_prefix", "restitution"});
       const std::uint64_t count = rd.natural(rd.require(g, path, "count", "a gas"), path + "/count");
       const double r = rd.positive(rd.require(g, path, "radius", "a gas"), path + "/radius", "radius");
       const double mass = rd.find(g, "mass") ? rd.positive(g["mass"], path + "/mass", "mass") : 1.0;
+      const double charge = rd.find(g, "charge") ? rd.number(g["charge"], path + "/charge") : 0.0;
       const double speed = rd.find(g, "speed") ? rd.non_negative(g["speed"], path + "/speed") : 0.0;
       const double ge = rd.find(g, "restitution") ? restitution(g["restitution"], path + "/restitution") : scene_e;
       sim::Vec3 lo{0, 0, 0}, hi = def.size;
@@ -168,7 +212,7 @@ World3File parse_world3(std::string_view text, std::string_view file_name) {
             ok = sim::distance_to_polygon(x, def.walls[w].corners) > r;
           if (!ok) continue;
           const double cz = u(-1, 1), phi = u(0, 6.283185307179586), sz = std::sqrt(1 - cz * cz);
-          def.spheres.push_back({x, {speed * sz * std::cos(phi), speed * sz * std::sin(phi), speed * cz}, r, mass, 0.0, ge});
+          def.spheres.push_back({x, {speed * sz * std::cos(phi), speed * sz * std::sin(phi), speed * cz}, r, mass, charge, ge});
           placed = true;
         }
         if (!placed)

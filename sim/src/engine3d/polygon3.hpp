@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "turtlegas/sim/toi3.hpp"
@@ -48,6 +49,31 @@ struct Polygon3 {
     for (std::size_t k = 0; k < corners.size(); ++k)
       if (dot(q - corners[k], inward[k]) < -tol) return false;
     return true;
+  }
+  /// The nearest point of the polygon to q and its feature: 0 the face (q's foot inside), 1 an
+  /// edge (index: from corner index to the next), 2 a corner.
+  struct Nearest {
+    Vec3 point;
+    int kind = 0;
+    std::uint32_t index = 0;
+  };
+  Nearest nearest(Vec3 q) const {
+    if (covers(q, 0.0)) return {q - dot(q - corners[0], normal) * normal, 0, 0};
+    Nearest best;
+    double dist = kNever;
+    const std::size_t n = corners.size();
+    for (std::size_t e = 0; e < n; ++e) {
+      const Vec3 de = q - corners[e];
+      const double s = std::clamp(dot(de, along[e]), 0.0, length[e]);
+      const Vec3 p = corners[e] + s * along[e];
+      const double d = norm(q - p);
+      if (d < dist) {
+        dist = d;
+        if (s > 0.0 && s < length[e]) best = {p, 1, static_cast<std::uint32_t>(e)};
+        else best = {p, 2, static_cast<std::uint32_t>(s == 0.0 ? e : (e + 1) % n)};
+      }
+    }
+    return best;
   }
   /// The distance from q to the polygon: to its plane where q's foot falls inside, else to the
   /// nearest edge.

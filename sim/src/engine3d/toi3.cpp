@@ -70,6 +70,29 @@ void squared_gap(Vec3 d, Vec3 w, Vec3 b, double rho, double* c) {
   c[4] = 0.25 * norm2(b);
 }
 
+Helix3::Helix3(Vec3 v, Vec3 a, Vec3 omega) {
+  w = norm(omega);
+  b = (1.0 / w) * omega;
+  v_par = dot(v, b);
+  a_par = dot(a, b);
+  const Vec3 a_perp = a - a_par * b;
+  v_d = (1.0 / (w * w)) * cross(a_perp, omega);
+  u0 = v - v_par * b - v_d;
+  bu0 = cross(b, u0);
+}
+
+Vec3 Helix3::displacement(double t) const {
+  // 1 - cos(w t) as 2 sin^2(w t / 2): no cancellation at small angles.
+  const double sh = std::sin(0.5 * w * t);
+  return (v_par * t + 0.5 * a_par * t * t) * b + t * v_d + (std::sin(w * t) / w) * u0 - (2.0 * sh * sh / w) * bu0;
+}
+
+Vec3 Helix3::velocity(double t) const {
+  return (v_par + a_par * t) * b + v_d + std::cos(w * t) * u0 - std::sin(w * t) * bu0;
+}
+
+double Helix3::accel() const { return std::sqrt(a_par * a_par + w * w * norm2(u0)); }
+
 double toi_sphere_sphere(Vec3 d, Vec3 w, Vec3 b, double sigma, double t_max) {
   if (b.x == 0.0 && b.y == 0.0 && b.z == 0.0) {
     const double dw = dot(d, w);

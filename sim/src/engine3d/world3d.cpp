@@ -15,6 +15,8 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -122,7 +124,10 @@ std::string first_sphere_overlap(const World3Def& def) {
 std::string check_world3(const World3Def& def) {
   for (int a = 0; a < 3; ++a)
     if (!(def.size[a] > 0.0) || !std::isfinite(def.size[a])) return "the arena's width, height and depth must be finite and > 0";
-  if (!is_finite(def.gravity) || !is_finite(def.electric)) return "gravity and electric must be finite";
+  if (!is_finite(def.gravity) || !is_finite(def.electric) || !is_finite(def.magnetic))
+    return "gravity, electric and magnetic must be finite";
+  if (def.mode == Mode::step && !(def.magnetic == Vec3{}))
+    return "a magnetic field is simulated in exact mode only in 3-D (step mode's kicks do not turn velocities yet)";
   if (!(def.tc >= 0.0) || !std::isfinite(def.tc)) return "tc must be finite and >= 0";
   if (def.mode == Mode::step && !(def.dt > 0.0 && std::isfinite(def.dt))) return "step mode's dt must be finite and > 0";
   for (std::size_t i = 0; i < def.spheres.size(); ++i) {
@@ -157,6 +162,19 @@ std::string check_world3(const World3Def& def) {
     double scale = 0.0;
     for (std::size_t k = 0; k < c.size(); ++k) scale = std::max(scale, norm(c[(k + 1) % c.size()] - c[k]));
     if (!(an > 1e-12 * scale * scale)) return at + "corners are collinear, or not in order around the polygon (no plane)";
+    const auto& keys = def.walls[w].keys;
+    if (!keys.empty() && def.boundary == Boundary3::periodic)
+      return at + "moving walls are not supported in a periodic arena (use \"boundary\": \"walls\" or \"none\")";
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+      const std::string key = at + "key " + std::to_string(k) + ": ";
+      if (!std::isfinite(keys[k].t) || !(keys[k].t > (k == 0 ? 0.0 : keys[k - 1].t)))
+        return key + "times must be finite, > 0 and increasing";
+      if (!is_finite(keys[k].shift)) return key + "the pose must be finite";
+      for (const Vec3& p : c)
+        for (int a = 0; a < 3; ++a)
+          if (p[a] + keys[k].shift[a] < 0.0 || p[a] + keys[k].shift[a] > def.size[a])
+            return key + "the wall leaves the arena (every pose's corners must lie in it)";
+    }
     const Vec3 n = (1.0 / an) * area;
     for (std::size_t k = 0; k < c.size(); ++k) {
       if (std::abs(dot(c[k] - c[0], n)) > 1e-9 * scale) return at + "corners are not in one plane";
@@ -191,6 +209,65 @@ struct World3::Impl {
   double contact_error = 0.0;
   double virial = 0.0;
   std::vector<double> wall_push;  // per wall: sum of m Δv . n over its contacts (World3::wall_push)
+  // Moving walls (docs/physics.md, "3-D: moving walls"): per wall, its translation `shift_ref`
+  // at time `key_t` and its velocity since, with the keys still ahead. A standing wall has all
+  // zero and no keys, and its formulas below are bit for bit those without motion (x - 0 == x).
+  struct Motion {
+    Vec3 shift_ref, u;
+    double t_ref = 0.0;
+    std::vector<Wall3Key> keys;
+    std::size_t next = 0;  // the key it is heading for (keys.size(): it has stopped)
+    Vec3 shift_at(double t) const { return shift_ref + (t - t_ref) * u; }
+  };
+  std::vector<Motion> motion;  // per wall; empty when no wall moves
+  double next_key = kNever;    // the earliest key ahead of any wall
+  double wall_work = 0.0;      // World3::wall_work
+  // A magnetic field (docs/physics.md, "3-D: magnetic fields"): per sphere omega = (q/m) B, kept
+  // only when B != 0. A sphere with omega != 0 flies a helix and every contact of it is found by
+  // conservative advancement (first_touch), up to a horizon of at most `cap` (one turn of the
+  // fastest-turning sphere): at the horizon it predicts again. In such a scene every crossing
+  // predicts in full (pairs are searched only up to each sphere's horizon).
+  std::vector<Vec3> omega;
+  double cap = kNever;
+  double limit = kNever;  // during a prediction: how far every search so far is proven
+  // A contact is found within 1e-12 r plus this: 2^-44 of the arena, some 500 times the round-off
+  // of a helix's position anywhere in it, so first_touch's margin (half the tolerance) holds.
+  double round_off = 0.0;
+  bool gyrates(std::uint32_t i) const { return !omega.empty() && !(omega[i] == Vec3{}); }
+  Vec3 pos_at(const Record& b, double dt) const {
+    const std::uint32_t i = index_of(b);
+    return gyrates(i) ? b.x + Helix3(b.v, b.a, omega[i]).displacement(dt) : fly(b.x, b.v, b.a, dt);
+  }
+  Vec3 vel_at(const Record& b, double dt) const {
+    const std::uint32_t i = index_of(b);
+    return gyrates(i) ? Helix3(b.v, b.a, omega[i]).velocity(dt) : b.v + dt * b.a;
+  }
+  std::uint32_t index_of(const Record& b) const { return static_cast<std::uint32_t>(&b - rec.data()); }
+  // A sphere's flight as seen by a search: position and velocity at s after `now`, and |x''|.
+  struct Path {
+    Vec3 x, v, a;
+    std::optional<Helix3> helix;
+    Vec3 pos(double s) const { return helix ? x + helix->displacement(s) : fly(x, v, a, s); }
+    Vec3 vel(double s) const { return helix ? helix->velocity(s) : v + s * a; }
+    double accel() const { return helix ? helix->accel() : norm(a); }
+  };
+  Path path_of(std::uint32_t i) const {
+    const Record& b = rec[i];
+    Path p{pos_at(b, now - b.t), vel_at(b, now - b.t), b.a, std::nullopt};
+    if (gyrates(i)) p.helix.emplace(p.v, b.a, omega[i]);
+    return p;
+  }
+  static constexpr int kMaxSteps = 20000;
+  // Conservative advancement (first_touch) with the prediction's running limit.
+  template <class Eval>
+  double touch(Eval eval, double accel, double horizon, double tol) {
+    horizon = std::min(horizon, limit);
+    if (!(horizon > 0.0)) return kNever;
+    double reached = 0.0;
+    const double t = first_touch(eval, accel, horizon, tol, kMaxSteps, reached);
+    if (t == kNever && reached < horizon) limit = reached;  // stopped early: predict again there
+    return t;
+  }
   std::vector<Event3>* log = nullptr;
   // Restitution (docs/physics.md, "3-D: restitution"): kept beside the records, and only when
   // some e < 1, so that an elastic gas's record and loop are unchanged.
@@ -203,7 +280,23 @@ struct World3::Impl {
   std::vector<Vec3> field_a;
   double dt = 0.0;
   std::uint64_t steps = 0;
+  // The wedge rule's figures (World3::wedged, energy_wedged).
+  std::uint64_t wedged = 0;
+  double energy_wedged = 0.0;
+  // Stops (World3::set_event_limit, set_stop_poll): looked at when `events` reaches next_check.
+  std::uint64_t event_limit = ~std::uint64_t{0};
+  std::function<bool()> stop_poll;
+  std::uint64_t poll_every = 4096;
+  std::uint64_t next_check = ~std::uint64_t{0};
+  void arm_check() { next_check = stop_poll ? std::min(event_limit, events + poll_every) : event_limit; }
+  [[gnu::cold]] void check_stop() {
+    if (events >= event_limit)
+      throw EventLimitReached("the event limit (" + std::to_string(event_limit) + ") was reached at t = " + std::to_string(now));
+    if (stop_poll && stop_poll()) throw StopRequested("stopped at t = " + std::to_string(now));
+    arm_check();
+  }
 
+  int n_cells(int a) const { return n[a]; }
   std::uint32_t cell_index(int cx, int cy, int cz) const {
     return static_cast<std::uint32_t>((cz * n[1] + cy) * n[0] + cx);
   }
@@ -228,15 +321,22 @@ struct World3::Impl {
   void bring(Record& b, double t) {
     const double dt = t - b.t;
     if (dt == 0.0) return;
-    b.x = fly(b.x, b.v, b.a, dt);
-    b.v += dt * b.a;
+    if (gyrates(index_of(b))) {
+      const Vec3 x = pos_at(b, dt);
+      b.v = vel_at(b, dt);
+      b.x = x;
+    } else {
+      b.x = fly(b.x, b.v, b.a, dt);
+      b.v += dt * b.a;
+    }
     b.t = t;
   }
 
   explicit Impl(const World3Def& def) : boundary(def.boundary), size(def.size) {
     double r_max = 0.0;
     for (const auto& s : def.spheres) r_max = std::max(r_max, s.radius);
-    const double cell = def.cell > 0.0 ? def.cell : 2.0 * r_max * (1.0 + 0x1p-20);
+    // Without spheres (a world of walls only) one cell per axis.
+    const double cell = def.cell > 0.0 ? def.cell : r_max > 0.0 ? 2.0 * r_max * (1.0 + 0x1p-20) : std::max({size.x, size.y, size.z});
     for (int a = 0; a < 3; ++a) {
       n[a] = std::max(1, static_cast<int>(std::min(1024.0, std::floor(size[a] / std::max(cell, 1e-300)))));
       if (boundary == Boundary3::periodic && n[a] < 3)
@@ -263,16 +363,34 @@ struct World3::Impl {
       walls.emplace_back(std::vector<Vec3>{{0, 0, Z}, {0, Y, Z}, {X, Y, Z}, {X, 0, Z}});
     }
     wall_push.assign(walls.size(), 0.0);
+    bool any_moves = false;
+    for (const auto& wd : def.walls) any_moves = any_moves || !wd.keys.empty();
+    if (any_moves) {
+      motion.resize(walls.size());
+      for (std::size_t k = 0; k < def.walls.size(); ++k) {
+        motion[k].keys = def.walls[k].keys;
+        aim(motion[k]);
+      }
+      next_key = earliest_key();
+    }
     const std::size_t cells = static_cast<std::size_t>(n[0]) * n[1] * n[2];
     head.assign(cells, kNone);
     cell_walls.assign(cells, {});
     // A wall is listed in every cell within r_max of its bounding box: a sphere whose centre
-    // is in the cell can touch it only then.
+    // is in the cell can touch it only then. A moving wall's box is the one around all its
+    // poses: it translates in straight lines between them, so it never leaves that box.
     for (std::uint32_t k = 0; k < walls.size(); ++k) {
+      Vec3 box_lo = walls[k].lo, box_hi = walls[k].hi;
+      if (k < def.walls.size())
+        for (const Wall3Key& key : def.walls[k].keys)
+          for (int a = 0; a < 3; ++a) {
+            box_lo[a] = std::min(box_lo[a], walls[k].lo[a] + key.shift[a]);
+            box_hi[a] = std::max(box_hi[a], walls[k].hi[a] + key.shift[a]);
+          }
       int lo[3], hi[3];
       for (int a = 0; a < 3; ++a) {
-        lo[a] = std::clamp(static_cast<int>(std::floor((walls[k].lo[a] - r_max) / w[a])), 0, n[a] - 1);
-        hi[a] = std::clamp(static_cast<int>(std::floor((walls[k].hi[a] + r_max) / w[a])), 0, n[a] - 1);
+        lo[a] = std::clamp(static_cast<int>(std::floor((box_lo[a] - r_max) / w[a])), 0, n[a] - 1);
+        hi[a] = std::clamp(static_cast<int>(std::floor((box_hi[a] + r_max) / w[a])), 0, n[a] - 1);
       }
       for (int z = lo[2]; z <= hi[2]; ++z)
         for (int y = lo[1]; y <= hi[1]; ++y)
@@ -299,7 +417,18 @@ struct World3::Impl {
       dt = def.dt;
       for (Record& b : rec) b.a = {};
     }
-    queue.reset(&rec[0].node, sizeof(Record), rec.size());
+    if (!(def.magnetic == Vec3{})) {
+      omega.resize(def.spheres.size());
+      double w_max = 0.0;
+      for (std::size_t i = 0; i < def.spheres.size(); ++i) {
+        omega[i] = (def.spheres[i].charge / def.spheres[i].mass) * def.magnetic;
+        w_max = std::max(w_max, norm(omega[i]));
+      }
+      if (w_max > 0.0) cap = 6.283185307179586 / w_max;
+      else omega.clear();
+      round_off = 0x1p-44 * std::max({size.x, size.y, size.z});
+    }
+    queue.reset(rec.empty() ? nullptr : &rec[0].node, sizeof(Record), rec.size());
     for (std::uint32_t i = 0; i < rec.size(); ++i) predict(i);
   }
 
@@ -319,6 +448,44 @@ struct World3::Impl {
     }
   }
   double step_end(std::uint64_t k) const { return static_cast<double>(k) * dt; }
+
+  // A wall's velocity towards its next key from the pose it has taken (the previous key's, or no
+  // shift at t = 0): the chord (shift_next - shift_ref) / (t_next - t_ref); 0 after the last.
+  static void aim(Motion& m) {
+    if (m.next >= m.keys.size()) {
+      m.u = {};
+      return;
+    }
+    const Wall3Key& k = m.keys[m.next];
+    m.u = (1.0 / (k.t - m.t_ref)) * (k.shift - m.shift_ref);
+  }
+  double earliest_key() const {
+    double t = kNever;
+    for (const Motion& m : motion)
+      if (m.next < m.keys.size()) t = std::min(t, m.keys[m.next].t);
+    return t;
+  }
+  // The keyframe at t (== next_key): the walls due take their poses exactly and aim at their next;
+  // then every sphere predicts again (a key changes a wall's velocity, so every contact predicted
+  // with it is void; O(N), and keys are rare).
+  void take_keys(double t) {
+    now = t;
+    for (Motion& m : motion)
+      if (m.next < m.keys.size() && m.keys[m.next].t == t) {
+        m.shift_ref = m.keys[m.next].shift;
+        m.t_ref = t;
+        ++m.next;
+        aim(m);
+      }
+    next_key = earliest_key();
+  }
+  void predict_all() {
+    for (Record& b : rec) ++b.count;  // every pending pair event of the old predictions goes stale
+    for (std::uint32_t i = 0; i < rec.size(); ++i)
+      if (rec[i].alive) predict(i);
+  }
+  Vec3 shift_of(std::uint32_t k) const { return k < motion.size() ? motion[k].shift_at(now) : Vec3{}; }
+  Vec3 velocity_of(std::uint32_t k) const { return k < motion.size() ? motion[k].u : Vec3{}; }
 
   // The earliest cell exit of body b (at now) over the three axes.
   double cell_exit(const Record& b, std::uint8_t& axis, std::int8_t& dir) const {
@@ -352,17 +519,20 @@ struct World3::Impl {
     const double before = best;
     const Polygon3& p = walls[k];
     const double tol = 1e-12 * p.scale;
-    const Vec3 d = b.x - p.corners[0];
+    // In the wall's frame (it translates at u, shifted by o from its t = 0 corners) the sphere
+    // flies x - o, v - u, a: the same family of flights, against the wall's t = 0 corners.
+    const Vec3 x = b.x - shift_of(k), v = b.v - velocity_of(k);
+    const Vec3 d = x - p.corners[0];
     double c[5], times[4];
     // The face: the memo's plane formula, both sides (s = r falling, s = -r rising).
     {
-      const double s0 = dot(d, p.normal), s1 = dot(b.v, p.normal), s2 = 0.5 * dot(b.a, p.normal);
+      const double s0 = dot(d, p.normal), s1 = dot(v, p.normal), s2 = 0.5 * dot(b.a, p.normal);
       for (int side = -1; side <= 1; side += 2) {
         c[0] = side * s0 - b.r; c[1] = side * s1; c[2] = side * s2;
         const int m = approach_times(c, 2, best, 1e-9 * b.r, times);
         for (int q = 0; q < m; ++q) {
           if (!(times[q] < best)) break;
-          if (p.covers(fly(b.x, b.v, b.a, times[q]), tol)) {
+          if (p.covers(fly(x, v, b.a, times[q]), tol)) {
             best = times[q];
             b.kind = Pending::face; b.partner = k; b.partner_count = 0;
             break;
@@ -374,13 +544,13 @@ struct World3::Impl {
     for (std::size_t e = 0; e < nc; ++e) {
       // The edge: the cylinder of radius r around its line, where the foot is on the segment.
       const Vec3 u = p.along[e];
-      const Vec3 de = b.x - p.corners[e];
-      const Vec3 dp = de - dot(de, u) * u, vp = b.v - dot(b.v, u) * u, ap = b.a - dot(b.a, u) * u;
+      const Vec3 de = x - p.corners[e];
+      const Vec3 dp = de - dot(de, u) * u, vp = v - dot(v, u) * u, ap = b.a - dot(b.a, u) * u;
       squared_gap(dp, vp, ap, b.r, c);
       const int m = approach_times(c, 4, best, 1e-9 * b.r * b.r, times);
       for (int q = 0; q < m; ++q) {
         if (!(times[q] < best)) break;
-        const double s = dot(fly(de, b.v, b.a, times[q]), u);
+        const double s = dot(fly(de, v, b.a, times[q]), u);
         if (s >= -tol && s <= p.length[e] + tol) {
           best = times[q];
           b.kind = Pending::edge; b.partner = k; b.partner_count = static_cast<std::uint32_t>(e);
@@ -388,7 +558,7 @@ struct World3::Impl {
         }
       }
       // The corner: the memo's wall-end formula.
-      squared_gap(de, b.v, b.a, b.r, c);
+      squared_gap(de, v, b.a, b.r, c);
       const int mc = approach_times(c, 4, best, 1e-9 * b.r * b.r, times);
       if (mc > 0 && times[0] < best) {
         best = times[0];
@@ -433,6 +603,10 @@ struct World3::Impl {
   void predict(std::uint32_t i) {
     Record& b = rec[i];
     bring(b, now);
+    if (!omega.empty()) {
+      predict_magnetic(i);
+      return;
+    }
     const double exit = cell_exit(b, b.axis, b.dir);
     double cand = kNever;
     b.kind = Pending::none;
@@ -443,6 +617,127 @@ struct World3::Impl {
         for (int ox = -1; ox <= 1; ++ox) scan_cell(i, b, k[0] + ox, k[1] + oy, k[2] + oz, cand);
     for (std::uint32_t wk : cell_walls[b.cell]) predict_wall(b, wk, cand, exit);
     schedule(i, b, cand, exit);
+  }
+
+  // A prediction in a scene with a magnetic field: every search is bounded by the horizon
+  // (the cell exit, at most `cap` ahead, less where a search stopped early); a sphere that reaches
+  // it without event predicts again (axis 3: no crossing).
+  void predict_magnetic(std::uint32_t i) {
+    Record& b = rec[i];
+    limit = cap;
+    const Path me = path_of(i);
+    double exit = me.helix ? helix_exit(b, me) : cell_exit(b, b.axis, b.dir);
+    double cand = kNever;
+    b.kind = Pending::none;
+    int k[3];
+    coords(b.cell, k);
+    for (int oz = -1; oz <= 1; ++oz)
+      for (int oy = -1; oy <= 1; ++oy)
+        for (int ox = -1; ox <= 1; ++ox) scan_cell_magnetic(i, me, k[0] + ox, k[1] + oy, k[2] + oz, cand, exit);
+    for (std::uint32_t wk : cell_walls[b.cell]) {
+      if (me.helix) predict_wall_helix(b, me, wk, cand, std::min(exit, limit));
+      else predict_wall(b, wk, cand, std::min(exit, limit));
+    }
+    if (limit < exit) {  // the horizon (cap, or where a search stopped) comes before the exit
+      exit = limit;
+      b.axis = 3;
+    }
+    if (cand > exit) b.kind = Pending::none;
+    schedule(i, b, cand, exit);
+  }
+
+  // The cell exit of a helix: each of the six faces' distance is linear in the position, so
+  // conservative advancement with |x''| finds its crossing (within tol inside the cell).
+  double helix_exit(Record& b, const Path& me) {
+    int k[3];
+    coords(b.cell, k);
+    double best = kNever;
+    b.axis = 3;
+    b.dir = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = k[a] * w[a], hi = (k[a] + 1 == n[a]) ? size[a] : lo + w[a];
+      const double tol = 1e-12 * w[a] + round_off;
+      for (int dir = -1; dir <= 1; dir += 2) {
+        const double t = touch(
+            [&](double s, double& g, double& gd) {
+              const double x = me.pos(s)[a];
+              const double v = me.vel(s)[a];
+              g = dir > 0 ? hi - x : x - lo;
+              gd = dir > 0 ? -v : v;
+            },
+            me.accel(), std::min(best, cap), tol);
+        if (t < best) {
+          best = t;
+          b.axis = static_cast<std::uint8_t>(a);
+          b.dir = static_cast<std::int8_t>(dir);
+        }
+      }
+    }
+    return best;
+  }
+
+  // Wall k against a helix: the distance to the polygon (a convex set, so convex in position) in
+  // the wall's frame; the feature is where the nearest point lies at the contact.
+  void predict_wall_helix(Record& b, const Path& me, std::uint32_t k, double& cand, double exit) {
+    const Polygon3& p = walls[k];
+    const Vec3 o = shift_of(k), u = velocity_of(k);
+    auto eval = [&](double s, double& g, double& gd) {
+      const Vec3 q = me.pos(s) - (o + s * u);
+      const Vec3 d = q - p.nearest(q).point;
+      const double dist = norm(d);
+      g = dist - b.r;
+      gd = dist > 0.0 ? dot(d, me.vel(s) - u) / dist : -1.0;
+    };
+    const double t = touch(eval, me.accel(), std::min(cand, exit), 1e-12 * b.r + round_off);
+    if (t < cand) {
+      cand = t;
+      const Polygon3::Nearest nf = p.nearest(me.pos(t) - (o + t * u));
+      b.kind = nf.kind == 0 ? Pending::face : nf.kind == 1 ? Pending::edge : Pending::corner;
+      b.partner = k;
+      b.partner_count = nf.kind == 0 ? 0 : nf.index;
+    }
+  }
+
+  // The spheres of one cell against sphere i in a magnetic scene: a pair neither of which
+  // gyrates by the closed forms (up to the horizon), else conservative advancement on the
+  // distance of centres.
+  void scan_cell_magnetic(std::uint32_t i, const Path& me, int cx, int cy, int cz, double& cand, double exit) {
+    Record& b = rec[i];
+    Vec3 shift;
+    int k[3] = {cx, cy, cz};
+    for (int a = 0; a < 3; ++a) {
+      if (k[a] >= 0 && k[a] < n[a]) continue;
+      if (boundary != Boundary3::periodic) return;
+      shift[a] = k[a] < 0 ? -size[a] : size[a];
+      k[a] = (k[a] + n[a]) % n[a];
+    }
+    for (std::uint32_t j = head[cell_index(k[0], k[1], k[2])]; j != kNone; j = rec[j].next) {
+      if (j == i) continue;
+      const Record& o = rec[j];
+      const double horizon = std::min({cand, exit, limit});
+      double t;
+      if (!me.helix && !gyrates(j)) {
+        const double dt = now - o.t;
+        const Vec3 xo = fly(o.x, o.v, o.a, dt) + shift, vo = o.v + dt * o.a;
+        t = toi_sphere_sphere(xo - b.x, vo - b.v, o.a - b.a, b.r + o.r, horizon);
+      } else {
+        Path other = path_of(j);
+        other.x += shift;
+        const double sigma = b.r + o.r;
+        t = touch(
+            [&](double s, double& g, double& gd) {
+              const Vec3 d = other.pos(s) - me.pos(s);
+              const double dist = norm(d);
+              g = dist - sigma;
+              gd = dot(d, other.vel(s) - me.vel(s)) / dist;
+            },
+            me.accel() + other.accel(), horizon, 1e-12 * std::min(b.r, o.r) + round_off);
+      }
+      if (t < cand) {
+        cand = t;
+        b.kind = Pending::pair; b.partner = j; b.partner_count = o.count;
+      }
+    }
   }
 
   // After a crossing along `axis` by `dir`: the kept contact candidate (still a true time of
@@ -570,11 +865,12 @@ struct World3::Impl {
         const Polygon3& p = walls[b.partner];
         Vec3 normal;
         Event3Kind kind;
-        const Vec3 d = b.x - p.corners[b.partner_count];
+        const Vec3 x = b.x - shift_of(b.partner);  // in the wall's frame, against its t = 0 corners
+        const Vec3 d = x - p.corners[b.partner_count];
         if (b.kind == Pending::face) {
-          normal = dot(b.x - p.corners[0], p.normal) >= 0.0 ? p.normal : -p.normal;  // towards the sphere
+          normal = dot(x - p.corners[0], p.normal) >= 0.0 ? p.normal : -p.normal;  // towards the sphere
           kind = Event3Kind::ball_wall;
-          contact_error = std::max(contact_error, std::abs(std::abs(dot(b.x - p.corners[0], normal)) - b.r) / b.r);
+          contact_error = std::max(contact_error, std::abs(std::abs(dot(x - p.corners[0], normal)) - b.r) / b.r);
         } else if (b.kind == Pending::edge) {
           const Vec3 u = p.along[b.partner_count];
           normal = d - dot(d, u) * u;
@@ -585,9 +881,18 @@ struct World3::Impl {
           kind = Event3Kind::ball_wall_corner;
           contact_error = std::max(contact_error, std::abs(norm(normal) - b.r) / b.r);
         }
+        if (motion.empty() && wedge(i, b, b.partner, (1.0 / norm(normal)) * normal)) return;
         const Vec3 v_before = b.v;
+        // The bounce in the wall's frame: v' = u + bounce(v - u) (u = 0 for a standing wall).
+        const bool moves = !motion.empty();  // else bit for bit the standing walls' bounce
+        const Vec3 u = velocity_of(b.partner);
+        if (moves) b.v -= u;
         if (inelastic) bounce_inelastic(i, b, normal, b.partner);
         else reflect(b, normal);
+        if (moves) {
+          b.v += u;
+          wall_work += 0.5 * b.m * (norm2(b.v) - norm2(v_before));
+        }
         wall_push[b.partner] += b.m * dot(b.v - v_before, normal) / norm(normal);
         note(kind, i, b.partner, b.partner_count);
         predict(i);
@@ -597,9 +902,89 @@ struct World3::Impl {
     }
   }
 
+  // The wedge (docs/physics.md, "3-D: wedged spheres"): sphere i (at now) meets standing wall k
+  // along n (the unit normal towards it) while touching a standing wall on the other side, -n.
+  // If every other contact it has is across n or out of reach, the zero-time sequence of its
+  // bounces between the two never ends (a bounce at e > 0 leaves the pair's relative speed e
+  // times what it was, never 0, and 0 is the only speed along n that opens both), and its limit
+  // is the sphere's velocity without its part along n: taken, booked, logged `wedged`. Out of
+  // reach: in that sequence the sphere keeps w, its velocity across n, and |v . n| never grows, so
+  // a contact along m (from the sphere) with something of velocity u (a standing wall: 0; a
+  // sphere: its own, which nothing else changes in zero time) opens at least at (u - w) . m -
+  // |n . m| |v . n|: positive (beyond 1e-9 of the speeds), it never closes. Moving walls: not
+  // asked (the caller's test). False, and the bounce is served as usual, otherwise.
+  bool wedge(std::uint32_t i, Record& b, std::uint32_t k, Vec3 n) {
+    const double touch = 1e-9 * b.r;  // the overlap budget
+    const double a = dot(b.v, n);
+    const Vec3 w = b.v - a * n;
+    const double margin = 1e-9 * (norm(w) + std::abs(a));
+    constexpr double kParallel = 1e-9;
+    std::uint32_t other = kNone;
+    bool reach_ok = true;
+    // A contact along m (unit, from the sphere) with something moving at u; `standing`: a wall.
+    auto asks = [&](Vec3 m, Vec3 u, bool standing) {
+      const double c = dot(n, m);
+      if (std::abs(c) <= kParallel) return;  // across
+      if (std::abs(c) >= 1.0 - kParallel) {
+        // In line: a standing wall on either side is the pair's; a sphere in line is a row (2-D's
+        // jammed chain), not this rule.
+        if (!standing) reach_ok = false;
+        return;
+      }
+      if (!(dot(u - w, m) - std::abs(c) * std::abs(a) > margin)) reach_ok = false;
+    };
+    for (const std::uint32_t q : cell_walls[b.cell]) {
+      if (q == k) continue;
+      const Vec3 d = walls[q].nearest(b.x).point - b.x;
+      const double dist = norm(d);
+      if (!(dist > 0.0) || dist - b.r > touch) continue;
+      const Vec3 m = (1.0 / dist) * d;
+      if (dot(n, m) >= 1.0 - kParallel && other == kNone) other = q;  // on the far side
+      asks(m, Vec3{}, true);
+    }
+    if (other == kNone || !reach_ok) return false;
+    int c[3];
+    coords(b.cell, c);
+    for (int dz = -1; dz <= 1 && reach_ok; ++dz)
+      for (int dy = -1; dy <= 1 && reach_ok; ++dy)
+        for (int dx = -1; dx <= 1 && reach_ok; ++dx) {
+          int q[3] = {c[0] + dx, c[1] + dy, c[2] + dz};
+          Vec3 shift;
+          bool skip = false;
+          for (int ax = 0; ax < 3; ++ax) {
+            if (q[ax] >= 0 && q[ax] < n_cells(ax)) continue;
+            if (boundary != Boundary3::periodic) skip = true;
+            shift[ax] = q[ax] < 0 ? -size[ax] : size[ax];
+            q[ax] = (q[ax] + n_cells(ax)) % n_cells(ax);
+          }
+          if (skip) continue;
+          for (std::uint32_t j = head[cell_index(q[0], q[1], q[2])]; j != kNone; j = rec[j].next) {
+            if (j == i) continue;
+            const Record& o = rec[j];
+            const double dt = now - o.t;
+            const Vec3 d = pos_at(o, dt) + shift - b.x;
+            const double dist = norm(d);
+            if (!(dist > 0.0) || dist - (b.r + o.r) > touch) continue;
+            asks((1.0 / dist) * d, vel_at(o, dt), false);
+          }
+        }
+    if (!reach_ok) return false;
+    energy_wedged += 0.5 * b.m * a * a;
+    ++wedged;
+    b.v = w;
+    ++b.count;
+    note(Event3Kind::wedged, i, k, other);
+    predict(i);
+    return true;
+  }
+
   void cross(std::uint32_t i) {
     Record& b = rec[i];
     bring(b, now);
+    if (b.axis == 3) {  // a magnetic scene's horizon: predict again, no crossing
+      predict(i);
+      return;
+    }
     int k[3];
     coords(b.cell, k);
     const int a = b.axis, dir = b.dir;
@@ -618,11 +1003,13 @@ struct World3::Impl {
     }
     unlink(i);
     link(i, cell_index(k[0], k[1], k[2]));
-    predict_strip(i, a, dir);
+    if (!omega.empty()) predict(i);  // searches are bounded there: the whole neighbourhood again
+    else predict_strip(i, a, dir);
   }
 
   void serve_until(double t) {
     while (!queue.empty() && queue.top_key() <= t) {
+      if (events >= next_check) check_stop();
       const std::uint32_t i = queue.top_id();
       now = queue.top_key();
       serve(i);
@@ -630,12 +1017,18 @@ struct World3::Impl {
   }
 
   void advance_to(double t) {
-    // Step mode: the contacts of a step (up to and at its end), then the kick.
-    if (!field_a.empty())
-      while (step_end(steps + 1) <= t) {
-        serve_until(step_end(steps + 1));
-        kick(step_end(++steps));
-      }
+    // Step mode: the contacts of a step (up to and at its end), then the kick. A moving wall's
+    // key: the contacts up to and at it, then the walls' new courses and every sphere predicted
+    // again (by the kick, when a step ends at the same instant).
+    for (;;) {
+      const double step = field_a.empty() ? kNever : step_end(steps + 1);
+      const double stop = std::min(step, next_key);
+      if (!(stop <= t)) break;
+      serve_until(stop);
+      if (stop == next_key) take_keys(stop);
+      if (stop == step) kick(step_end(++steps));
+      else predict_all();
+    }
     serve_until(t);
     now = t;
   }
@@ -643,6 +1036,18 @@ struct World3::Impl {
   // The acceleration the fields give sphere i (step mode keeps it beside the straight flight).
   Vec3 accel(std::size_t i) const { return field_a.empty() ? rec[i].a : field_a[i]; }
 };
+
+void World3::set_event_limit(std::uint64_t limit) {
+  impl_->event_limit = limit;
+  impl_->arm_check();
+}
+void World3::set_stop_poll(std::function<bool()> poll, std::uint64_t every) {
+  impl_->stop_poll = std::move(poll);
+  impl_->poll_every = std::max<std::uint64_t>(1, every);
+  impl_->arm_check();
+}
+std::uint64_t World3::wedged() const { return impl_->wedged; }
+double World3::energy_wedged() const { return impl_->energy_wedged; }
 
 World3::World3(const World3Def& def) {
   const std::string problem = check_world3(def);
@@ -655,7 +1060,12 @@ World3& World3::operator=(World3&&) noexcept = default;
 
 void World3::advance_to(double t, std::vector<Event3>* log) {
   impl_->log = log;
-  impl_->advance_to(std::max(t, impl_->now));
+  try {
+    impl_->advance_to(std::max(t, impl_->now));
+  } catch (...) {
+    impl_->log = nullptr;
+    throw;
+  }
   impl_->log = nullptr;
 }
 double World3::time() const { return impl_->now; }
@@ -663,11 +1073,11 @@ std::size_t World3::sphere_count() const { return impl_->rec.size(); }
 bool World3::alive(std::size_t i) const { return impl_->rec[i].alive; }
 Vec3 World3::position(std::size_t i) const {
   const Record& b = impl_->rec[i];
-  return fly(b.x, b.v, b.a, impl_->now - b.t);
+  return impl_->pos_at(b, impl_->now - b.t);
 }
 Vec3 World3::velocity(std::size_t i) const {
   const Record& b = impl_->rec[i];
-  return b.v + (impl_->now - b.t) * b.a;
+  return impl_->vel_at(b, impl_->now - b.t);
 }
 std::size_t World3::wall_count() const { return impl_->walls.size(); }
 double World3::kinetic_energy() const {
@@ -693,6 +1103,8 @@ std::uint64_t World3::events() const { return impl_->events; }
 double World3::max_contact_error() const { return impl_->contact_error; }
 double World3::virial_sum() const { return impl_->virial; }
 double World3::wall_push(std::size_t w) const { return impl_->wall_push.at(w); }
+Vec3 World3::wall_shift(std::size_t w) const { return impl_->shift_of(static_cast<std::uint32_t>(w)); }
+double World3::wall_work() const { return impl_->wall_work; }
 double World3::wall_area(std::size_t w) const {
   const std::vector<Vec3>& c = impl_->walls.at(w).corners;
   Vec3 twice;  // Newell's: twice the area along the normal, for any planar polygon
@@ -715,7 +1127,8 @@ double World3::max_overlap_now() const {
       const double gap = m.rec[i].r + m.rec[j].r - norm(d);
       worst = std::max(worst, gap / std::min(m.rec[i].r, m.rec[j].r));
     }
-    for (const Polygon3& p : m.walls) worst = std::max(worst, (m.rec[i].r - p.distance(xi)) / m.rec[i].r);
+    for (std::uint32_t k = 0; k < m.walls.size(); ++k)
+      worst = std::max(worst, (m.rec[i].r - m.walls[k].distance(xi - m.shift_of(k))) / m.rec[i].r);
   }
   return worst;
 }

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "turtlegas/sim/stops.hpp"
 #include "turtlegas/sim/events.hpp"
 #include "turtlegas/sim/world_def.hpp"
 #include "turtlegas/sim/world_stats.hpp"
@@ -17,16 +18,6 @@ namespace turtlegas::sim {
 struct Ray;
 struct RayHit;
 struct EngineState;
-
-/// World::advance_to ran into the bound set with World::set_event_limit.
-struct EventLimitReached : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-/// World::advance_to was stopped because the poll set with World::set_stop_poll returned true.
-struct StopRequested : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 /// The momentum one collision of a ball exchanged, for observers of a gas (World::set_impulse_log):
 /// wall pressure is the impulse the walls received, the virial pressure the sum of r . dp.

@@ -1,14 +1,16 @@
 // SPDX-License-Identifier: MIT
 // The 3-D gas (docs/architecture.md, "The 3-D room"; docs/physics.md, "3-D"): spheres, convex
-// polygon walls with their faces, edges and corners, uniform gravity and electric fields, exact
-// and event-driven. The order of work of one event is written at the top of world3d.cpp.
+// polygon walls with their faces, edges and corners (standing or translating), uniform gravity,
+// electric and magnetic fields, exact and event-driven. The order of work of one event is written at the top of world3d.cpp.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "turtlegas/sim/stops.hpp"
 #include "turtlegas/sim/vec3.hpp"
 #include "turtlegas/sim/world_def.hpp"
 
@@ -30,10 +32,20 @@ struct Sphere3Def {
   double restitution = 1.0;
 };
 
+/// A moving wall's pose at a keyframe: its translation from its corners at t = 0.
+struct Wall3Key {
+  double t = 0.0;  ///< seconds, > 0, increasing along a wall's keys
+  Vec3 shift;      ///< world units: every corner at time t is its t = 0 corner plus shift
+};
+
 /// A convex planar polygon, corners in order (3 or more, not collinear).
 struct Wall3Def {
-  std::vector<Vec3> corners;
+  std::vector<Vec3> corners;  ///< at t = 0
   double restitution = 1.0;  ///< in [0, 1]; a contact takes this times the sphere's e
+  /// A translating wall (docs/physics.md, "3-D: moving walls"): between two keys (and from t = 0
+  /// and no shift to the first) it moves at constant velocity; after the last it stays. Empty:
+  /// it stands. Not in a periodic arena.
+  std::vector<Wall3Key> keys = {};
 };
 
 struct World3Def {
@@ -41,6 +53,9 @@ struct World3Def {
   Boundary3 boundary = Boundary3::none;
   Vec3 gravity;   ///< units / s^2, on every sphere
   Vec3 electric;  ///< acceleration charge / mass * electric on each sphere
+  /// Uniform B, any direction: a sphere of charge q and mass m feels dv/dt = (q/m) v x B, and flies
+  /// a helix (docs/physics.md, "3-D: magnetic fields"). Exact mode only.
+  Vec3 magnetic;
   double cell = 0.0;  ///< the grid's smallest cell side; 0: the largest diameter (times 1 + 2^-20)
   /// Inelastic-collapse threshold t_c in seconds (2-D's effects.tc, docs/physics.md "3-D:
   /// restitution"): used only when some e < 1. A pair one of whose spheres changed course less
@@ -63,6 +78,10 @@ enum class Event3Kind : std::uint8_t {
   ball_wall_edge,    ///< a sphere, b wall index, c the edge (from corner c to corner c + 1)
   ball_wall_corner,  ///< a sphere, b wall index, c the corner
   exit,              ///< a left an open arena
+  /// a sphere touching two standing walls on opposite sides lost its velocity between them (the
+  /// limit of its zero-time bounces, docs/physics.md "3-D: wedged spheres"): b the wall it met,
+  /// c the wall on the other side
+  wedged,
 };
 
 struct Event3 {
@@ -88,8 +107,15 @@ class World3 {
   World3(World3&&) noexcept;
   World3& operator=(World3&&) noexcept;
 
-  /// Serves every event up to time t (seconds, >= time()); appends them to log if given.
+  /// Serves every event up to time t (seconds, >= time()); appends them to log if given. Throws
+  /// EventLimitReached or StopRequested (below) with the world consistent at its last event
+  /// (time() says when), which the run cannot go on from.
   void advance_to(double t, std::vector<Event3>* log = nullptr);
+  /// A bound on the events served (events(), from construction), as World::set_event_limit.
+  void set_event_limit(std::uint64_t limit);
+  /// `poll` is called after every `every` events served; when it returns true advance_to throws
+  /// StopRequested (a signal, a wall clock: the caller's). nullptr removes it.
+  void set_stop_poll(std::function<bool()> poll, std::uint64_t every = 4096);
   double time() const;
 
   std::size_t sphere_count() const;  ///< including removed ones
@@ -117,6 +143,16 @@ class World3 {
   /// over wall_area(w) is the pressure on the wall (docs/observables.md).
   double wall_push(std::size_t w) const;
   double wall_area(std::size_t w) const;  ///< the polygon's area
+  /// The wedge rule's count and the kinetic energy it took (docs/physics.md, "3-D: wedged
+  /// spheres"): 0 unless a sphere touched two standing walls on opposite sides at once.
+  std::uint64_t wedged() const;
+  double energy_wedged() const;
+  /// The translation of wall w from its t = 0 corners, at time(); zero for a standing wall.
+  Vec3 wall_shift(std::size_t w) const;
+  /// The kinetic energy moving walls have given the spheres since the start (negative: taken),
+  /// booked at each bounce off a moving wall as m/2 (|v'|^2 - |v|^2). With every e = 1,
+  /// energy() - its start equals it to round-off (docs/physics.md, "3-D: moving walls").
+  double wall_work() const;
 
  private:
   struct Impl;
