@@ -28,7 +28,7 @@ struct DiscView {
 
 /// The buffers of the overlap measure, kept between measures so that a run measuring at many
 /// instants allocates once: the live discs bucketed by cell (32 bytes a disc) and the buckets'
-/// ends (4 bytes for each of at most 2 x live buckets).
+/// ends (4 bytes for each of at most 2 x bodies buckets).
 struct OverlapScratch {
   struct Disc {
     Vec2 at;
@@ -115,13 +115,12 @@ Overlap deepest_overlap(OverlapScratch& s, std::size_t n, Pos&& pos, Radius&& ra
     worst.depth = std::max(worst.depth, depth);
     worst.relative = std::max(worst.relative, depth / r);
   };
-  std::uint32_t live = 0;
-  for (std::size_t i = 0; i < n; ++i) live += alive(i) ? 1u : 0u;
-  if (live == 0) return worst;
-  // The buckets: about one per live disc, a power of two.
-  const std::size_t buckets = std::bit_ceil(std::max<std::size_t>(live, 2));
-  s.disc.resize(live);
+  if (n == 0) return worst;
+  // The buckets: about one per disc, a power of two (sized by all the bodies, so that the live
+  // ones need not be counted in a pass of their own: each pass reads every body's record).
+  const std::size_t buckets = std::bit_ceil(std::max<std::size_t>(n, 2));
   s.end.assign(buckets, 0);
+  std::uint32_t live = 0;
   Cells c;
   c.width = periodic_width;
   c.height = periodic_height;
@@ -155,8 +154,10 @@ Overlap deepest_overlap(OverlapScratch& s, std::size_t n, Pos&& pos, Radius&& ra
     }
     shape(cell);
     rmax = 0.0;
+    live = 0;
     for (std::size_t i = 0; i < n; ++i) {
       if (!alive(i)) continue;
+      ++live;
       rmax = std::max(rmax, radius(i));
       const auto [cx, cy] = c.of(pos(i));
       ++s.end[c.bucket(cx, cy)];
@@ -168,6 +169,7 @@ Overlap deepest_overlap(OverlapScratch& s, std::size_t n, Pos&& pos, Radius&& ra
     std::fill(s.end.begin(), s.end.end(), 0u);
   }
   s.cell = c.cell;
+  s.disc.resize(live);
   // Pass 2: the discs in bucket order (end[k] ends up at the end of bucket k).
   std::uint32_t sum = 0;
   for (std::uint32_t& e : s.end) {
