@@ -55,18 +55,40 @@ struct RunTotals {
   std::uint64_t faults = 0;
 };
 
-/// How many times a run measures the deepest overlap when --overlap-samples does not say: at every
-/// control step of the run, but at most 1000 times, and fewer for large scenes (at least 16), so
-/// that measuring (about bodies x (log2 bodies + 1 + walls) operations each time, some 70 ns
-/// each) stays near 4e6 operations, about 0.3 s, in all.
-std::uint64_t overlap_samples(double until, double dt, std::size_t bodies, std::size_t walls) {
-  const double n = static_cast<double>(std::max<std::size_t>(bodies, 1));
-  const double per_sample = n * (std::log2(n) + 1.0 + static_cast<double>(walls));
+/// The instants at which a run may measure the deepest overlap when --overlap-samples does not say:
+/// every control step of the run, at most 1000 of them. Which of them are measured is the
+/// SampleBudget's to say.
+std::uint64_t overlap_instants(double until, double dt) {
   const double steps = dt > 0.0 ? std::ceil(until / dt) : 1000.0;
-  const double by_cost = std::max(16.0, std::floor(4e6 / per_sample));
-  const double k = std::min({steps, 1000.0, by_cost});
+  const double k = std::min(steps, 1000.0);
   return k >= 1.0 ? static_cast<std::uint64_t>(k) : 1;
 }
+
+/// Which of the default instants the self-check measures, so that it costs a bounded share of the
+/// run (docs/cli.md, "The overlap self-check"): a measure costs about `cost` body-measures (each
+/// body against its neighbours and the walls: bodies x (1 + walls/8)), and one is taken at an
+/// instant only if the run has served kEventsPer events per body-measure taken so far, this one
+/// included, beyond a small allowance (kAllowance body-measures, well under a millisecond) that
+/// lets a small scene be measured at every instant. Counted in events, not in wall time, so that
+/// the same run measures at the same instants every time: its stats are reproducible.
+struct SampleBudget {
+  /// A body-measure (~30-100 ns) against an event (~150-500 ns at N = 10^4 to 10^6): one per 4
+  /// events keeps the measures near 5 % of the run (docs/performance.md, "What `--stats` costs").
+  static constexpr std::uint64_t kEventsPer = 4;
+  static constexpr std::uint64_t kAllowance = 4096;
+  std::uint64_t cost = 0;
+  bool unlimited = false;  ///< --overlap-samples given: every instant asked for is measured
+  std::uint64_t taken = 0;
+
+  SampleBudget(std::size_t bodies, std::size_t walls, bool every)
+      : cost(std::max<std::uint64_t>(1, bodies + bodies * walls / 8)), unlimited(every) {}
+  /// Whether to measure at an instant `events` events into the run; counts it if so.
+  bool take(std::uint64_t events) {
+    if (!unlimited && (taken + 1) * cost > kAllowance + events / kEventsPer) return false;
+    ++taken;
+    return true;
+  }
+};
 
 /// The --stats summary on stdout.
 void print_summary(const formats::RunFigures& run, const sim::World& world, const world::Scene& scene,
@@ -236,8 +258,8 @@ CLI::App* add_run_command(CLI::App& app, RunCommandLine& line, std::vector<std::
       ->check(real_in(0, big, "distance", true));
   run->add_option("--overlap-samples", opt.overlap_samples,
                   "With --stats or --stats-json: measure the deepest overlap at this many evenly spaced instants "
-                  "besides every contact and the end (0: none; default: every control step, at most 1000, fewer "
-                  "for large scenes)")
+                  "besides every contact and the end (0: none; default: at the control steps, at most 1000, as "
+                  "many as keep the measures near 5 % of the run: docs/cli.md)")
       ->check(integer_in(0, 1000000000, "samples"));
   run->add_option("--record", opt.record,
                   "Write a recording here (docs/recording.md; play it with `turtlegas replay`, draw it with `render`)");
@@ -350,11 +372,13 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   // The deepest overlap is measured at evenly spaced instants of the run (overlap_samples), not
   // only at contacts and at its end: an overlap the engine does not see (a body sinking without
   // an event, a wall that appears through it) shows in --stats all the same.
-  const std::uint64_t samples = !(opt.stats || !opt.stats_json.empty()) ? 0
-                                : opt.overlap_samples ? *opt.overlap_samples
-                                                      : overlap_samples(opt.until, def.dt, def.balls.size() + def.turtles.size(),
-                                                                        def.walls.size());
-  if (samples > 0 && opt.until > 0.0) limits.sample_every = opt.until / static_cast<double>(samples);
+  const std::uint64_t instants = !(opt.stats || !opt.stats_json.empty()) ? 0
+                                 : opt.overlap_samples                     ? *opt.overlap_samples
+                                                                           : overlap_instants(opt.until, def.dt);
+  if (instants > 0 && opt.until > 0.0) limits.sample_every = opt.until / static_cast<double>(instants);
+  const std::size_t arena_walls = def.arena.boundary == sim::Boundary::walls ? 4 : 0;
+  SampleBudget budget(def.balls.size() + def.turtles.size(), def.walls.size() + arena_walls,
+                      opt.overlap_samples.has_value());
   sim::Overlap sampled;
   double check_seconds = 0.0;  // in the samples of `sampled`: left out of the collisions per second
   std::optional<formats::RecordingWriter> recorder;
@@ -602,6 +626,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   if (recorder) recorder->keyframe(world, current_names());  // the first, at the start
   if (end.first == Stop::until) try {
     limits.until = opt.until;
+    const std::uint64_t events_at_start = world.stats().events;
     end = run_in_chunks(world.time(), world.stats().events, limits, pace, start, progress, "", advance, [&] { flush(true); },
                         [&](double t, const std::string& why) {
                           // A checkpoint that cannot be written (a full disk) stops the checkpoints,
@@ -617,7 +642,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
                         },
                         [&](double, std::uint64_t events, bool at_key, bool at_sample) {
                           if (recorder && (at_key || recorder->keyframe_due(events))) recorder->keyframe(world, current_names());
-                          if (at_sample) {
+                          if (at_sample && budget.take(events - events_at_start)) {
                             const auto check_start = Clock::now();
                             const sim::Overlap o = world.measure_overlap();
                             check_seconds += seconds_since(check_start);
@@ -661,7 +686,7 @@ int run_command(const RunOptions& opt, const turtle::Registry& registry) {
   run.wall_seconds = seconds_since(start);
   run.check_seconds = check_seconds;
   run.energy_start = totals.energy_start;
-  run.overlap_samples = samples;
+  run.overlap_samples = budget.taken;
   if (resume) {
     run.resumed = restored ? "state" : "replay";
     run.resumed_t = resume->t;

@@ -162,7 +162,15 @@ Stopped run_in_chunks(double from, std::uint64_t events, const Limits& limits, P
   const double key_every = limits.keyframe_every.value_or(0.0);
   double next_key = next_multiple(t, key_every);
   const double sample_every = limits.sample_every.value_or(0.0);
-  double next_sample = next_multiple(t, sample_every);
+  // The samples are at k x sample_every, k counted: finding k again from t (floor(t / every) + 1)
+  // rounds to the instant just measured for some k, which then was measured twice, an ulp apart.
+  double sample_k = sample_every > 0.0 ? std::floor(t / sample_every) + 1.0 : 0.0;
+  auto next_sample_after = [&](double at) {
+    if (!(sample_every > 0.0)) return static_cast<double>(INFINITY);
+    while (!(sample_k * sample_every > at)) sample_k += 1.0;
+    return sample_k * sample_every;
+  };
+  double next_sample = next_sample_after(t);
   while (t < limits.until) {
     if (const int sig = stop_signal()) return {Stop::signal, sig};
     if (limits.max_wall_seconds && seconds_since(start) >= *limits.max_wall_seconds) return {Stop::max_wall_seconds, 0};
@@ -195,7 +203,7 @@ Stopped run_in_chunks(double from, std::uint64_t events, const Limits& limits, P
     const bool at_key = t >= next_key;
     if (at_key) next_key = next_multiple(t, key_every);
     const bool at_sample = t >= next_sample;
-    if (at_sample) next_sample = next_multiple(t, sample_every);
+    if (at_sample) next_sample = next_sample_after(t);
     cut(t, events, at_key, at_sample);
     note_run_time(t);
     if (t >= next_checkpoint) {

@@ -658,6 +658,34 @@ TEST_CASE("robust: --stats measures the overlap over the run, not only at contac
   CHECK(json::parse(read(out)).at("max_overlap_relative").get<double>() == 0.0);
 }
 
+TEST_CASE("robust: --stats' default samples are budgeted by events, the same on every run (issue 31)") {
+  // A gas of 20000 discs for 1 s: 30 control steps, but measuring 20000 bodies at each would cost
+  // more than the run. The default measures only as often as the run's events pay for (one
+  // body-measure per 4 events), counted in events so that two runs measure at the same instants;
+  // --overlap-samples N measures at all N.
+  TempDir dir;
+  const fs::path w = dir.write("gas.json", R"({"format": "turtlegas-world/1", "seed": 5,
+    "arena": {"width": 1000, "height": 1000, "boundary": "walls"},
+    "gas": [{"count": 20000, "radius": 0.8, "speed": 40, "region": [[2, 2], [998, 998]]}]})");
+  const fs::path out = dir.path / "stats.json";
+  std::vector<std::uint64_t> taken;
+  for (int k = 0; k < 2; ++k) {
+    const Result r = run(dir, {"run", w.string(), "--until", "1", "--stats-json", out.string()});
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    const json st = json::parse(read(out));
+    taken.push_back(st.at("overlap_samples").get<std::uint64_t>());
+    // At most one measure of the 30000 body-measures (20000 x (1 + 4/8)) per 120000 events.
+    CHECK(taken.back() * 30000 <= 4096 + st.at("events").get<std::uint64_t>() / 4);
+  }
+  CHECK(taken[0] >= 1);
+  CHECK(taken[0] < 30);
+  CHECK(taken[0] == taken[1]);
+  const Result all = run(dir, {"run", w.string(), "--until", "1", "--stats-json", out.string(), "--overlap-samples", "30"});
+  REQUIRE(all.code == 0);
+  CHECK(json::parse(read(out)).at("overlap_samples").get<std::uint64_t>() == 30);
+}
+
 TEST_CASE("robust: serve refuses an output that is its world file, or a directory, with exit 2") {
   // serve --events / --inputs-out / --record checked only against each other: `serve w.json --record
   // w.json` overwrote the world file with a recording. Refused before anything is served.

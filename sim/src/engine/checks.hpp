@@ -37,9 +37,9 @@ double energy(const Look<F, kExtras>& l, const Field& field) {
 }
 
 /// The deepest overlap now among the pairs that can touch (deepest_overlap, with the walls where
-/// they are now).
+/// they are now). `scratch` keeps its buffers from one measure to the next.
 template <bool kBallBall, Flight F, bool kExtras>
-Overlap measure_overlap(const Look<F, kExtras>& l, const Arena& arena) {
+Overlap measure_overlap(const Look<F, kExtras>& l, const Arena& arena, OverlapScratch& scratch) {
   // Read in place: no copy of the bodies (a million of them would add ~40 bytes a ball to the peak).
   const BodyStore& s = l.bodies;
   const std::size_t n = s.size();
@@ -47,7 +47,6 @@ Overlap measure_overlap(const Look<F, kExtras>& l, const Arena& arena) {
   auto pos = [&](std::size_t i) { return l.motion.pos(s.body[i], static_cast<std::uint32_t>(i), l.now - s.body[i].t); };
   auto rad = [&](std::size_t i) { return s.body[i].r; };
   auto alive = [&](std::size_t i) { return s.body[i].cell != kNone; };
-  const DiscView discs{n, pos, rad, alive};
   const bool periodic = arena.periodic();
   std::vector<Segment> walls_now = l.walls.segments;
   for (const Mover& m : l.schedule.movers) walls_now[m.wall] = m.segment_at(l.walls.segments[m.wall], l.now);
@@ -56,8 +55,8 @@ Overlap measure_overlap(const Look<F, kExtras>& l, const Arena& arena) {
   if (!kBallBall && nb > 0) {
     // Balls pass through each other by request: measure walls for everyone, and pairs among the
     // turtles and between turtles and balls.
-    Overlap worst = deepest_overlap(discs, walls_now, periodic ? arena.width : 0.0, periodic ? arena.height : 0.0, false,
-                                    body_layers, wall_layers);
+    Overlap worst = deepest_overlap(scratch, n, pos, rad, alive, walls_now, periodic ? arena.width : 0.0,
+                                    periodic ? arena.height : 0.0, false, body_layers, wall_layers);
     for (std::uint32_t t = nb; t < n; ++t) {
       if (!alive(t)) continue;
       for (std::uint32_t j = 0; j < n; ++j) {
@@ -69,8 +68,8 @@ Overlap measure_overlap(const Look<F, kExtras>& l, const Arena& arena) {
     }
     return worst;
   }
-  return deepest_overlap(discs, walls_now, periodic ? arena.width : 0.0, periodic ? arena.height : 0.0, true,
-                         body_layers, wall_layers);
+  return deepest_overlap(scratch, n, pos, rad, alive, walls_now, periodic ? arena.width : 0.0,
+                         periodic ? arena.height : 0.0, true, body_layers, wall_layers, arena.width);
 }
 
 }  // namespace

@@ -197,7 +197,9 @@ class Engine final : public EngineBase {
   }
   const Stats& stats() const override { return record_.stats; }
   const std::vector<double>& energy_taken() const override { return record_.taken; }
-  Overlap measure_overlap() const override { return detail::measure_overlap<kBallBall>(look(), arena_); }
+  Overlap measure_overlap() const override {
+    return detail::measure_overlap<kBallBall>(look(), arena_, overlap_scratch_);
+  }
   Overlap max_contact_overlap() const override { return record_.max_contact; }
   double cell_size() const override { return std::min(grid_.cell_w(), grid_.cell_h()); }
   int cells_x() const override { return grid_.nx(); }
@@ -387,6 +389,9 @@ class Engine final : public EngineBase {
   } rows_seen_;
 
   EventRecord record_;
+  /// The overlap measure's buffers (measure_overlap), kept so that a run measuring at many instants
+  /// allocates once; a measure writes them, so it is no more for concurrent use than the rest.
+  mutable OverlapScratch overlap_scratch_;
 };
 
 template <Flight F, bool kBallBall, bool kStep, bool kExtras>
