@@ -7,7 +7,7 @@
 #
 #   bash bench/enki_ir.sh BUILD_DIR "100 1000 10000" [PAIRS: 3] [STEPS: 300 for N <= 1000, else 30]
 #   env: CORE (default 1), RAYS (turtlegas ring, default 8), ENKI_SENSORS (ir|none|default; default ir),
-#        TG_SENSE (on|off, default on), OUT (enki_epuck's build dir, default /tmp/enki-ir-build)
+#        TG_SENSE (on|off|read, default on), OUT (enki_epuck's build dir, default /tmp/enki-ir-build)
 set -euo pipefail
 HERE="$(cd "$(dirname "$0")" && pwd)"
 TG="$(cd "${1:?usage: enki_ir.sh BUILD_DIR \"N...\" [PAIRS] [STEPS]}" && pwd)"

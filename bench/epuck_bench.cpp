@@ -4,10 +4,12 @@
 // rays reaching 12 units beyond its rim and running epuck_swarm (controllers/epuck_swarm.cpp): read
 // the ring, set the wheels for one control step (dt 0.1 s), every step. bench/enki_ir/enki_epuck.cpp
 // is the same scene in Enki; bench/enki_ir.sh runs the two side by side.
+// --sense off drives the same loop blind, --sense read reads the ring each step and drives blind
+// all the same (read - off: what the reading costs, on the same motion).
 // Prints one JSON line: turtle-steps per CPU second of the scheduler thread over the timed steps
 // (the first step, which starts every program, is left out), contacts, rays cast.
 //
-//   epuck_bench [--turtles N] [--steps S] [--rays K] [--sense on|off] [--mode exact|step]
+//   epuck_bench [--turtles N] [--steps S] [--rays K] [--sense on|off|read] [--mode exact|step]
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -30,16 +32,16 @@ constexpr double kRadius = 3.7, kSpeed = 12.8, kAxle = 5.1, kReach = 12.0, kPitc
 
 int run(int argc, char** argv) {
   int turtles = 1000, steps = 300, rays = 8;
-  bool sense = true;
+  std::string sense = "on";
   sim::Mode mode = sim::Mode::exact;
-  const bench::Usage usage("epuck_bench [--turtles N] [--steps S] [--rays K] [--sense on|off] [--mode exact|step]");
+  const bench::Usage usage("epuck_bench [--turtles N] [--steps S] [--rays K] [--sense on|off|read] [--mode exact|step]");
   const bool go = bench::for_each_option(argc, argv, usage, [&](const std::string& a, const std::string& v) {
     if (a == "--turtles") turtles = static_cast<int>(usage.whole(a, v, 1, 10000000));
     else if (a == "--steps") steps = static_cast<int>(usage.whole(a, v, 1, 100000000));
     else if (a == "--rays") rays = static_cast<int>(usage.whole(a, v, 1, 360));
     else if (a == "--sense") {
-      if (v != "on" && v != "off") usage.error("--sense takes on or off, not " + v);
-      sense = v == "on";
+      if (v != "on" && v != "off" && v != "read") usage.error("--sense takes on, off or read, not " + v);
+      sense = v;
     } else if (a == "--mode") mode = bench::mode_option(usage, v);
     else usage.error("unknown option " + a);
   });
@@ -68,7 +70,7 @@ int run(int argc, char** argv) {
     def.turtles.push_back(t);
     turtle::TurtleProgram p;
     p.controller = "epuck_swarm";
-    p.params = {{"reach", kReach}, {"sense", sense ? 1.0 : 0.0}};
+    p.params = {{"reach", kReach}, {"sense", sense == "on" ? 1.0 : sense == "off" ? 0.0 : 2.0}};
     p.senses = {ring};
     p.axle = kAxle;
     programs.push_back(p);

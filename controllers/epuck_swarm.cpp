@@ -19,15 +19,17 @@ namespace turtlegas::controllers {
 void epuck_swarm(turtle::Turtle& t, const turtle::Params& p) {
   const auto sensor = p.get<std::string>("sensor");
   const double gain = p.get<double>("gain");
-  // "sense": 0 drives blind (the same loop with every ray reading nothing): what sensing costs.
-  const bool sense = p.get<double>("sense") != 0.0;
+  // "sense": 0 drives blind (the same loop with every ray reading nothing); 2 reads the ring and
+  // drives blind all the same: the motion of 0 and the reading of 1, so 2 - 0 is what sensing costs.
+  const double mode = p.get<double>("sense");
+  const bool sense = mode == 1.0, read = mode != 0.0;
   const double v = t.speed();
   const double reach = p.get<double>("reach");
   std::vector<turtle::Reading> ring;
   for (;;) {
     double left = 0.0, right = 0.0, front = 0.0;
+    if (read) t.scan(sensor, ring);
     if (sense) {
-      t.scan(sensor, ring);
       for (const turtle::Reading& r : ring) {
         const double b = std::remainder(r.bearing, 360.0);  // (-180, 180]: negative on the left
         const double near = std::clamp(1.0 - (r.distance - t.radius()) / reach, 0.0, 1.0);
@@ -55,7 +57,7 @@ turtle::ControllerInfo epuck_swarm_info() {
       turtle::string_param("sensor", "ir", {}, "the range sensor to steer by: a ring (the turtle's \"senses\")"),
       turtle::number_param("gain", 1.0, 0, inf, "how much a side's proximity (0 at the range, 1 at the rim) slows the wheel on that side"),
       turtle::number_param("reach", 12.0, 1e-9, inf, "units beyond the rim where proximity falls to 0 (the ring's range less the radius)"),
-      turtle::number_param("sense", 1.0, 0, 1, "1 reads the ring each step; 0 drives blind (what sensing costs)")};
+      turtle::number_param("sense", 1.0, 0, 2, "1 reads the ring each step; 0 drives blind; 2 reads it and drives blind (2 - 0: what sensing costs)")};
   info.restartable = true;  // it reads its Turtle and Params only
   return info;
 }
