@@ -24,6 +24,8 @@ void tag_seeing(turtle::Turtle&, const turtle::Params&);
 turtle::ControllerInfo tag_seeing_info();
 void braitenberg(turtle::Turtle&, const turtle::Params&);
 turtle::ControllerInfo braitenberg_info();
+void epuck_swarm(turtle::Turtle&, const turtle::Params&);
+turtle::ControllerInfo epuck_swarm_info();
 
 turtle::Registry builtin_registry() {
   turtle::Registry r = turtle::base_registry();
@@ -37,6 +39,7 @@ turtle::Registry builtin_registry() {
   r.add("tag_camera", tag_camera, tag_camera_info());
   r.add("tag_seeing", tag_seeing, tag_seeing_info());
   r.add("braitenberg", braitenberg, braitenberg_info());
+  r.add("epuck_swarm", epuck_swarm, epuck_swarm_info());
   return r;
 }
 

@@ -84,6 +84,9 @@ json WorldHost::world_json() const {
           {"balls", server_->world().ball_count()},
           {"walls", server_->world().walls().size()},
           {"turtles", turtles},
+          // The world file's "colour" keys, by body id, as "#rrggbb" (what cameras see; the viewer
+          // draws those bodies in them). Bodies without one are not listed.
+          {"colours", server_->colours().by_id},
           {"views", views_json(*server_)}};
 }
 

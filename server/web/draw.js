@@ -15,6 +15,8 @@ const FLASH_MS = 400;
 export const TURTLE_COLOURS = ['#4e79a7', '#f28e2b', '#e15759', '#76b7b2', '#59a14f', '#edc948', '#b07aa1', '#ff9da7',
                                '#9c755f', '#bab0ac'];
 export const turtleColour = (i) => TURTLE_COLOURS[i % TURTLE_COLOURS.length];
+// A body's colour from the world file's "colour" key (the world message's `colours`, by id), if any.
+const worldColour = (id) => (S.world && S.world.colours && S.world.colours[id]) || null;
 
 function bucketColour(k) {
   // A blue-green-yellow-red ramp.
@@ -65,7 +67,7 @@ export function drawPanel(p, now) {
     for (const w of S.walls) {
       const pose = wallPose(w, S.t);
       const passes = followed && !((w.cat & followed.mask) && (followed.cat & w.mask));
-      ctx.strokeStyle = COLOURS.wall;
+      ctx.strokeStyle = worldColour(w.id) || COLOURS.wall;
       ctx.globalAlpha = pose.present ? 1 : 0.35;
       ctx.lineWidth = 2.5 * px;
       ctx.setLineDash(passes || !pose.present ? [6 * px, 5 * px] : []);
@@ -100,7 +102,7 @@ export function drawPanel(p, now) {
     for (const [i, t] of S.turtles.entries()) {
       if (t.gone) continue;  // crushed, out of the arena or removed: no longer in the world
       if (t.x + t.radius < x0 || t.x - t.radius > x1 || t.y + t.radius < y0 || t.y - t.radius > y1) continue;
-      ctx.fillStyle = turtleColour(i);
+      ctx.fillStyle = worldColour(t.id) || turtleColour(i);
       ctx.beginPath();
       ctx.arc(t.x, t.y, t.radius, 0, 2 * Math.PI);
       ctx.fill();
@@ -208,6 +210,19 @@ function drawBalls(ctx, px, x0, x1, y0, y1) {
         ctx.arc(x, y, r, 0, 2 * Math.PI);
       }
     }
+    ctx.fill();
+  }
+  // Balls with a colour of their own in the world file: drawn over their speed's colour in it.
+  const colours = S.world && S.world.colours;
+  if (!colours) return;
+  for (let i = 0; i < b.n; i++) {
+    const c = colours[b.ids[i]];
+    if (!c) continue;
+    const x = pos[2 * i], y = pos[2 * i + 1], r = Math.max(rad[i], 0.75 * px);
+    if (!(x + r >= x0 && x - r <= x1 && y + r >= y0 && y - r <= y1)) continue;
+    ctx.fillStyle = c;
+    ctx.beginPath();
+    ctx.arc(x, y, r, 0, 2 * Math.PI);
     ctx.fill();
   }
 }

@@ -59,6 +59,10 @@ void World::teleport_turtle(std::size_t i, Vec2 pos, double heading) {
   impl_->engine->teleport_turtle(i, pos, heading);
 }
 RayHit World::cast_ray(const Ray& ray) const { return impl_->engine->cast_ray(ray); }
+void World::cast_rays(const Ray& ray, const Vec2* dirs, std::size_t n, std::vector<RayHit>& out) const {
+  out.resize(n);
+  impl_->engine->cast_rays(ray, dirs, n, out.data());
+}
 void World::balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const {
   impl_->engine->balls_in_rect(lo, hi, out);
 }

@@ -38,7 +38,7 @@ TEST_CASE("turtlegas tag prints a ranking and writes it as JSON, the same every 
 
   const Result bad = run(dir, {"tag", "worlds/tag.json", "--controllers", "tag_chaser,wandr"});
   CHECK(bad.code == 2);
-  CHECK(bad.err.find("--controllers: controller 'wandr' is not registered; known: braitenberg, mirror, script, ") != std::string::npos);
+  CHECK(bad.err.find("--controllers: controller 'wandr' is not registered; known: braitenberg, epuck_swarm, mirror, script, ") != std::string::npos);
   CHECK(bad.err.find("wander; did you mean 'wander'?") != std::string::npos);
   const Result missing = run(dir, {"tag", "worlds/nope.json", "--controllers", "tag_chaser"});
   CHECK(missing.code == 2);

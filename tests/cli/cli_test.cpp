@@ -391,7 +391,7 @@ TEST_CASE("cli: turtle input errors exit with 2 and say why") {
       const Result r = command == std::string("run") ? run(dir, {"run", w.string(), "--until", "1"})
                                                      : run(dir, {"check", w.string()});
       CHECK(r.code == 2);
-      CHECK(contains(r.err, w.string() + ": /turtles/1/controller: controller 'wandr' is not registered; known: braitenberg, mirror, script, "
+      CHECK(contains(r.err, w.string() + ": /turtles/1/controller: controller 'wandr' is not registered; known: braitenberg, epuck_swarm, mirror, script, "
                                          "spiral, square, tag_camera, tag_chaser, tag_evader, tag_random, tag_seeing, wall_follower, wander; "
                                          "did you mean 'wander'?"));
     }

@@ -276,38 +276,48 @@ TEST_CASE("cast_ray through a periodic arena's seams", "[rays]") {
   CHECK_THROWS_AS(w.cast_ray(Ray{{150, 100}, {0, -1}}), std::invalid_argument);  // infinite in a periodic arena
 }
 
+/// The scene of the random-ray cases: a gas of 500 discs, four inner walls with ends of their own,
+/// two turtles (one invisible to turtles), a moving wall unless periodic.
+WorldDef ray_scene(sim::Boundary boundary, std::uint64_t seed) {
+  WorldDef def = random_gas(500, 0.12, 3.0, 60.0, seed, boundary);
+  const double W = def.arena.width, H = def.arena.height;
+  std::mt19937_64 rng(seed);
+  auto uni = [&](double a, double b) { return a + (b - a) * (static_cast<double>(rng() >> 11) * 0x1.0p-53); };
+  // Some balls taken out to make room for walls and turtles; walls with ends of their own.
+  for (int k = 0; k < 4; ++k) {
+    const double y = (0.2 + 0.2 * k) * H;
+    def.walls.push_back({"iw" + std::to_string(k), {0.3 * W + 7 * k, y}, {0.6 * W, y + 0.05 * H}});
+  }
+  def.turtles.push_back(turtle("ta", {0.5 * W, 0.5 * H}, 30, 8));
+  def.turtles.push_back(turtle("tb", {0.25 * W, 0.7 * H}, 200, 8));
+  def.turtles.back().layers = {2, 1u};  // sees walls and balls only: invisible to turtles
+  if (boundary != sim::Boundary::periodic)
+    def.walls.push_back(moving("mover", {0.1 * W, 0.9 * H}, {0.2 * W, 0.95 * H}, {{5.0, {0.1 * W, 0.8 * H}, {0.25 * W, 0.9 * H}}}));
+  std::erase_if(def.balls, [&](const BallDef& b) {
+    for (const auto& t : def.turtles)
+      if (sim::norm(b.pos - t.pos) < b.radius + t.radius + 2) return true;
+    for (const auto& wd : def.walls) {
+      const sim::Segment s = sim::make_segment(wd.from, wd.to);
+      const Vec2 rel = b.pos - s.p1;
+      const double foot = std::clamp(sim::dot(rel, s.u), 0.0, s.len);
+      if (sim::norm(rel - foot * s.u) < b.radius + 2) return true;
+    }
+    return false;
+  });
+  for (auto& b : def.balls) b.vel = 0.2 * b.vel;  // keep the mover clear for the run
+  return def;
+}
+
 TEST_CASE("cast_ray equals the brute-force reference on random rays", "[rays]") {
   for (sim::Boundary boundary : {sim::Boundary::walls, sim::Boundary::periodic, sim::Boundary::none}) {
     for (sim::Mode mode : {sim::Mode::exact, sim::Mode::step}) {
       const std::uint64_t seed = 31 + static_cast<int>(boundary) * 10 + (mode == sim::Mode::step);
       INFO("boundary " << static_cast<int>(boundary) << ", mode " << (mode == sim::Mode::step ? "step" : "exact")
                        << ", seed " << seed);
-      WorldDef def = random_gas(500, 0.12, 3.0, 60.0, seed, boundary);
+      const WorldDef def = ray_scene(boundary, seed);
       const double W = def.arena.width, H = def.arena.height;
       std::mt19937_64 rng(seed);
       auto uni = [&](double a, double b) { return a + (b - a) * (static_cast<double>(rng() >> 11) * 0x1.0p-53); };
-      // Some balls taken out to make room for walls and turtles; walls with ends of their own.
-      for (int k = 0; k < 4; ++k) {
-        const double y = (0.2 + 0.2 * k) * H;
-        def.walls.push_back({"iw" + std::to_string(k), {0.3 * W + 7 * k, y}, {0.6 * W, y + 0.05 * H}});
-      }
-      def.turtles.push_back(turtle("ta", {0.5 * W, 0.5 * H}, 30, 8));
-      def.turtles.push_back(turtle("tb", {0.25 * W, 0.7 * H}, 200, 8));
-      def.turtles.back().layers = {2, 1u};  // sees walls and balls only: invisible to turtles
-      if (boundary != sim::Boundary::periodic)
-        def.walls.push_back(moving("mover", {0.1 * W, 0.9 * H}, {0.2 * W, 0.95 * H}, {{5.0, {0.1 * W, 0.8 * H}, {0.25 * W, 0.9 * H}}}));
-      std::erase_if(def.balls, [&](const BallDef& b) {
-        for (const auto& t : def.turtles)
-          if (sim::norm(b.pos - t.pos) < b.radius + t.radius + 2) return true;
-        for (const auto& wd : def.walls) {
-          const sim::Segment s = sim::make_segment(wd.from, wd.to);
-          const Vec2 rel = b.pos - s.p1;
-          const double foot = std::clamp(sim::dot(rel, s.u), 0.0, s.len);
-          if (sim::norm(rel - foot * s.u) < b.radius + 2) return true;
-        }
-        return false;
-      });
-      for (auto& b : def.balls) b.vel = 0.2 * b.vel;  // keep the mover clear for the run
       sim::World w(def, mode);
       const double cell = w.cell_size();
       std::size_t hits = 0, checked = 0;
@@ -336,6 +346,59 @@ TEST_CASE("cast_ray equals the brute-force reference on random rays", "[rays]") 
         }
       }
       CHECK(hits > checked / 2);
+    }
+  }
+}
+
+TEST_CASE("cast_rays gives cast_ray's answers, bit for bit, for rings and fans of rays", "[rays]") {
+  for (sim::Boundary boundary : {sim::Boundary::walls, sim::Boundary::periodic, sim::Boundary::none}) {
+    for (sim::Mode mode : {sim::Mode::exact, sim::Mode::step}) {
+      const std::uint64_t seed = 71 + static_cast<int>(boundary) * 10 + (mode == sim::Mode::step);
+      INFO("boundary " << static_cast<int>(boundary) << ", mode " << (mode == sim::Mode::step ? "step" : "exact")
+                       << ", seed " << seed);
+      const WorldDef def = ray_scene(boundary, seed);
+      const double W = def.arena.width, H = def.arena.height;
+      std::mt19937_64 rng(seed);
+      auto uni = [&](double a, double b) { return a + (b - a) * (static_cast<double>(rng() >> 11) * 0x1.0p-53); };
+      sim::World w(def, mode);
+      const double cell = w.cell_size();
+      std::size_t hits = 0, checked = 0;
+      std::vector<Vec2> dirs;
+      std::vector<RayHit> got;
+      for (int step = 1; step <= 6; ++step) {
+        w.advance_to(step * 0.2 + (step % 2 ? w.dt() / 3 : 0.0));
+        for (int q = 0; q < 150; ++q) {
+          Ray ray;
+          ray.origin = {uni(-0.1 * W, 1.1 * W), uni(-0.1 * H, 1.1 * H)};
+          if (q % 7 == 0) ray.origin = {std::floor(ray.origin.x / cell) * cell, std::floor(ray.origin.y / cell) * cell};  // a cell corner
+          // Mostly sensor ranges (a few cells); some long, some 0.
+          ray.range = q % 10 == 0 ? uni(0, 0.5 * W) : q % 10 == 1 ? 0.0 : uni(0, 3 * cell);
+          if (q % 5 == 0) ray.layers = def.turtles[1].layers, ray.self = 1;
+          if (q % 5 == 1) ray.origin = w.turtle(0).pos, ray.self = 0;
+          const int n = 1 + q % 24;
+          const double a0 = uni(0, 2 * M_PI);
+          dirs.clear();
+          for (int k = 0; k < n; ++k) dirs.push_back({std::sin(a0 + 2 * M_PI * k / n), std::cos(a0 + 2 * M_PI * k / n)});
+          if (q % 4 == 2) dirs.push_back({1.0, 0.0}), dirs.push_back({0.0, -1.0});  // along the cell lines
+          w.cast_rays(ray, dirs.data(), dirs.size(), got);
+          REQUIRE(got.size() == dirs.size());
+          for (std::size_t k = 0; k < dirs.size(); ++k) {
+            Ray one = ray;
+            one.dir = dirs[k];
+            const RayHit want = w.cast_ray(one);
+            INFO("t " << w.time() << " fan " << q << " ray " << k << " from (" << ray.origin.x << ", " << ray.origin.y
+                      << ") dir (" << one.dir.x << ", " << one.dir.y << ") range " << ray.range << ": got "
+                      << name(got[k].target) << " " << got[k].index << " at " << got[k].distance << ", want "
+                      << name(want.target) << " " << want.index << " at " << want.distance);
+            // Bit for bit: the same distance (kNever when nothing), target and index.
+            CHECK(got[k].distance == want.distance);
+            CHECK((!want.hit() || (got[k].target == want.target && got[k].index == want.index)));
+            ++checked;
+            hits += want.hit();
+          }
+        }
+      }
+      CHECK(hits > checked / 4);
     }
   }
 }

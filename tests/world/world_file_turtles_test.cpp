@@ -152,7 +152,7 @@ TEST_CASE("an unregistered controller names the registered ones") {
                                      {"id": "c", "pos": [150, 50], "controller": "wandr"}])");
   const tw::WorldFileError e = error_of(text);
   CHECK(std::string(e.what()) ==
-        "w.json: /turtles/2/controller: controller 'wandr' is not registered; known: braitenberg, mirror, script, spiral, square, "
+        "w.json: /turtles/2/controller: controller 'wandr' is not registered; known: braitenberg, epuck_swarm, mirror, script, spiral, square, "
         "tag_camera, tag_chaser, tag_evader, tag_random, tag_seeing, wall_follower, wander; did you mean 'wander'?");
   // Without a registry (load_world_file, parse_world: the bodies only) names are not checked.
   CHECK(tw::parse_world(text, "w.json").turtles.size() == 3);

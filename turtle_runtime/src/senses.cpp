@@ -64,13 +64,22 @@ void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& 
   ray.self = static_cast<std::uint32_t>(index);
   out.clear();
   out.reserve(sensor->bearings.size());
+  // The rays at once (World::cast_rays: cast_ray's answers, the grid near the turtle read once).
+  thread_local std::vector<sim::Vec2> dirs;
+  thread_local std::vector<sim::RayHit> cast;
+  dirs.clear();
+  for (const double b : sensor->bearings) {
+    // Behind a mirror the program's bearing b looks along 360 - b (Turtle::mirrored).
+    const double heading = st.heading + sim::to_radians(mirrored ? -b : b);
+    dirs.push_back({std::sin(heading), std::cos(heading)});  // Logo: 0 is +y, clockwise
+  }
+  w.cast_rays(ray, dirs.data(), dirs.size(), cast);
+  // The sense event's text only when there is a log to take it (a bench, a batch run without one).
+  const bool logged = server->log != nullptr;
   std::string ranges = "[", hits = "[", colours = "[";
   for (std::size_t k = 0; k < sensor->bearings.size(); ++k) {
     const double b = sensor->bearings[k];
-    // Behind a mirror the program's bearing b looks along 360 - b (Turtle::mirrored).
-    const double heading = st.heading + sim::to_radians(mirrored ? -b : b);
-    ray.dir = {std::sin(heading), std::cos(heading)};  // Logo: 0 is +y, clockwise
-    sim::RayHit hit = w.cast_ray(ray);
+    sim::RayHit hit = cast[k];
     if (hit.hit() && (sensor->noise > 0.0 || sensor->dropout > 0.0)) {
       // From the program's own stream, only for noisy sensors: noiseless runs draw nothing.
       auto uniform = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
@@ -85,7 +94,7 @@ void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& 
     }
     Reading r;
     r.bearing = b;
-    if (k > 0) {
+    if (logged && k > 0) {
       ranges += ", ";
       hits += ", ";
       colours += ", ";
@@ -97,17 +106,22 @@ void Agent::sense(const std::string& name, bool mirrored, std::vector<Reading>& 
                : hit.target == sim::RayTarget::wall_end ? "wall-end"
                : hit.target == sim::RayTarget::ball     ? "ball"
                                                         : "turtle";
-      ranges += sim::format_number(hit.distance);
-      hits += nlohmann::json(r.what).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+      if (logged) {
+        ranges += sim::format_number(hit.distance);
+        hits += nlohmann::json(r.what).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+      }
       if (sensor->camera) r.colour = server->colours.of(r.kind, r.what);
     } else {
-      ranges += "null";
-      hits += "null";
+      if (logged) {
+        ranges += "null";
+        hits += "null";
+      }
       if (sensor->camera) r.colour = sensor->background;
     }
-    if (sensor->camera) colours += nlohmann::json(r.colour).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    if (logged && sensor->camera) colours += nlohmann::json(r.colour).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     out.push_back(std::move(r));
   }
+  if (!logged) return;
   LogEvent e;
   e.t = w.time();
   e.kind = "sense";

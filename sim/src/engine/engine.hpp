@@ -187,6 +187,7 @@ class Engine final : public EngineBase {
   void teleport_turtle(std::size_t i, Vec2 pos, double heading) override;
   void balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const override;  // region.hpp
   RayHit cast_ray(const Ray& ray) const override;  // rays.hpp
+  void cast_rays(const Ray& ray, const Vec2* dirs, std::size_t n, RayHit* out) const override;  // rays.hpp
   bool turtle_alive(std::size_t k) const override {
     return k < turtles_.size() && bodies_.body[bodies_.balls() + k].cell != kNone;
   }

@@ -54,6 +54,7 @@ class EngineBase {
   virtual bool turtle_alive(std::size_t i) const = 0;
   virtual void balls_in_rect(Vec2 lo, Vec2 hi, std::vector<std::uint32_t>& out) const = 0;
   virtual RayHit cast_ray(const Ray& ray) const = 0;
+  virtual void cast_rays(const Ray& ray, const Vec2* dirs, std::size_t n, RayHit* out) const = 0;
   virtual double cell_size() const = 0;
   virtual int cells_x() const = 0;
   virtual int cells_y() const = 0;

@@ -190,5 +190,138 @@ RayHit Engine<F, kBallBall, kStep, kExtras>::cast_ray(const Ray& ray) const {
   }
 }
 
+// A sensor's rays at once (World::cast_rays). Whatever cast_ray finds for a ray lies in a cell of
+// its walk or within `pad` cells of one, and every cell of the walk up to the range lies in the
+// box of cells around [o - range, o + range] (one cell of slack for the floor's rounding, `pad`
+// for the discs and the step). So the objects listed in that box, each tested with cast_ray's own
+// closed forms, range test and tie rule, hold cast_ray's answer: the same distance, bit for bit,
+// for every ray (a superset of the objects the walk tests cannot give a nearer hit, or the walk
+// would have missed it). Each ray then costs its candidates, not a walk of the grid.
+template <Flight F, bool kBallBall, bool kStep, bool kExtras>
+void Engine<F, kBallBall, kStep, kExtras>::cast_rays(const Ray& ray, const Vec2* dirs, std::size_t n, RayHit* out) const {
+  const Vec2 o = ray.origin;
+  const double range = ray.range;
+  const double cw = grid_.cell_w(), ch = grid_.cell_h();
+  int pad = 1;
+  if constexpr (kStep) pad += static_cast<int>(std::ceil(step_.dmax / std::min(cw, ch)));
+  const int nx = grid_.nx(), ny = grid_.ny();
+  // The cell holding coordinate v (ring cells 0 and n + 1 take what lies beyond the arena), as
+  // cast_ray's cell_of finds it: floor(v / cell) + 1, corrected against the lines themselves.
+  auto cell_of = [&](double v, double cell, int cells, bool x_axis) {
+    const auto line = [&](int k) { return x_axis ? grid_.x_line(k) : grid_.y_line(k); };
+    int k = static_cast<int>(std::clamp(std::floor(v / cell) + 1.0, 0.0, cells + 1.0));
+    while (k > 0 && line(k - 1) > v) --k;
+    while (k <= cells && line(k) <= v) ++k;
+    return k;
+  };
+  bool batch = !arena_.periodic() && is_finite(o) && std::isfinite(range) && range >= 0.0 && n > 1;
+  int x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+  if (batch) {
+    // The walk steps into a cell when its line is within range, a distance rounded once or twice:
+    // the margin (far below a cell) takes in a cell whose line is that close to the box's edge.
+    const double mx = range + 1e-9 * (range + std::fabs(o.x) + cw), my = range + 1e-9 * (range + std::fabs(o.y) + ch);
+    x0 = std::max(0, cell_of(o.x - mx, cw, nx, true) - pad), x1 = std::min(nx + 1, cell_of(o.x + mx, cw, nx, true) + pad);
+    y0 = std::max(0, cell_of(o.y - my, ch, ny, false) - pad), y1 = std::min(ny + 1, cell_of(o.y + my, ch, ny, false) + pad);
+    // Each ray tests every candidate of the box, where a walk visits its first block and a strip
+    // of 2 pad + 1 cells per cell crossed; a candidate's test costs less than a cell's visit, and
+    // there are fewer discs than cells. So only while the box is at most 4 walks: a ring's short
+    // rays gathered, a lidar's long rays (a box of thousands of cells) walked.
+    const double walk = (2.0 * pad + 1.0) * (2.0 * pad + 1.0 + 2.0 * range / std::min(cw, ch));
+    batch = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1) <= 4.0 * walk;
+  }
+  if (!batch) {
+    Ray r = ray;
+    for (std::size_t k = 0; k < n; ++k) {
+      r.dir = dirs[k];
+      out[k] = cast_ray(r);
+    }
+    return;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const double len = norm(dirs[k]);
+    if (!(len > 0.0) || !std::isfinite(len)) throw std::invalid_argument("cast_ray: the direction must be finite and not zero");
+  }
+  const bool sees_default = ray.layers.collides_with(Layers{});
+  struct Disc {
+    Vec2 rel;
+    double r;
+    RayTarget target;
+    std::uint32_t index;
+  };
+  // Scratch reused across calls on this thread (a World is read by one thread at a time).
+  thread_local std::vector<Disc> discs;
+  thread_local std::vector<std::uint32_t> walls, ends;
+  discs.clear();
+  walls.clear();
+  ends.clear();
+  const std::uint32_t nb = bodies_.balls();
+  auto gather = [&](std::uint32_t head, RayTarget target) {
+    for (std::uint32_t i = head; i != kNone; i = bodies_.body[i].next) {
+      const Body& b = bodies_.body[i];
+      const std::uint32_t index = target == RayTarget::ball ? i : i - nb;
+      if (target == RayTarget::turtle && index == ray.self) continue;
+      if constexpr (kExtras) {
+        if (!(bodies_.layers.empty() ? sees_default : ray.layers.collides_with(bodies_.layers[i]))) continue;
+      } else if (!sees_default) {
+        continue;
+      }
+      // As cast_ray's rel (its shift is zero outside a periodic arena).
+      discs.push_back({motion_.pos(b, i, now_ - b.t) + Vec2{} - o, b.r, target, index});
+    }
+  };
+  for (int iy = y0; iy <= y1; ++iy)
+    for (int ix = x0; ix <= x1; ++ix) {
+      const int c = grid_.index(ix, iy);
+      const auto cell = static_cast<std::size_t>(c);
+      gather(bodies_.head[cell], RayTarget::ball);
+      if constexpr (kExtras) gather(bodies_.turtle_head[cell], RayTarget::turtle);
+      if (!grid_.has_walls(c)) continue;
+      walls.insert(walls.end(), grid_.walls_begin(c), grid_.walls_end(c));
+      ends.insert(ends.end(), grid_.ends_begin(c), grid_.ends_end(c));
+    }
+  // A wall passes through many cells: test it once.
+  std::sort(walls.begin(), walls.end());
+  walls.erase(std::unique(walls.begin(), walls.end()), walls.end());
+  std::sort(ends.begin(), ends.end());
+  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+  auto seen = [&](const Layers& l) {
+    if constexpr (kExtras) return ray.layers.collides_with(l);
+    else return sees_default;
+  };
+  std::erase_if(walls, [&](std::uint32_t w) { return !seen(walls_.layers[w]); });
+  std::erase_if(ends, [&](std::uint32_t e) { return !seen(walls_.end_layers[e]); });
+
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec2 u = dirs[k] / norm(dirs[k]);
+    RayHit best;
+    auto consider = [&](double d, RayTarget target, std::uint32_t index) {
+      if (!(d <= range)) return;
+      if (d < best.distance || (d == best.distance && (target < best.target || (target == best.target && index < best.index))))
+        best = {d, target, index};
+    };
+    for (const Disc& d : discs) {
+      if (!(std::fabs(sim::cross(d.rel, u)) < d.r)) continue;
+      consider(ray_disc(d.rel, u, d.r), d.target, d.index);
+    }
+    for (const std::uint32_t w : walls) {
+      Segment s = walls_.segments[w];
+      s.p1 += Vec2{};
+      consider(ray_segment(o - s.p1, u, s), RayTarget::wall, w);
+    }
+    for (const std::uint32_t e : ends) consider(ray_point(o - (walls_.ends[e].p + Vec2{}), u), RayTarget::wall_end, walls_.ends[e].wall);
+    if constexpr (kExtras) {
+      for (const Mover& m : schedule_.movers) {
+        const std::uint32_t w = m.wall;
+        if (!seen(walls_.layers[w])) continue;
+        const Segment s = m.segment_at(walls_.segments[w], now_);
+        consider(ray_segment(o - s.p1, u, s), RayTarget::wall, w);
+        consider(ray_point(o - s.p1, u), RayTarget::wall_end, w);
+        consider(ray_point(o - (s.p1 + s.len * s.u), u), RayTarget::wall_end, w);
+      }
+    }
+    out[k] = best;
+  }
+}
+
 }  // namespace
 }  // namespace turtlegas::sim::detail
