@@ -393,8 +393,8 @@ nlohmann::json Observer::result() const {
         frac += static_cast<double>(c) / n_balls *
                 (std::exp(-m * lo * lo / (2.0 * T)) - std::exp(-m * hi * hi / (2.0 * T)));
       else if (T > 0.0) {
-        auto cdf = [&](double v) {
-          const double x = v * std::sqrt(m / T);
+        auto cdf = [&, mass = m](double v) {  // (a structured binding is captured by copy: clang 14)
+          const double x = v * std::sqrt(mass / T);
           return std::erf(x / std::sqrt(2.0)) - std::sqrt(2.0 / 3.14159265358979323846) * x * std::exp(-x * x / 2.0);
         };
         frac += static_cast<double>(c) / n_balls * (cdf(hi) - cdf(lo));

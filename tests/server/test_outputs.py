@@ -83,7 +83,9 @@ def test_runaway_pauses_when_alone():
             w.request({"type": "resume"})
             time.sleep(0.5)
             t2 = w.request({"type": "ping"})["t"]
-            check(t1 > t0 and t2 > t1, "the world ran, paused and went on after resume: %r %r %r" % (t0, t1, t2))
+            # (t1 may equal t0: under load the world can pause before it takes a step after the
+            # first ping; what matters is that it ran before, held still, and runs after resume.)
+            check(t0 > 0 and t1 >= t0 and t2 > t1, "the world ran, paused and went on after resume: %r %r %r" % (t0, t1, t2))
             w.close()
         # With --until the run is bounded: no warning, and leaving does not pause it.
         with Server(world("gas_1000.json"), "--speed", "max", "--until", "0.2", "--events", events) as s:

@@ -281,8 +281,6 @@ TEST_CASE("cast_ray through a periodic arena's seams", "[rays]") {
 WorldDef ray_scene(sim::Boundary boundary, std::uint64_t seed) {
   WorldDef def = random_gas(500, 0.12, 3.0, 60.0, seed, boundary);
   const double W = def.arena.width, H = def.arena.height;
-  std::mt19937_64 rng(seed);
-  auto uni = [&](double a, double b) { return a + (b - a) * (static_cast<double>(rng() >> 11) * 0x1.0p-53); };
   // Some balls taken out to make room for walls and turtles; walls with ends of their own.
   for (int k = 0; k < 4; ++k) {
     const double y = (0.2 + 0.2 * k) * H;

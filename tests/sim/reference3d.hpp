@@ -19,6 +19,8 @@
 #include <random>
 #include <vector>
 
+#include <catch2/catch.hpp>
+
 #include "turtlegas/sim/toi3.hpp"
 #include "turtlegas/sim/vec3.hpp"
 #include "turtlegas/sim/world3d.hpp"
@@ -228,6 +230,42 @@ inline sim::World3Def random_scene(std::uint64_t seed, int n, bool gravity, bool
     if (ok) def.spheres.push_back({x, {u(-2, 2), u(-2, 2), u(-2, 2)}, r, u(0.5, 2.0), electric || magnetic ? u(-1.5, 1.5) : 0.0});
   }
   return def;
+}
+
+/// Runs def to `until` in the engine and in the reference and requires the two to agree event
+/// for event (kind, bodies, wall feature, time within 1e-7) over the first 40 events at most, at
+/// least 15: hard spheres are chaotic, and the reference's 1e-12 r contact tolerance grows by the
+/// ratio of free path to radius at each collision. Counts the compared events by kind into `kinds`
+/// (indexed by Event3Kind) and returns them (the engine's) with the engine's overlap at the end.
+struct Agreed {
+  std::vector<sim::Event3> events;
+  double overlap = 0.0;  ///< World3::max_overlap_now at `until`
+};
+inline Agreed agree_with_reference(const sim::World3Def& def, double until, int (&kinds)[6]) {
+  sim::World3 w(def);
+  std::vector<sim::Event3> fast, slow;
+  w.advance_to(until, &fast);
+  Reference3 ref(def);
+  ref.run(until, slow, fast.size() + 1);
+  const std::size_t n = std::min<std::size_t>(std::min(fast.size(), slow.size()), 40);
+  REQUIRE(n >= 15);
+  for (std::size_t k = 0; k < n; ++k) {
+    INFO("event " << k << " t " << fast[k].t << " vs " << slow[k].t);
+    REQUIRE(fast[k].kind == slow[k].kind);
+    ++kinds[static_cast<int>(fast[k].kind)];
+    const auto lo = std::min(fast[k].a, fast[k].b), hi = std::max(fast[k].a, fast[k].b);
+    if (fast[k].kind == sim::Event3Kind::ball_ball) {
+      REQUIRE(lo == slow[k].a);
+      REQUIRE(hi == slow[k].b);
+    } else {
+      REQUIRE(fast[k].a == slow[k].a);
+      REQUIRE(fast[k].b == slow[k].b);
+      REQUIRE(fast[k].c == slow[k].c);
+    }
+    REQUIRE(std::abs(fast[k].t - slow[k].t) < 1e-7);
+  }
+  fast.resize(n);
+  return {fast, w.max_overlap_now()};
 }
 
 }  // namespace turtlegas::test3

@@ -296,7 +296,6 @@ struct World3::Impl {
     arm_check();
   }
 
-  int n_cells(int a) const { return n[a]; }
   std::uint32_t cell_index(int cx, int cy, int cz) const {
     return static_cast<std::uint32_t>((cz * n[1] + cy) * n[0] + cx);
   }
@@ -568,16 +567,23 @@ struct World3::Impl {
     if (best < before) cand = best;
   }
 
+  // Cell k (column, row, layer) of a neighbourhood brought into the grid: false outside an arena
+  // that is not periodic, else wrapped, with `shift` the periodic image's offset.
+  bool wrap_cell(int* k, Vec3& shift) const {
+    for (int a = 0; a < 3; ++a) {
+      if (k[a] >= 0 && k[a] < n[a]) continue;
+      if (boundary != Boundary3::periodic) return false;
+      shift[a] = k[a] < 0 ? -size[a] : size[a];
+      k[a] = (k[a] + n[a]) % n[a];
+    }
+    return true;
+  }
+
   // The spheres of one cell against b (at now): the earliest approach below cand.
   void scan_cell(std::uint32_t i, Record& b, int cx, int cy, int cz, double& cand) {
     Vec3 shift;
     int k[3] = {cx, cy, cz};
-    for (int a = 0; a < 3; ++a) {
-      if (k[a] >= 0 && k[a] < n[a]) continue;
-      if (boundary != Boundary3::periodic) return;
-      shift[a] = k[a] < 0 ? -size[a] : size[a];
-      k[a] = (k[a] + n[a]) % n[a];
-    }
+    if (!wrap_cell(k, shift)) return;
     for (std::uint32_t j = head[cell_index(k[0], k[1], k[2])]; j != kNone; j = rec[j].next) {
       if (j == i) continue;
       const Record& o = rec[j];
@@ -705,12 +711,7 @@ struct World3::Impl {
     Record& b = rec[i];
     Vec3 shift;
     int k[3] = {cx, cy, cz};
-    for (int a = 0; a < 3; ++a) {
-      if (k[a] >= 0 && k[a] < n[a]) continue;
-      if (boundary != Boundary3::periodic) return;
-      shift[a] = k[a] < 0 ? -size[a] : size[a];
-      k[a] = (k[a] + n[a]) % n[a];
-    }
+    if (!wrap_cell(k, shift)) return;
     for (std::uint32_t j = head[cell_index(k[0], k[1], k[2])]; j != kNone; j = rec[j].next) {
       if (j == i) continue;
       const Record& o = rec[j];
@@ -950,14 +951,7 @@ struct World3::Impl {
         for (int dx = -1; dx <= 1 && reach_ok; ++dx) {
           int q[3] = {c[0] + dx, c[1] + dy, c[2] + dz};
           Vec3 shift;
-          bool skip = false;
-          for (int ax = 0; ax < 3; ++ax) {
-            if (q[ax] >= 0 && q[ax] < n_cells(ax)) continue;
-            if (boundary != Boundary3::periodic) skip = true;
-            shift[ax] = q[ax] < 0 ? -size[ax] : size[ax];
-            q[ax] = (q[ax] + n_cells(ax)) % n_cells(ax);
-          }
-          if (skip) continue;
+          if (!wrap_cell(q, shift)) continue;
           for (std::uint32_t j = head[cell_index(q[0], q[1], q[2])]; j != kNone; j = rec[j].next) {
             if (j == i) continue;
             const Record& o = rec[j];
