@@ -110,7 +110,9 @@ void read_observe(Spec& spec, const nlohmann::ordered_json& o, const std::string
   };
   if (!o.is_object()) throw bad("", "an object: {\"from\": T, \"window\": S, \"samples\": K, ...} (docs/sweeps.md)");
   formats::ObserveOptions opt;
-  for (const auto& [k, v] : o.items()) {
+  for (const auto& item : o.items()) {
+    const std::string& k = item.key();  // (not a structured binding: the lambdas below use them, clang 14)
+    const auto& v = item.value();
     auto number = [&] {
       if (!v.is_number()) throw bad("/" + k, "a number");
       return v.get<double>();
