@@ -198,23 +198,38 @@ class ModuleTest(unittest.TestCase):
 
     def test_run_releases_the_gil(self):
         w = turtlegas.World.load(periodic_gas(count=2000, side=200))
-        started = threading.Event()
+        # The run must last far longer than the interpreter's switch interval (5 ms), on any
+        # machine: a fixed simulated time finished inside a 50 ms sleep on a fast one. Time one
+        # simulated second first, then ask for about half a second of wall time.
+        t = time.perf_counter()
+        w.run(1.0)
+        per_unit = max(time.perf_counter() - t, 1e-6)
+        until = w.time + min(max(0.5 / per_unit, 1.0), 10000.0)
+        window = {}
 
         def work():
-            started.set()
-            w.run(30.0)
+            window["t0"] = time.perf_counter()
+            w.run(until)
+            window["t1"] = time.perf_counter()
 
+        # The main thread spins and marks each millisecond in which it ran. Held by C++ code, the
+        # GIL would keep it out for the whole run but the edges (one switch interval each).
+        ms = [0] * 20000
+        start = time.perf_counter()
         worker = threading.Thread(target=work)
         worker.start()
-        started.wait()
-        time.sleep(0.05)  # let the worker enter run()
-        spins = 0
         while worker.is_alive():
-            spins += 1
+            k = int((time.perf_counter() - start) * 1000)
+            if k < len(ms):
+                ms[k] += 1
         worker.join()
-        self.assertGreater(w.stats["events"], 10 ** 5)
-        # Held by C++ code, the GIL would not let this thread in at all while the engine runs.
-        self.assertGreater(spins, 1000, "the main thread barely ran while the world ran")
+        self.assertEqual(w.time, until)
+        first = int((window["t0"] - start) * 1000) + 10
+        last = int((window["t1"] - start) * 1000) - 10
+        self.assertGreater(last - first, 100, "the run was too short to tell")
+        ran = sum(1 for k in range(first, min(last, len(ms))) if ms[k] > 0)
+        self.assertGreater(ran, 0.25 * (min(last, len(ms)) - first),
+                           "the main thread barely ran while the world ran")
 
     def test_run_refuses_going_back(self):
         w = turtlegas.World.load("worlds/gas.json")
