@@ -422,3 +422,32 @@ TEST_CASE("a turtle that touches a slanted wall, turns along it and drives on is
     }
   }
 }
+
+// The world fuzzer's finding (issue 29): a command whose end lies 10^105 s away (forward 2.4e107
+// at speed 60, or an arc of radius 7.8e58) cast its control-step index, 1.2e107, to a 64-bit
+// integer (undefined behaviour; UBSan in the debug-asan subset stops on it). The command runs on
+// as any other, and its end is not snapped to a step no run reaches.
+TEST_CASE("a command that ends astronomically far away runs on and ends nothing early", "[turtle]") {
+  for (Mode mode : kModes) {
+    INFO(name(mode));
+    WorldDef d = box(1000, 1000);
+    d.turtles.push_back(turtle("far", {100, 100}, 90, 10, 60));   // heading 90: +x
+    d.turtles.push_back(turtle("still", {500, 500}, 0, 10, 60));
+    d.turtles.push_back(turtle("arc", {500, 200}, 90, 10, 60));
+    World w(d, mode);
+    w.command_turtle(0, move(2.4e107));
+    w.command_turtle(1, {TurtleCommand::Kind::wait, 1e300});
+    TurtleCommand arc{TurtleCommand::Kind::arc, 7.8e58 * 1e-3 / 60.0};
+    arc.speed = 60.0;
+    arc.rate = 60.0 / 7.8e58;
+    w.command_turtle(2, arc);
+    w.advance_to(2.0);
+    const TurtleState far = w.turtle(0), still = w.turtle(1), bent = w.turtle(2);
+    CHECK(far.pos.x == Approx(220).epsilon(1e-12));
+    CHECK(far.busy);
+    CHECK(still.busy);
+    CHECK(still.pos.x == 500.0);
+    CHECK(bent.pos.x == Approx(620).epsilon(1e-12));  // a circle of radius 7.8e58 is a line here
+    CHECK(bent.busy);
+  }
+}

@@ -117,7 +117,10 @@ std::uint64_t Turtles::snap_end(std::size_t k, double end, double t_base, double
   if (busy_[k] == 0 || !(end < kNever)) return kNoStep;
   const double t = t_base + end;
   const double j = std::round(t / dt);
-  if (j < 1.0) return kNoStep;
+  // An end 2^53 or more steps away (a hostile `forward 1e107`) is not snapped: no run reaches
+  // it, step indices past 2^53 are not exact in the double control_boundary multiplies, and the
+  // index would not fit the integer (the world fuzzer's finding, issue 29).
+  if (!(j >= 1.0 && j < 0x1p53)) return kNoStep;
   const auto step = static_cast<std::uint64_t>(j);
   if (std::abs(t - control_boundary(step, dt)) > kCommandSnap * std::max(t, dt)) return kNoStep;
   end_step[k] = step;
