@@ -16,6 +16,7 @@
 
 #include "cli_common.hpp"
 #include "output_file.hpp"
+#include "overlap_budget.hpp"
 #include "run_loop.hpp"
 #include "signals.hpp"
 #include "turtlegas/formats/observables.hpp"
@@ -122,6 +123,22 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
   });
   if (opt.max_events) world->set_event_limit(*opt.max_events);
   Stopped end{Stop::until, 0};
+  // The overlap self-check as 2-D's (docs/cli.md, "The overlap self-check"): with the stats asked
+  // for, the deepest overlap at the end and at evenly spaced instants of the run, as many as the
+  // event budget allows (all of them with --overlap-samples).
+  const bool want_stats = opt.stats || !opt.stats_json.empty();
+  const std::uint64_t instants = !want_stats ? 0 : opt.overlap_samples ? *opt.overlap_samples : overlap_instants(opt.until, w.def.dt);
+  SampleBudget budget(world->sphere_count(), world->wall_count(), opt.overlap_samples.has_value());
+  std::uint64_t next_instant = 1;
+  auto instant = [&](std::uint64_t k) { return opt.until * static_cast<double>(k) / static_cast<double>(instants); };
+  double sampled = 0.0, check_seconds = 0.0, sampled_at = -1.0;
+  const std::uint64_t events_at_start = world->events();
+  auto measure = [&] {
+    const auto check_start = std::chrono::steady_clock::now();
+    const double o = world->max_overlap_now();
+    check_seconds += seconds_since(check_start);
+    return o;
+  };
   // Chunks of at most 10^5 events' worth of time would need a rate; a chunk of simulated time
   // that shrinks when the log grows large keeps memory bounded instead.
   double chunk = std::max(opt.until / 1000.0, 1e-9);
@@ -134,7 +151,8 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
       end = {Stop::max_wall_seconds, 0};
       break;
     }
-    const double t = std::min(opt.until, world->time() + chunk);
+    double t = std::min(opt.until, world->time() + chunk);
+    if (next_instant <= instants) t = std::min(t, instant(next_instant));
     log.clear();
     try {
       if (observer) observer->advance_to(t);  // stops at its sample times on the way
@@ -146,6 +164,10 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
       end = {Stop::max_events, 0};
     }
     progress.update(world->time(), world->events(), "");
+    if (next_instant <= instants && end.first == Stop::until && world->time() >= instant(next_instant)) {
+      while (next_instant <= instants && world->time() >= instant(next_instant)) ++next_instant;
+      if (budget.take(world->events() - events_at_start)) sampled = std::max(sampled, measure()), sampled_at = world->time();
+    }
     if (events_file) {
       std::string text;
       for (const sim::Event3& e : log) {
@@ -169,7 +191,7 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
       if (world->alive(i)) balls.push_back({{"id", w.ball_ids[i]}, {"pos", vec(world->position(i))}, {"vel", vec(world->velocity(i))}});
     state_file->stream() << nlohmann::json{{"t", world->time()}, {"balls", balls}, {"turtles", nlohmann::json::array()}}.dump(1) + "\n";
   }
-  const double overlap = world->sphere_count() <= 4096 ? world->max_overlap_now() : 0.0;
+  const double overlap = !want_stats ? 0.0 : sampled_at == world->time() ? sampled : std::max(sampled, measure());
   nlohmann::json stats{{"dimensions", 3},
                        {"mode", std::string(sim::to_string(w.def.mode))},
                        {"collisions", world->collisions()},
@@ -177,7 +199,9 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
                        {"wall_seconds", wall},
                        {"energy_start", e0},
                        {"energy_end", world->energy()},
-                       {"max_overlap", std::max(overlap, 0.0)},
+                       {"max_overlap", overlap},
+                       {"overlap_samples", budget.taken},
+                       {"check_seconds", check_seconds},
                        {"max_contact_error", world->max_contact_error()},
                        {"wedged", world->wedged()},
                        {"energy_wedged", world->energy_wedged()}};
@@ -186,9 +210,11 @@ int run3d(const RunOptions& opt, const world::World3File& file) {
   if (moving) stats["wall_work"] = world->wall_work();  // energy_end - energy_start at e = 1 (docs/physics.md)
   if (stats_file) stats_file->stream() << stats.dump(1) + "\n";
   if (opt.stats)
-    std::printf("3-D %s run to t = %g: %llu collisions, %llu events, energy %.15g -> %.15g, max overlap %.3g r, %.3f s\n",
+    std::printf("3-D %s run to t = %g: %llu collisions, %llu events, energy %.15g -> %.15g, max overlap %.3g r "
+                "(the end and %llu instants), %.3f s (the overlap self-check's %.3f s included)\n",
                 std::string(sim::to_string(w.def.mode)).c_str(), world->time(), static_cast<unsigned long long>(world->collisions()),
-                static_cast<unsigned long long>(world->events()), e0, world->energy(), std::max(overlap, 0.0), wall);
+                static_cast<unsigned long long>(world->events()), e0, world->energy(), overlap,
+                static_cast<unsigned long long>(budget.taken), wall, check_seconds);
   if (opt.stats && moving) std::printf("  moving walls gave the spheres %.15g of energy (wall_work)\n", world->wall_work());
   if (opt.stats && world->wedged() > 0)
     std::printf("  squeezed %llu wedged, taking %.15g of energy (docs/physics.md, \"3-D: wedged spheres\")\n",

@@ -22,6 +22,7 @@
 #include <unordered_map>
 
 #include "engine3d/polygon3.hpp"
+#include "engine3d/overlap3.hpp"
 #include "event_queue.hpp"
 #include "turtlegas/sim/roots.hpp"
 #include "turtlegas/sim/toi3.hpp"
@@ -1108,23 +1109,18 @@ double World3::wall_area(std::size_t w) const {
 
 double World3::max_overlap_now() const {
   const Impl& m = *impl_;
-  double worst = 0.0;
-  const std::size_t n = m.rec.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!m.rec[i].alive) continue;
-    const Vec3 xi = position(i);
-    for (std::size_t j = i + 1; j < n && n <= 4096; ++j) {
-      if (!m.rec[j].alive) continue;
-      Vec3 d = position(j) - xi;
-      if (m.boundary == Boundary3::periodic)
-        for (int k = 0; k < 3; ++k) d[k] -= m.size[k] * std::nearbyint(d[k] / m.size[k]);
-      const double gap = m.rec[i].r + m.rec[j].r - norm(d);
-      worst = std::max(worst, gap / std::min(m.rec[i].r, m.rec[j].r));
-    }
-    for (std::uint32_t k = 0; k < m.walls.size(); ++k)
-      worst = std::max(worst, (m.rec[i].r - m.walls[k].distance(xi - m.shift_of(k))) / m.rec[i].r);
-  }
-  return worst;
+  std::array<double, 3> period{};
+  if (m.boundary == Boundary3::periodic)
+    for (int a = 0; a < 3; ++a) period[a] = m.size[a];
+  detail::Overlap3Scratch scratch;
+  return detail::deepest_overlap3(
+      scratch, m.rec.size(), [&](std::size_t i) { return position(i); }, [&](std::size_t i) { return m.rec[i].r; },
+      [&](std::size_t i) { return m.rec[i].alive; }, period, [&](std::uint32_t i, const Vec3& x) {
+        double worst = 0.0;
+        for (std::uint32_t k = 0; k < m.walls.size(); ++k)
+          worst = std::max(worst, (m.rec[i].r - m.walls[k].distance(x - m.shift_of(k))) / m.rec[i].r);
+        return worst;
+      });
 }
 
 }  // namespace turtlegas::sim

@@ -132,8 +132,9 @@ class World3 {
   std::uint64_t events() const;      ///< every event served, cell crossings and stale ones included
   /// The largest |distance - contact distance| / radius at the contacts served so far.
   double max_contact_error() const;
-  /// The largest overlap now, over every pair and wall, relative to the smaller radius (O(N^2)
-  /// over pairs for up to 4096 spheres, through the grid above).
+  /// The largest overlap now, over every pair and wall, relative to the smaller radius; 0 when
+  /// nothing overlaps. O(N) over pairs (an independent hashed grid, engine3d/overlap3.hpp) plus
+  /// N x walls, at any N.
   double max_overlap_now() const;
   /// Sum over served sphere-sphere collisions of m1 m2 / (m1 + m2) * (Δv . d): the collision
   /// virial's numerator, for the pressure of a periodic gas (docs/physics.md).
