@@ -96,6 +96,29 @@ TEST_CASE("check and run of worlds/gas3d_box.json") {
   CHECK(nlohmann::json::parse(read(dir.path / "st0.json"))["max_overlap"].get<double>() < 1e-9);
 }
 
+TEST_CASE("run of a 3-D world with --stats: the overlap self-check samples instants and changes nothing") {
+  TempDir dir;
+  // --overlap-samples 3: the instants 2/3, 4/3 and the end, each every sphere against every wall
+  // and (through the hashed grid) every other sphere; the run is cut there, its log unchanged.
+  const auto plain = run(dir, {"run", "worlds/gas3d_box.json", "--until", "2", "--events", (dir.path / "a.jsonl").string()});
+  REQUIRE(plain.code == 0);
+  const auto r = run(dir, {"run", "worlds/gas3d_box.json", "--until", "2", "--overlap-samples", "3", "--events",
+                           (dir.path / "b.jsonl").string(), "--stats-json", (dir.path / "st.json").string(), "--stats"});
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(read(dir.path / "a.jsonl") == read(dir.path / "b.jsonl"));
+  CHECK(!read(dir.path / "a.jsonl").empty());
+  const auto st = nlohmann::json::parse(read(dir.path / "st.json"));
+  CHECK(st["overlap_samples"] == 3);
+  CHECK(st["check_seconds"].get<double>() >= 0.0);
+  CHECK(st["max_overlap"].get<double>() < 1e-9);
+  CHECK(contains(r.out, "the end and 3 instants"));
+  // Without --overlap-samples the budget decides; a small gas is measured at its control steps.
+  const auto b = run(dir, {"run", "worlds/gas3d_box.json", "--until", "1", "--stats-json", (dir.path / "st2.json").string()});
+  REQUIRE(b.code == 0);
+  CHECK(nlohmann::json::parse(read(dir.path / "st2.json"))["overlap_samples"].get<int>() >= 1);
+}
+
 TEST_CASE("run --mode step of a 3-D world: the kick at each step's end, the floor met inside a step") {
   // worlds/tests/fall_step3d.json's sphere (z_n = 9 - n (n - 1) / 128 at dt = 1/16): the floor at
   // t = 2.03125 in step mode, t = 2 in exact mode (9 - 2 t^2 = 1); --dt halves the step.
